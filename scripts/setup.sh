@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Install everything shadermatrix needs on Debian 12, as root. Idempotent; pinned.
+# Versions live here and in pyproject.toml / requirements.lock; README says why.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# Debian 12 (bookworm) packages, pinned to the versions in bookworm + security.
+APT_PKGS=(
+  "mesa-vulkan-drivers=22.3.6-1+deb12u2"   # lavapipe (software Vulkan 1.3) and RADV
+  "libvulkan1=1.3.239.0-1"                 # Vulkan loader
+  "vulkan-validationlayers=1.3.239.0-2"    # VK_LAYER_KHRONOS_validation for tests
+  "glslc=2023.2-1"                         # shaderc: batches many GLSL/HLSL compiles in one process
+  "glslang-tools=12.0.0-2"                 # glslangValidator (HLSL front end, version reporting)
+  "spirv-tools=2023.1-2"                   # spirv-val, spirv-opt, spirv-as, spirv-dis
+)
+NAGA_VERSION=30.0.1
+
+missing=()
+for spec in "${APT_PKGS[@]}"; do
+  pkg=${spec%%=*}; want=${spec#*=}
+  have=$(dpkg-query -W -f='${Status} ${Version}' "$pkg" 2>/dev/null || true)
+  [[ "$have" == "install ok installed $want" ]] || missing+=("$spec")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# naga (WGSL front end + validator), pinned, from crates.io.
+if ! command -v naga >/dev/null 2>&1 || [[ "$(naga --version 2>/dev/null)" != "$NAGA_VERSION" ]]; then
+  if ! command -v cargo >/dev/null 2>&1; then
+    echo "setup: cargo is needed to install naga-cli $NAGA_VERSION — install Rust (rustup) first" >&2
+    exit 1
+  fi
+  echo "setup: cargo install naga-cli $NAGA_VERSION (about a minute)"
+  cargo install naga-cli --locked --version "$NAGA_VERSION" --root "$PWD/.tools" -q
+fi
+
+# Python environment in .venv with the package installed editable.
+PY=${PYTHON:-python3}
+if [[ ! -x .venv/bin/python ]]; then
+  "$PY" -m venv .venv
+fi
+stamp=.venv/.setup-stamp
+want_stamp=$(cat requirements.lock pyproject.toml | sha256sum | cut -d' ' -f1)
+if [[ ! -f $stamp || "$(cat $stamp)" != "$want_stamp" ]]; then
+  echo "setup: installing Python packages into .venv"
+  .venv/bin/python -m pip install -q --disable-pip-version-check -r requirements.lock
+  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+  echo "$want_stamp" > "$stamp"
+fi
