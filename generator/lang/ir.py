@@ -1,0 +1,235 @@
+"""Typed intermediate representation of brick functions.
+
+Every node carries its source location; every expression carries its type.
+Emitters (generator/targets/) walk these nodes; nothing else reads brick text.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from .types import Type
+
+
+@dataclass(frozen=True)
+class Loc:
+    path: str
+    line: int
+    col: int
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line}:{self.col}"
+
+
+# ---------------------------------------------------------------- expressions
+
+@dataclass
+class Expr:
+    ty: Type
+    loc: Loc
+
+
+@dataclass
+class Const(Expr):
+    value: Any  # float, int or bool
+
+
+@dataclass
+class Var(Expr):
+    """A local, a parameter, a named constant (PI) or a global resource."""
+
+    name: str
+    scope: str = "local"  # "local" | "param" | "const" | "global"
+
+
+@dataclass
+class Unary(Expr):
+    op: str  # "-" | "not"
+    operand: Expr
+
+
+@dataclass
+class Binary(Expr):
+    """Arithmetic (+ - * / %), comparison (< <= > >= == !=), logic (and or).
+
+    Mixed scalar/vector and matrix/vector operands are allowed where every
+    target allows them; the checker has already rejected everything else.
+    """
+
+    op: str
+    lhs: Expr
+    rhs: Expr
+
+
+@dataclass
+class Call(Expr):
+    """A call to a brick function (by its linked name)."""
+
+    func: str
+    args: list[Expr]
+
+
+@dataclass
+class Intrinsic(Expr):
+    """A call to an entry of the intrinsics table (generator/lang/intrinsics.py)."""
+
+    name: str
+    args: list[Expr]
+
+
+@dataclass
+class Construct(Expr):
+    """vec3(x, y, z), vec3(s) splat, mat3(c0, c1, c2) columns, float(i), Struct(a, b)."""
+
+    args: list[Expr]
+
+
+@dataclass
+class Swizzle(Expr):
+    base: Expr
+    components: str  # over "xyzw"
+
+
+@dataclass
+class Member(Expr):
+    base: Expr
+    field: str
+
+
+@dataclass
+class Index(Expr):
+    base: Expr
+    index: Expr
+
+
+@dataclass
+class Select(Expr):
+    """`a if cond else b`; emitted as ?: or WGSL select()."""
+
+    cond: Expr
+    if_true: Expr
+    if_false: Expr
+
+
+# ---------------------------------------------------------------- statements
+
+@dataclass
+class Stmt:
+    loc: Loc
+
+
+@dataclass
+class Decl(Stmt):
+    """First assignment of a local: declares it in the enclosing block."""
+
+    name: str
+    ty: Type
+    value: Expr
+
+
+@dataclass
+class Assign(Stmt):
+    target: Expr  # Var, single-component Swizzle, Member, or Index
+    op: str | None  # None for =, "+" for +=, ...
+    value: Expr
+
+
+@dataclass
+class If(Stmt):
+    cond: Expr
+    then: list[Stmt]
+    orelse: list[Stmt]
+
+
+@dataclass
+class For(Stmt):
+    """for var in range(count): count is a compile-time int constant."""
+
+    var: str
+    count: int
+    body: list[Stmt]
+
+
+@dataclass
+class Return(Stmt):
+    value: Expr | None
+
+
+# ---------------------------------------------------------------- top level
+
+@dataclass
+class Param:
+    name: str
+    ty: Type
+    loc: Loc
+    assigned: bool = False  # the body assigns it (WGSL parameters are immutable)
+
+
+@dataclass
+class Function:
+    name: str
+    params: list[Param]
+    ret: Type
+    body: list[Stmt]
+    loc: Loc
+    doc: str = ""
+    calls: list[str] = field(default_factory=list)  # brick functions it calls, in order
+
+    def signature(self) -> str:
+        args = ", ".join(f"{p.name}: {p.ty}" for p in self.params)
+        return f"{self.name}({args}) -> {self.ret}"
+
+
+@dataclass
+class Module:
+    """One parsed brick file."""
+
+    path: str
+    doc: str
+    meta: dict
+    meta_loc: Loc
+    structs: dict[str, Type]
+    constants: dict[str, Const]
+    functions: dict[str, Function]
+    source_hash: str
+
+
+# ---------------------------------------------------------------- traversal
+
+def children(node) -> list:
+    """Direct sub-nodes of an expression or statement (for generic walks)."""
+    if isinstance(node, (Unary,)):
+        return [node.operand]
+    if isinstance(node, Binary):
+        return [node.lhs, node.rhs]
+    if isinstance(node, (Call, Intrinsic, Construct)):
+        return list(node.args)
+    if isinstance(node, (Swizzle, Member)):
+        return [node.base]
+    if isinstance(node, Index):
+        return [node.base, node.index]
+    if isinstance(node, Select):
+        return [node.cond, node.if_true, node.if_false]
+    if isinstance(node, Decl):
+        return [node.value]
+    if isinstance(node, Assign):
+        return [node.target, node.value]
+    if isinstance(node, If):
+        return [node.cond, *node.then, *node.orelse]
+    if isinstance(node, For):
+        return list(node.body)
+    if isinstance(node, Return):
+        return [node.value] if node.value is not None else []
+    return []
+
+
+def walk(node):
+    """Pre-order walk over a node and everything below it."""
+    yield node
+    for c in children(node):
+        yield from walk(c)
+
+
+def walk_body(stmts):
+    for s in stmts:
+        yield from walk(s)

@@ -1,0 +1,211 @@
+"""Brick files (Python syntax) → typed IR. Parsed with `ast`; never imported or executed.
+
+A brick file holds a docstring, a literal `BRICK = {...}` metadata dict (read
+with ast.literal_eval), optional UPPERCASE literal constants, optional structs
+(`class Name:` with annotated fields only) and typed pure functions.
+"""
+from __future__ import annotations
+
+import ast
+import hashlib
+from dataclasses import dataclass
+
+from . import ir
+from .errors import SourceError
+from .intrinsics import CONSTANTS
+from .typecheck import Checker
+from .types import BUILTIN_TYPES, Type, struct
+
+
+@dataclass(frozen=True)
+class Signature:
+    """The signature of a function defined outside the module being parsed (slots, other bricks)."""
+
+    params: tuple  # ((name, Type), ...)
+    ret: Type
+
+
+def _loc(path: str, node) -> ir.Loc:
+    return ir.Loc(path, getattr(node, "lineno", 1), getattr(node, "col_offset", 0) + 1)
+
+
+def _err(path, node, message, hint=""):
+    loc = _loc(path, node)
+    return SourceError(loc.path, loc.line, loc.col, message, hint)
+
+
+def _syntax_tree(text: str, path: str) -> ast.Module:
+    try:
+        return ast.parse(text, filename=path)
+    except SyntaxError as e:
+        raise SourceError(path, e.lineno or 1, e.offset or 1, f"syntax error: {e.msg}",
+                          "a brick is written in a small typed subset of Python syntax") from None
+
+
+def read_meta(text: str, path: str) -> tuple[dict, ir.Loc, str]:
+    """Read only a brick's docstring and BRICK metadata (no function bodies)."""
+    tree = _syntax_tree(text, path)
+    doc = ast.get_docstring(tree) or ""
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "BRICK" for t in node.targets):
+            try:
+                meta = ast.literal_eval(node.value)
+            except (ValueError, SyntaxError, TypeError):
+                raise _err(path, node.value, "BRICK must be a literal dict",
+                           "use only strings, numbers, lists and dicts in BRICK (no names or calls)") from None
+            if not isinstance(meta, dict):
+                raise _err(path, node.value, "BRICK must be a dict", 'write BRICK = {"kind": ..., "params": {...}}')
+            return meta, _loc(path, node), doc
+    raise SourceError(path, 1, 1, "no BRICK metadata dict", 'add BRICK = {"kind": "...", "params": {...}} at top level')
+
+
+def parse_type(path: str, node, structs: dict[str, Type]) -> Type:
+    """A type annotation: a builtin type name or a struct declared in the same brick."""
+    if isinstance(node, ast.Name):
+        if node.id in BUILTIN_TYPES:
+            return BUILTIN_TYPES[node.id]
+        if node.id in structs:
+            return structs[node.id]
+    if isinstance(node, ast.Constant) and node.value is None:
+        raise _err(path, node, "functions must return a value", "bricks are pure: return a float, vector or struct")
+    names = ", ".join(sorted(BUILTIN_TYPES))
+    shown = ast.unparse(node) if isinstance(node, ast.AST) else str(node)
+    raise _err(path, node, f"unknown type '{shown}'", f"use one of {names} or a struct declared in this brick")
+
+
+def check_identifier(path: str, node, name: str) -> None:
+    if name.startswith("_") or "__" in name:
+        raise _err(path, node, f"identifier '{name}' starts with or contains '__' / '_'",
+                   "names beginning with '_' or containing '__' are reserved for the generator; rename it")
+
+
+def parse_module(text: str, path: str, externals: dict[str, Signature] | None = None) -> ir.Module:
+    """Parse and type-check one brick file. `externals` are callable names it may use (slots)."""
+    tree = _syntax_tree(text, path)
+    doc = ast.get_docstring(tree) or ""
+    meta, meta_loc = None, ir.Loc(path, 1, 1)
+    structs: dict[str, Type] = {}
+    constants: dict[str, ir.Const] = {}
+    fdefs: list[ast.FunctionDef] = []
+    for i, node in enumerate(tree.body):
+        if i == 0 and isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str):
+            continue
+        if isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name):
+            name = node.targets[0].id
+            if name == "BRICK":
+                meta, meta_loc, _ = read_meta(text, path)
+                continue
+            constants[name] = _module_constant(path, node, name, node.value)
+            continue
+        if isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and node.value is not None:
+            name = node.target.id
+            c = _module_constant(path, node, name, node.value)
+            want = parse_type(path, node.annotation, structs)
+            if c.ty != want:
+                raise _err(path, node.value, f"constant {name} is declared {want} but its value is {c.ty}",
+                           "write a float literal with a decimal point (1.0) for float constants")
+            constants[name] = c
+            continue
+        if isinstance(node, ast.ClassDef):
+            structs[node.name] = _parse_struct(path, node, structs)
+            continue
+        if isinstance(node, ast.FunctionDef):
+            fdefs.append(node)
+            continue
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            raise _err(path, node, "imports are not allowed in a brick",
+                       "bricks are parsed, never executed; intrinsics (pow, dot, ...) and constants (PI) need no import")
+        raise _err(path, node, f"'{type(node).__name__}' is not allowed at the top level of a brick",
+                   "a brick holds a docstring, BRICK = {...}, UPPERCASE constants, structs and functions")
+    if meta is None:
+        raise SourceError(path, 1, 1, "no BRICK metadata dict", 'add BRICK = {"kind": "...", "params": {...}} at top level')
+
+    # First pass: signatures, so functions may call each other in any order.
+    sigs: dict[str, Signature] = dict(externals or {})
+    for f in fdefs:
+        check_identifier(path, f, f.name)
+        if f.name in sigs:
+            raise _err(path, f, f"function '{f.name}' is defined twice or shadows a slot", "rename one of them")
+        sigs[f.name] = _signature(path, f, structs)
+    functions: dict[str, ir.Function] = {}
+    for f in fdefs:
+        checker = Checker(path, structs, constants, sigs, set(externals or {}))
+        functions[f.name] = checker.function(f, sigs[f.name])
+    _reject_recursion(path, functions, fdefs)
+    digest = hashlib.sha256(text.encode()).hexdigest()
+    return ir.Module(path, doc, meta, meta_loc, structs, constants, functions, digest)
+
+
+def _module_constant(path, node, name, value) -> ir.Const:
+    if not name.isupper():
+        raise _err(path, node, f"module-level name '{name}' is not a constant",
+                   "only BRICK and UPPERCASE literal constants may be assigned at the top level")
+    if name in CONSTANTS:
+        raise _err(path, node, f"'{name}' redefines a built-in constant", "use the built-in or pick another name")
+    sign = 1
+    v = value
+    if isinstance(v, ast.UnaryOp) and isinstance(v.op, ast.USub):
+        sign, v = -1, v.operand
+    if isinstance(v, ast.Constant) and type(v.value) in (int, float):
+        val = sign * v.value
+        ty = BUILTIN_TYPES["float" if isinstance(val, float) else "int"]
+        return ir.Const(ty, _loc(path, node), val)
+    raise _err(path, value, f"constant {name} must be a number literal", "write e.g. K = 0.5 or N = 4")
+
+
+def _parse_struct(path, node: ast.ClassDef, structs) -> Type:
+    check_identifier(path, node, node.name)
+    if node.bases or node.keywords or node.decorator_list:
+        raise _err(path, node, "a struct is a plain class with annotated fields", "remove base classes and decorators")
+    fields = []
+    for i, item in enumerate(node.body):
+        if i == 0 and isinstance(item, ast.Expr) and isinstance(item.value, ast.Constant) and isinstance(item.value.value, str):
+            continue
+        if isinstance(item, ast.AnnAssign) and isinstance(item.target, ast.Name) and item.value is None:
+            check_identifier(path, item, item.target.id)
+            fields.append((item.target.id, parse_type(path, item.annotation, structs)))
+            continue
+        raise _err(path, item, "a struct body holds only annotated fields (name: type)",
+                   "move functions to the top level; remove default values")
+    if not fields:
+        raise _err(path, node, f"struct {node.name} has no fields", "add at least one annotated field")
+    return struct(node.name, fields)
+
+
+def _signature(path, f: ast.FunctionDef, structs) -> Signature:
+    a = f.args
+    if a.vararg or a.kwarg or a.kwonlyargs or a.defaults or a.posonlyargs or a.kw_defaults:
+        raise _err(path, f, "only plain positional parameters with type annotations are allowed",
+                   "remove *args, **kwargs, defaults and keyword-only parameters")
+    if f.decorator_list:
+        raise _err(path, f.decorator_list[0], "decorators are not allowed", "remove the decorator")
+    params = []
+    for arg in a.args:
+        check_identifier(path, arg, arg.arg)
+        if arg.annotation is None:
+            raise _err(path, arg, f"parameter '{arg.arg}' has no type", f"annotate it, e.g. {arg.arg}: float")
+        params.append((arg.arg, parse_type(path, arg.annotation, structs)))
+    if f.returns is None:
+        raise _err(path, f, f"function '{f.name}' has no return type", "annotate it, e.g. -> vec3")
+    return Signature(tuple(params), parse_type(path, f.returns, structs))
+
+
+def _reject_recursion(path, functions: dict[str, ir.Function], fdefs) -> None:
+    nodes = {f.name: f for f in fdefs}
+    state: dict[str, int] = {}
+
+    def visit(name, stack):
+        state[name] = 1
+        for callee in functions[name].calls:
+            if callee not in functions:
+                continue
+            if state.get(callee) == 1:
+                raise _err(path, nodes[callee], f"recursion: {' -> '.join(stack + [callee])}",
+                           "shading languages do not allow recursion; unroll it or use a loop")
+            if callee not in state:
+                visit(callee, stack + [callee])
+        state[name] = 2
+
+    for name in functions:
+        if name not in state:
+            visit(name, [name])
