@@ -1,0 +1,18 @@
+"""Torrance-Sparrow (V-cavity) geometry factor as a visibility term.
+
+G = min(1, 2 (n.h)(n.v) / (v.h), 2 (n.h)(n.l) / (v.h)) (Torrance & Sparrow 1967;
+Blinn 1977; RTR3 eq. 7.54), and V = G / (4 (n.l)(n.v)).
+"""
+BRICK = {
+    "kind": "visibility",
+    "cite": "Torrance & Sparrow 1967; RTR3 eq. 7.54",
+}
+
+
+def vis(NdotL: float, NdotV: float, NdotH: float, VdotH: float, alpha: float) -> float:
+    # v.h is floored at 1e-4: it is 0 only for l = -v, where G is 0/0.
+    # n.l is floored likewise: the caller clamps n.v but passes n.l as is.
+    vh = max(VdotH, 0.0001)
+    nl = max(NdotL, 0.0001)
+    G = min(1.0, min(2.0 * NdotH * NdotV / vh, 2.0 * NdotH * nl / vh))
+    return G / (4.0 * nl * NdotV)

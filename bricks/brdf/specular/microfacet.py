@@ -1,0 +1,28 @@
+"""Microfacet specular: f_r = F(v.h) * D(n.h) * G(l, v) / (4 (n.l)(n.v)).
+
+Cook & Torrance 1982; the factored form of RTR3 §7.6.1 eq. 7.51
+(f = F D G / (4 cos theta_i cos theta_o)), with the visibility term
+V = G / (4 (n.l)(n.v)) supplied by the `vis` slot, so that a filler can fold
+the cosines into its own expression (RTR3 §7.6.1, "visibility term").
+Slots: ndf (D, normalized so that the integral of D cos theta_h is 1),
+fresnel (F(f0, v.h)), vis (V).
+"""
+BRICK = {
+    "kind": "specular",
+    "cite": "Cook & Torrance 1982; RTR3 eq. 7.51 with visibility term V = G/(4 n.l n.v)",
+    "params": {
+        "alpha": {"type": "float", "range": [0.0, 1.0], "default": 0.3, "doc": "roughness: GGX alpha, Beckmann RMS slope m"},
+        "f0": {"type": "vec3", "range": [0.0, 1.0], "default": [0.04, 0.04, 0.04], "doc": "Fresnel reflectance at normal incidence"},
+    },
+    "slots": {
+        "ndf": {"kind": "ndf", "default": "ggx"},
+        "fresnel": {"kind": "fresnel", "default": "schlick"},
+        "vis": {"kind": "visibility", "default": "smith_schlick"},
+    },
+}
+
+
+def specular(NdotL: float, NdotV: float, NdotH: float, VdotH: float, alpha: float, f0: vec3) -> vec3:
+    D = ndf(NdotH, alpha)
+    Vis = vis(NdotL, NdotV, NdotH, VdotH, alpha)
+    return fresnel(f0, VdotH) * (D * Vis)

@@ -1,0 +1,270 @@
+"""Brick discovery, the metadata schema, kinds and their entry contracts, and slots.
+
+A brick is one file under a brick directory; its id is the file stem, its kind
+comes from its BRICK metadata. Bricks are parsed (generator.lang), never imported.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .lang import Signature, SourceError, parse_module, read_meta
+from .lang import ir
+from .lang.types import BUILTIN_TYPES, FLOAT, VEC3, Type
+
+REPO = Path(__file__).resolve().parent.parent
+BUILTIN_BRICKS = REPO / "bricks"
+
+
+@dataclass(frozen=True)
+class Kind:
+    """What a kind of brick must define.
+
+    entries: function names the kind must define (the generator calls them).
+    interface: for slot kinds called from inside another brick, the fixed
+      signature of the single entry; None when arguments are bound by name
+      from the shading context (geometry, parameters, textures).
+    ret: the return type of every entry.
+    """
+
+    entries: tuple[str, ...]
+    ret: Type
+    interface: tuple | None = None
+    prefix_entries: str = ""  # packing: every function named get_<input> is an entry
+
+
+KINDS: dict[str, Kind] = {
+    "diffuse": Kind(("diffuse",), VEC3),
+    "specular": Kind(("specular",), VEC3),
+    "ndf": Kind(("ndf",), FLOAT, (("NdotH", FLOAT), ("alpha", FLOAT))),
+    "fresnel": Kind(("fresnel",), VEC3, (("f0", VEC3), ("VdotH", FLOAT))),
+    "visibility": Kind(("vis",), FLOAT, (("NdotL", FLOAT), ("NdotV", FLOAT), ("NdotH", FLOAT),
+                                          ("VdotH", FLOAT), ("alpha", FLOAT))),
+    "light": Kind(("light_dir", "light_radiance"), VEC3),
+    "shadow": Kind(("shadow",), FLOAT),
+    "packing": Kind((), VEC3, prefix_entries="get_"),
+    "normal": Kind(("normal",), VEC3),
+    "output": Kind(("output",), BUILTIN_TYPES["vec4"], (("color", VEC3),)),
+}
+BRDF_KINDS = ("diffuse", "specular")
+
+# Geometric inputs a BRDF entry may name as parameters (DESIGN.md conventions).
+GEOMETRY = {"L": VEC3, "V": VEC3, "N": VEC3, "H": VEC3, "T": VEC3, "B": VEC3,
+            "NdotL": FLOAT, "NdotV": FLOAT, "NdotH": FLOAT, "LdotH": FLOAT, "VdotH": FLOAT,
+            "LdotV": FLOAT, "RdotV": FLOAT}
+# Shading-context inputs of light, shadow, packing and normal bricks.
+SURFACE = {"P": VEC3, "N": VEC3, "T": VEC3, "B": VEC3, "uv": BUILTIN_TYPES["vec2"]}
+PARAM_TYPES = ("float", "vec2", "vec3", "vec4", "mat4")
+META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc"}
+
+
+@dataclass
+class Param:
+    name: str
+    ty: Type
+    default: object
+    range: tuple | None
+    doc: str = ""
+
+
+@dataclass
+class Brick:
+    """One parsed brick file."""
+
+    id: str
+    kind: str
+    path: Path
+    display_path: str
+    module: ir.Module
+    params: dict[str, Param]
+    slots: dict[str, dict]  # slot name -> {"kind": k, "default": filler id}
+    textures: dict[str, dict]
+    cite: str
+    doc: str
+
+    @property
+    def entries(self) -> list[ir.Function]:
+        k = KINDS[self.kind]
+        if k.prefix_entries:
+            return [f for n, f in self.module.functions.items() if n.startswith(k.prefix_entries)]
+        return [self.module.functions[n] for n in k.entries]
+
+
+@dataclass
+class Library:
+    """Every brick found, by (kind, id)."""
+
+    bricks: dict[tuple[str, str], Brick] = field(default_factory=dict)
+    errors: list[SourceError] = field(default_factory=list)
+
+    def get(self, kind: str, brick_id: str) -> Brick | None:
+        return self.bricks.get((kind, brick_id))
+
+    def of_kind(self, kind: str) -> list[Brick]:
+        return sorted((b for (k, _), b in self.bricks.items() if k == kind), key=lambda b: b.id)
+
+    def find(self, brick_id: str, kinds) -> list[Brick]:
+        return [self.bricks[(k, brick_id)] for k in kinds if (k, brick_id) in self.bricks]
+
+
+def display(path: Path) -> str:
+    """A path as shown in messages and provenance: relative to the repo when inside it."""
+    try:
+        return str(path.resolve().relative_to(REPO))
+    except ValueError:
+        return str(path)
+
+
+def load_library(extra_dirs=(), strict: bool = True) -> Library:
+    """Parse every brick in bricks/ and the extra directories (an engine's own bricks)."""
+    lib = Library()
+    dirs = [BUILTIN_BRICKS, *[Path(d) for d in extra_dirs]]
+    for d in dirs:
+        if not d.is_dir():
+            raise SourceError(str(d), 1, 1, "brick directory not found", "pass an existing directory to --bricks")
+        for path in sorted(d.rglob("*.py")):
+            try:
+                b = load_brick(path)
+            except SourceError as e:
+                if strict:
+                    raise
+                lib.errors.append(e)
+                continue
+            other = lib.bricks.get((b.kind, b.id))
+            if other is not None:
+                raise SourceError(b.display_path, 1, 1, f"{b.kind} brick '{b.id}' is also defined in {other.display_path}",
+                                  "rename one of the files (the file stem is the brick id)")
+            lib.bricks[(b.kind, b.id)] = b
+    return lib
+
+
+def _meta_error(shown: str, loc: ir.Loc, message: str, hint: str) -> SourceError:
+    return SourceError(shown, loc.line, loc.col, message, hint)
+
+
+def load_brick(path: Path) -> Brick:
+    """Parse one brick file and check its metadata against its functions."""
+    shown = display(path)
+    text = path.read_text(encoding="utf-8")
+    meta, loc, doc = read_meta(text, shown)
+    unknown = set(meta) - META_KEYS
+    if unknown:
+        raise _meta_error(shown, loc, f"unknown BRICK key(s): {', '.join(sorted(unknown))}",
+                          f"allowed keys: {', '.join(sorted(META_KEYS))}")
+    kind = meta.get("kind")
+    if kind not in KINDS:
+        raise _meta_error(shown, loc, f"unknown brick kind {kind!r}", f"use one of {', '.join(KINDS)}")
+    if not doc.strip():
+        raise SourceError(shown, 1, 1, "a brick needs a docstring", "say what model it is and cite the paper and equation")
+    cite = meta.get("cite", "")
+    if not isinstance(cite, str) or not cite.strip():
+        raise _meta_error(shown, loc, "BRICK has no 'cite'", 'add "cite": "Author Year, eq. N" (the source of the formula)')
+    params = _params(shown, loc, meta.get("params", {}))
+    slots = _slots(shown, loc, meta.get("slots", {}))
+    textures = meta.get("textures", {})
+    if not isinstance(textures, dict):
+        raise _meta_error(shown, loc, "'textures' must be a dict", 'write "textures": {"albedo_map": {"srgb": True}}')
+    externals = {}
+    for sname, s in slots.items():
+        iface = KINDS[s["kind"]].interface
+        if iface is not None:
+            externals[sname] = Signature(iface, KINDS[s["kind"]].ret)
+    module = parse_module(text, shown, externals)
+    brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip())
+    _check_entries(brick, loc)
+    return brick
+
+
+def _params(shown, loc, raw) -> dict[str, Param]:
+    if not isinstance(raw, dict):
+        raise _meta_error(shown, loc, "'params' must be a dict", 'write "params": {"n": {"type": "float", ...}}')
+    out = {}
+    for name, spec in raw.items():
+        if not isinstance(spec, dict) or spec.get("type") not in PARAM_TYPES:
+            raise _meta_error(shown, loc, f"parameter '{name}' needs a type",
+                              f"give \"type\" one of {', '.join(PARAM_TYPES)}")
+        ty = BUILTIN_TYPES[spec["type"]]
+        rng = spec.get("range")
+        if rng is not None and not (isinstance(rng, (list, tuple)) and len(rng) == 2 and rng[0] <= rng[1]):
+            raise _meta_error(shown, loc, f"parameter '{name}' has a bad range {rng!r}", "write [low, high]")
+        default = spec.get("default")
+        if default is None:
+            raise _meta_error(shown, loc, f"parameter '{name}' has no default", "add a \"default\" value")
+        problem = check_value(ty, rng, default)
+        if problem:
+            raise _meta_error(shown, loc, f"default of '{name}': {problem}", "fix the default")
+        out[name] = Param(name, ty, default, tuple(rng) if rng else None, spec.get("doc", ""))
+    return out
+
+
+def _slots(shown, loc, raw) -> dict[str, dict]:
+    if not isinstance(raw, dict):
+        raise _meta_error(shown, loc, "'slots' must be a dict", 'write "slots": {"ndf": {"kind": "ndf", "default": "ggx"}}')
+    for name, s in raw.items():
+        if not isinstance(s, dict) or s.get("kind") not in KINDS or not isinstance(s.get("default"), str):
+            raise _meta_error(shown, loc, f"slot '{name}' needs a kind and a default filler",
+                              '"slots": {"ndf": {"kind": "ndf", "default": "ggx"}}')
+    return raw
+
+
+def check_value(ty: Type, rng, value) -> str:
+    """'' when value fits type and range, else what is wrong."""
+    n = ty.components
+    vals = value if isinstance(value, (list, tuple)) else [value]
+    if ty.kind == "scalar" and isinstance(value, (list, tuple)):
+        return f"expected one number, got a list of {len(value)}"
+    if len(vals) != n and not (len(vals) == 1 and ty.kind == "vector"):
+        return f"expected {n} numbers for {ty}, got {len(vals)}"
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+        return f"expected numbers for {ty}, got {value!r}"
+    if rng is not None:
+        bad = [v for v in vals if not rng[0] <= v <= rng[1]]
+        if bad:
+            return f"{bad[0]!r} is outside the range [{rng[0]}, {rng[1]}]"
+    return ""
+
+
+def _check_entries(b: Brick, loc) -> None:
+    k = KINDS[b.kind]
+    fns = b.module.functions
+    for name in k.entries:
+        if name not in fns:
+            raise _meta_error(b.display_path, loc, f"a {b.kind} brick must define '{name}'",
+                              f"add def {name}(...) -> {k.ret}")
+    for f in b.entries:
+        ret = k.ret
+        if f.ret != ret:
+            raise SourceError(b.display_path, f.loc.line, f.loc.col, f"'{f.name}' must return {ret}, not {f.ret}",
+                              "fix the return annotation")
+        if k.interface is not None:
+            got = tuple((p.name, p.ty) for p in f.params)
+            if got != k.interface:
+                want = ", ".join(f"{n}: {t}" for n, t in k.interface)
+                raise SourceError(b.display_path, f.loc.line, f.loc.col,
+                                  f"'{f.name}' must have the {b.kind} slot signature ({want})",
+                                  "keep every parameter, even unused ones, in this order")
+            continue
+        allowed = dict(GEOMETRY if b.kind in BRDF_KINDS else SURFACE)
+        for p in f.params:
+            want = allowed.get(p.name) or (b.params[p.name].ty if p.name in b.params else None)
+            if p.ty.kind == "texture":
+                if p.name not in b.textures:
+                    raise SourceError(b.display_path, p.loc.line, p.loc.col, f"texture '{p.name}' is not declared",
+                                      f'add "textures": {{"{p.name}": {{"srgb": False}}}} to BRICK')
+                continue
+            if want is None and b.kind == "packing":
+                continue  # a material parameter of the BRDF, bound when composed
+            if want is None:
+                raise SourceError(b.display_path, p.loc.line, p.loc.col,
+                                  f"parameter '{p.name}' is neither a shading input nor a declared param",
+                                  f"use one of {', '.join(sorted(allowed))}, or declare '{p.name}' in BRICK['params']")
+            if want != p.ty:
+                raise SourceError(b.display_path, p.loc.line, p.loc.col,
+                                  f"parameter '{p.name}' is {p.ty} here but {want} by convention or declaration",
+                                  f"annotate it {want}")
+    needs = b.module.meta.get("needs")
+    if needs is not None:
+        used = sorted({p.name for f in b.entries for p in f.params if p.name in GEOMETRY})
+        if sorted(needs) != used:
+            raise _meta_error(b.display_path, loc, f"BRICK['needs'] {sorted(needs)} differs from the inputs the entry reads {used}",
+                              "list exactly the geometric inputs named as parameters (or drop 'needs')")
