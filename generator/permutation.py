@@ -1,0 +1,180 @@
+"""Spec strings and permutation keys: one canonical string and a short stable hash.
+
+A spec names bricks and their slot fillers:
+    lambert+microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick)
+    albedo_texture(normal=normal_map)
+Canonical form: every slot written out (defaults included) in the brick's
+declared slot order, no spaces. The hash of the canonical key names files;
+raw strings from users never do.
+"""
+from __future__ import annotations
+
+import hashlib
+import re
+from dataclasses import dataclass
+
+from .bricks import BRDF_KINDS, Brick, Library
+
+_TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[()+=,])")
+PRECISIONS = ("fp32",)  # fp16 is on the roadmap (issue: accuracy); the key keeps the axis
+
+
+class SpecError(ValueError):
+    """A bad spec string; `col` is the 1-based column inside the spec."""
+
+    def __init__(self, spec: str, col: int, message: str, hint: str = ""):
+        self.spec, self.col, self.message, self.hint = spec, col, message, hint
+        super().__init__(f"{message} in '{spec}' at column {col}" + (f" — {hint}" if hint else ""))
+
+
+@dataclass(frozen=True)
+class Node:
+    """One brick of a spec with its slot fillers (resolved)."""
+
+    brick: Brick
+    fillers: tuple  # ((slot, Node), ...) in the brick's slot order
+
+    def canonical(self) -> str:
+        if not self.fillers:
+            return self.brick.id
+        return f"{self.brick.id}({','.join(f'{s}={n.canonical()}' for s, n in self.fillers)})"
+
+    def walk(self):
+        """This node and every filler below it, callers first."""
+        yield self
+        for _, n in self.fillers:
+            yield from n.walk()
+
+
+def _tokens(spec: str):
+    pos, out = 0, []
+    while pos < len(spec):
+        if spec[pos:].strip() == "":
+            break
+        m = _TOKEN.match(spec, pos)
+        if not m:
+            raise SpecError(spec, pos + 1, f"unexpected character {spec[pos]!r}",
+                            "a spec is brick ids joined by '+', with slot fillers in parentheses: a+b(slot=c)")
+        out.append((m.group(1), m.start(1) + 1))
+        pos = m.end()
+    out.append(("", len(spec) + 1))
+    return out
+
+
+def parse_spec(spec: str, lib: Library, kinds) -> list[Node]:
+    """Parse and resolve a '+'-joined spec whose top-level bricks have one of `kinds`."""
+    toks = _tokens(spec)
+    i = 0
+
+    def term(kinds_here):
+        nonlocal i
+        name, col = toks[i]
+        if not name or not (name[0].isalpha()):
+            raise SpecError(spec, col, "expected a brick id" + (f", got {name!r}" if name else ""),
+                            "list bricks with `shadermatrix bricks`")
+        i += 1
+        found = lib.find(name, kinds_here)
+        if not found:
+            known = sorted({b.id for k in kinds_here for b in lib.of_kind(k)})
+            raise SpecError(spec, col, f"unknown {'/'.join(kinds_here)} brick '{name}'",
+                            f"known: {', '.join(known)}")
+        brick = found[0]
+        given: dict[str, Node] = {}
+        if toks[i][0] == "(":
+            i += 1
+            while True:
+                sname, scol = toks[i]
+                if sname not in brick.slots:
+                    slots = ", ".join(brick.slots) or "none"
+                    raise SpecError(spec, scol, f"'{brick.id}' has no slot {sname!r}", f"its slots: {slots}")
+                if sname in given:
+                    raise SpecError(spec, scol, f"slot '{sname}' is filled twice", "fill each slot once")
+                i += 1
+                if toks[i][0] != "=":
+                    raise SpecError(spec, toks[i][1], "expected '='", "write slot=filler")
+                i += 1
+                given[sname] = term((brick.slots[sname]["kind"],))
+                if toks[i][0] == ",":
+                    i += 1
+                    continue
+                if toks[i][0] == ")":
+                    i += 1
+                    break
+                raise SpecError(spec, toks[i][1], "expected ',' or ')'", "close the slot list")
+        fillers = []
+        for sname, s in brick.slots.items():
+            node = given.get(sname)
+            if node is None:
+                dflt = lib.get(s["kind"], s["default"])
+                if dflt is None:
+                    raise SpecError(spec, col, f"default filler '{s['default']}' of slot '{sname}' is missing",
+                                    f"fill the slot explicitly: {brick.id}({sname}=...)")
+                node = Node(dflt, _default_fillers(dflt, lib, spec, col))
+            fillers.append((sname, node))
+        return Node(brick, tuple(fillers))
+
+    nodes = [term(kinds)]
+    while toks[i][0] == "+":
+        i += 1
+        nodes.append(term(kinds))
+    if toks[i][0]:
+        raise SpecError(spec, toks[i][1], f"unexpected {toks[i][0]!r}", "join bricks with '+'")
+    return nodes
+
+
+def _default_fillers(brick: Brick, lib: Library, spec: str, col: int) -> tuple:
+    out = []
+    for sname, s in brick.slots.items():
+        d = lib.get(s["kind"], s["default"])
+        if d is None:
+            raise SpecError(spec, col, f"default filler '{s['default']}' of slot '{sname}' is missing", "")
+        out.append((sname, Node(d, _default_fillers(d, lib, spec, col))))
+    return tuple(out)
+
+
+def parse_brdf(spec: str, lib: Library) -> list[Node]:
+    """A BRDF spec: one diffuse and/or one specular term, diffuse first in canonical form."""
+    nodes = parse_spec(spec, lib, BRDF_KINDS)
+    kinds = [n.brick.kind for n in nodes]
+    if len(set(kinds)) != len(kinds):
+        raise SpecError(spec, 1, "a BRDF has at most one diffuse and one specular term",
+                        "write diffuse+specular, e.g. lambert+blinn_phong_normalized")
+    return sorted(nodes, key=lambda n: BRDF_KINDS.index(n.brick.kind))
+
+
+def canonical(nodes: list[Node]) -> str:
+    return "+".join(n.canonical() for n in nodes)
+
+
+@dataclass(frozen=True)
+class LightKey:
+    light: str  # light brick id
+    shadow: str  # canonical shadow spec
+
+    def canonical(self) -> str:
+        return f"{self.light}/{self.shadow}"
+
+
+@dataclass(frozen=True)
+class Permutation:
+    """A permutation key: what one specialized shader implements."""
+
+    brdf: str  # canonical BRDF spec
+    lights: tuple  # (LightKey, ...) in order
+    packing: str  # canonical packing spec
+    output: str = "linear"
+    precision: str = "fp32"
+
+    def canonical(self) -> str:
+        lights = ",".join(k.canonical() for k in self.lights) or "-"
+        return (f"brdf={self.brdf};lights={lights};packing={self.packing};"
+                f"output={self.output};precision={self.precision}")
+
+    @property
+    def hash(self) -> str:
+        """12 hex digits of the SHA-256 of the canonical key (file names, cache keys)."""
+        return hashlib.sha256(self.canonical().encode()).hexdigest()[:12]
+
+
+def spec_hash(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()[:12]
