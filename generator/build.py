@@ -1,0 +1,105 @@
+"""`shadermatrix build`: a scene's permutations → sources, SPIR-V and manifest.json.
+
+Compose every permutation in every language, compile them all in batches,
+write what changed atomically, then the manifest. A permutation that fails
+(brick error, compiler error) is reported and the others still build.
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import __version__
+from .bricks import Library
+from .cache import atomic_write, sha256
+from .compose import LANGUAGES, Composed, compose_permutation
+from .lang import SourceError
+from .scene import Scene
+from .toolchain import CompileJob, compile_many, tool_versions
+
+
+@dataclass
+class BuildResult:
+    manifest: dict
+    failures: list[str] = field(default_factory=list)
+    written: int = 0
+    unchanged: int = 0
+
+    @property
+    def ok(self) -> bool:
+        return not self.failures
+
+
+def show_progress() -> bool:
+    """Progress bars on a terminal, quiet in CI and in pipes."""
+    return sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")
+
+
+def job_key(h: str, stage: str, lang: str) -> str:
+    return f"{h}.{stage}.{lang}"
+
+
+def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> BuildResult:
+    """Build every permutation of `scene` into `out`; see the module docstring."""
+    out = Path(out)
+    composed: dict[str, Composed] = {}
+    errors: dict[str, list[str]] = {}
+    jobs: list[CompileJob] = []
+    for h, perm in sorted(scene.permutations.items()):
+        try:
+            c = compose_permutation(perm, lib, languages)
+        except SourceError as e:
+            errors[h] = [str(e)]
+            continue
+        composed[h] = c
+        for src in c.sources:
+            jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
+                                   line_map=tuple(src.line_map)))
+    results = compile_many(jobs, optimize=True, validate=True, progress=show_progress())
+
+    res = BuildResult(manifest={})
+    entries = []
+    for h, perm in sorted(scene.permutations.items()):
+        entry = {"id": perm.canonical(), "hash": h, "objects": scene.users.get(h, []), "languages": {}}
+        errs = list(errors.get(h, []))
+        c = composed.get(h)
+        if c is not None:
+            entry["bricks"] = dict(sorted(c.bricks.items()))
+            for src in c.sources:
+                r = results[job_key(h, src.stage, src.language)]
+                rel_src = f"{src.language}/{h}.{src.stage}.{src.language}"
+                rel_spv = f"{src.language}/{h}.{src.stage}.spv"
+                data = src.text.encode()
+                _count(res, atomic_write(out / rel_src, data))
+                item = {"source": rel_src, "source_sha256": sha256(data)}
+                if r.ok and r.spirv:
+                    _count(res, atomic_write(out / rel_spv, r.spirv))
+                    item.update({"spirv": rel_spv, "spirv_sha256": sha256(r.spirv)})
+                else:
+                    errs += [str(d) for d in r.diagnostics if d.severity == "error"] or [f"{rel_src}: compile failed"]
+                entry["languages"].setdefault(src.language, {})[src.stage] = item
+        entry["status"] = "failed" if errs else "ok"
+        if errs:
+            entry["errors"] = errs
+            res.failures.append(f"{h} ({perm.canonical()}):\n  " + "\n  ".join(errs))
+        entries.append(entry)
+    res.manifest = {
+        "generator": f"shadermatrix {__version__}",
+        "scene": scene.name,
+        "tools": tool_versions(),
+        "languages": list(languages),
+        "permutations": entries,
+    }
+    text = json.dumps(res.manifest, indent=2, sort_keys=False) + "\n"
+    _count(res, atomic_write(out / "manifest.json", text.encode()))
+    return res
+
+
+def _count(res: BuildResult, changed: bool) -> None:
+    if changed:
+        res.written += 1
+    else:
+        res.unchanged += 1

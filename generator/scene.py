@@ -1,0 +1,236 @@
+"""Scene manifests (TOML) → the permutations a scene needs, and nothing more.
+
+Schema (README "Scene files"):
+    [scene]            name, output (default "linear"), precision (default "fp32")
+    [materials.NAME]   brdf = spec, packing = spec (default "constants"), params = {...}
+    [lights.NAME]      type = light brick, shadow = spec (default "none"), params = {...}
+    [light_sets]       NAME = [light names, in order]
+    [[objects]]        name, material = NAME, lights = light set NAME
+Only (material × light set) pairs that some object uses become permutations.
+"""
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .bricks import Library, check_value
+from .compose import brdf_params, check_packing
+from .lang import SourceError
+from .permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
+
+
+class Locator:
+    """Finds line:col of tables and keys in TOML text (tomllib keeps no positions)."""
+
+    def __init__(self, path: str, text: str):
+        self.path, self.lines = path, text.splitlines()
+
+    def _header(self, header: str, nth: int = 0) -> int:
+        pat = re.compile(r"^\s*\[\[?\s*" + r"\s*\.\s*".join(re.escape(p) for p in header.split(".")) + r"\s*\]\]?")
+        hits = [i for i, line in enumerate(self.lines) if pat.match(line)]
+        return hits[nth] if len(hits) > nth else -1
+
+    def find(self, header: str, *keys: str, nth: int = 0) -> tuple[int, int]:
+        """(line, col) of header's key path (keys may continue inside an inline table)."""
+        start = self._header(header, nth) if header else -1
+        if header and start < 0:
+            return 1, 1
+        line_no, col = start + 1, 1
+        i = start + 1
+        while i < len(self.lines) and keys:
+            line = self.lines[i]
+            if re.match(r"^\s*\[", line):
+                break
+            m = re.match(r"^\s*" + re.escape(keys[0]) + r"\s*=", line)
+            if m:
+                line_no, col = i + 1, line.index(keys[0]) + 1
+                for k in keys[1:]:
+                    km = re.search(r"(?<![\w.])" + re.escape(k) + r"\s*=", line[col:])
+                    if km:
+                        col = col + km.start() + 1
+                return line_no, col
+            i += 1
+        return line_no, col
+
+    def error(self, where: tuple[int, int], message: str, hint: str = "") -> SourceError:
+        return SourceError(self.path, where[0], where[1], message, hint)
+
+
+@dataclass
+class Material:
+    name: str
+    brdf: str
+    packing: str
+    params: dict
+
+
+@dataclass
+class Light:
+    name: str
+    type: str
+    shadow: str
+    params: dict
+
+
+@dataclass
+class Scene:
+    path: Path
+    name: str
+    output: str
+    precision: str
+    materials: dict[str, Material]
+    lights: dict[str, Light]
+    light_sets: dict[str, list[str]]
+    objects: list[dict]
+    permutations: dict[str, Permutation] = field(default_factory=dict)  # hash -> key
+    users: dict[str, list[str]] = field(default_factory=dict)  # hash -> object names
+
+
+def load_scene(path, lib: Library) -> Scene:
+    """Read, validate and reduce a TOML scene to its permutations."""
+    path = Path(path)
+    shown = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as e:
+        raise SourceError(shown, 1, 1, f"cannot read scene: {e.strerror}", "check the path") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        m = re.search(r"\(at line (\d+), column (\d+)\)", str(e))
+        line, col = (int(m.group(1)), int(m.group(2))) if m else (1, 1)
+        msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(e))
+        raise SourceError(shown, line, col, f"TOML syntax error: {msg}", "fix the scene file's syntax") from None
+    loc = Locator(shown, text)
+    known = {"scene", "materials", "lights", "light_sets", "objects"}
+    for key in data:
+        if key not in known:
+            raise loc.error(_top(loc, key), f"unknown section '{key}'",
+                            f"sections: {', '.join(sorted(known))}")
+    head = data.get("scene", {})
+    output = head.get("output", "linear")
+    precision = head.get("precision", "fp32")
+    if precision not in PRECISIONS:
+        raise loc.error(loc.find("scene", "precision"), f"precision '{precision}' is not supported",
+                        f"use one of {', '.join(PRECISIONS)}")
+    if lib.get("output", output) is None:
+        raise loc.error(loc.find("scene", "output"), f"unknown output brick '{output}'",
+                        f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
+    scene = Scene(path, head.get("name", path.stem), output, precision, {}, {}, {}, [])
+
+    for name, m in _table(loc, data, "materials").items():
+        where = loc.find(f"materials.{name}")
+        if not isinstance(m, dict) or "brdf" not in m:
+            raise loc.error(where, f"material '{name}' has no brdf", 'add brdf = "lambert+blinn_phong_normalized"')
+        brdf = _spec(loc, f"materials.{name}", "brdf", m["brdf"], lambda s: canonical(parse_brdf(s, lib)))
+        packing = _spec(loc, f"materials.{name}", "packing", m.get("packing", "constants"),
+                        lambda s: canonical(parse_spec(s, lib, ("packing",))))
+        nodes = parse_brdf(brdf, lib)
+        types = brdf_params(nodes)
+        ranges = {k: p.range for n in nodes for x in n.walk() for k, p in x.brick.params.items()}
+        params = m.get("params", {})
+        _check_params(loc, f"materials.{name}", params, types, ranges, f"BRDF '{brdf}'")
+        problem = check_packing(Permutation(brdf, (), packing, output), lib)
+        if problem:
+            raise loc.error(loc.find(f"materials.{name}", "packing"), problem, "use the constants packing for this BRDF")
+        scene.materials[name] = Material(name, brdf, packing, params)
+
+    for name, li in _table(loc, data, "lights").items():
+        where = loc.find(f"lights.{name}")
+        ltype = li.get("type") if isinstance(li, dict) else None
+        lb = lib.get("light", ltype) if isinstance(ltype, str) else None
+        if lb is None:
+            raise loc.error(loc.find(f"lights.{name}", "type") if ltype else where,
+                            f"light '{name}' has unknown type {ltype!r}",
+                            f"type is one of {', '.join(b.id for b in lib.of_kind('light'))}")
+        shadow = _spec(loc, f"lights.{name}", "shadow", li.get("shadow", "none"),
+                       lambda s: canonical(parse_spec(s, lib, ("shadow",))))
+        snode = parse_spec(shadow, lib, ("shadow",))[0]
+        types = {k: p.ty for k, p in lb.params.items()}
+        ranges = {k: p.range for k, p in lb.params.items()}
+        for n in snode.walk():
+            types.update({k: p.ty for k, p in n.brick.params.items()})
+            ranges.update({k: p.range for k, p in n.brick.params.items()})
+        params = li.get("params", {})
+        _check_params(loc, f"lights.{name}", params, types, ranges, f"light '{ltype}' with shadow '{shadow}'")
+        scene.lights[name] = Light(name, ltype, shadow, params)
+
+    for name, members in _table(loc, data, "light_sets").items():
+        where = loc.find("light_sets", name)
+        if not isinstance(members, list) or not all(isinstance(x, str) for x in members):
+            raise loc.error(where, f"light set '{name}' must be a list of light names", 'write outdoor = ["sun"]')
+        for x in members:
+            if x not in scene.lights:
+                raise loc.error(where, f"light set '{name}' names unknown light '{x}'",
+                                f"lights: {', '.join(scene.lights) or 'none defined'}")
+        scene.light_sets[name] = members
+
+    objects = data.get("objects", [])
+    if not isinstance(objects, list):
+        raise loc.error((1, 1), "objects must be an array of tables", "write [[objects]] sections")
+    for i, obj in enumerate(objects):
+        where = loc.find("objects", nth=i)
+        oname = obj.get("name", f"object{i}")
+        mat = obj.get("material")
+        if mat not in scene.materials:
+            raise loc.error(loc.find("objects", "material", nth=i), f"object '{oname}' uses unknown material {mat!r}",
+                            f"materials: {', '.join(scene.materials) or 'none defined'}")
+        lset = obj.get("lights", [])
+        if isinstance(lset, str):
+            if lset not in scene.light_sets:
+                raise loc.error(loc.find("objects", "lights", nth=i), f"object '{oname}' uses unknown light set {lset!r}",
+                                f"light sets: {', '.join(scene.light_sets) or 'none defined'}")
+            names = scene.light_sets[lset]
+        else:
+            raise loc.error(loc.find("objects", "lights", nth=i) if "lights" in obj else where,
+                            f"object '{oname}' needs lights = a light set name", 'write lights = "outdoor"')
+        m = scene.materials[mat]
+        keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in names)
+        perm = Permutation(m.brdf, keys, m.packing, output, precision)
+        scene.permutations.setdefault(perm.hash, perm)
+        scene.users.setdefault(perm.hash, []).append(oname)
+        scene.objects.append({"name": oname, "material": mat, "lights": names, "permutation": perm.hash})
+    return scene
+
+
+def _top(loc: Locator, key: str) -> tuple[int, int]:
+    for i, line in enumerate(loc.lines):
+        if re.match(r"^\s*\[\[?\s*" + re.escape(key) + r"\b", line) or re.match(r"^\s*" + re.escape(key) + r"\s*=", line):
+            return i + 1, line.index(key) + 1
+    return 1, 1
+
+
+def _table(loc: Locator, data: dict, key: str) -> dict:
+    t = data.get(key, {})
+    if not isinstance(t, dict):
+        raise loc.error(_top(loc, key), f"'{key}' must be a table", f"write [{key}.NAME] sections")
+    return t
+
+
+def _spec(loc: Locator, header: str, key: str, value, resolve) -> str:
+    where = loc.find(header, key)
+    if not isinstance(value, str):
+        raise loc.error(where, f"{key} must be a spec string", 'write e.g. "lambert+blinn_phong_normalized"')
+    try:
+        return resolve(value)
+    except SpecError as e:
+        line, col = where
+        text = loc.lines[line - 1] if 0 < line <= len(loc.lines) else ""
+        q = text.find('"', col - 1)
+        col = q + 1 + e.col if q >= 0 else col
+        raise loc.error((line, col), e.message, e.hint) from None
+
+
+def _check_params(loc: Locator, header: str, params, types: dict, ranges: dict, owner: str) -> None:
+    if not isinstance(params, dict):
+        raise loc.error(loc.find(header, "params"), "params must be a table", "write params = { n = 64.0 }")
+    for k, v in params.items():
+        where = loc.find(header, "params", k)
+        if k not in types:
+            raise loc.error(where, f"unknown parameter '{k}' for {owner}",
+                            f"its parameters: {', '.join(types) or 'none'}")
+        problem = check_value(types[k], ranges.get(k), v)
+        if problem:
+            raise loc.error(where, f"parameter '{k}': {problem}", "see `shadermatrix bricks` for types and ranges")
