@@ -14,6 +14,7 @@ APT_PKGS=(
   "spirv-tools=2023.1-2"                   # spirv-val, spirv-opt, spirv-as, spirv-dis
 )
 NAGA_VERSION=30.0.1
+RUST_TOOLCHAIN=1.95.0   # only used when cargo is missing; naga 30 needs rust >= 1.87
 
 missing=()
 for spec in "${APT_PKGS[@]}"; do
@@ -28,19 +29,43 @@ if ((${#missing[@]})); then
   apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# naga (WGSL front end + validator), pinned, from crates.io.
-if ! command -v naga >/dev/null 2>&1 || [[ "$(naga --version 2>/dev/null)" != "$NAGA_VERSION" ]]; then
+# naga (WGSL front end + validator), pinned, from crates.io into .tools/bin
+# (generator/toolchain.py looks there before PATH). A naga of the pinned
+# version already on PATH is used as is.
+naga_version() { "$1" --version 2>/dev/null || true; }
+if [[ "$(naga_version .tools/bin/naga)" != "$NAGA_VERSION" ]] &&
+   ! { command -v naga >/dev/null 2>&1 && [[ "$(naga_version naga)" == "$NAGA_VERSION" ]]; }; then
+  export PATH="${CARGO_HOME:-$HOME/.cargo}/bin:$PATH"
   if ! command -v cargo >/dev/null 2>&1; then
-    echo "setup: cargo is needed to install naga-cli $NAGA_VERSION — install Rust (rustup) first" >&2
-    exit 1
+    # Debian's cargo (1.65) is too old for naga 30 (rust-version 1.87): pinned rustup toolchain.
+    echo "setup: installing Rust $RUST_TOOLCHAIN (minimal profile) with rustup"
+    command -v curl >/dev/null 2>&1 || {
+      export DEBIAN_FRONTEND=noninteractive
+      apt-get update -qq && apt-get install -y -qq --no-install-recommends curl ca-certificates >/dev/null
+    }
+    command -v cc >/dev/null 2>&1 || {
+      export DEBIAN_FRONTEND=noninteractive
+      apt-get update -qq && apt-get install -y -qq --no-install-recommends gcc libc6-dev >/dev/null
+    }
+    rustup_init=$(mktemp)
+    curl --proto '=https' --tlsv1.2 -sSf -o "$rustup_init" \
+      "https://static.rust-lang.org/rustup/dist/$(uname -m)-unknown-linux-gnu/rustup-init"
+    chmod +x "$rustup_init"
+    "$rustup_init" -y -q --profile minimal --default-toolchain "$RUST_TOOLCHAIN" --no-modify-path
+    rm -f "$rustup_init"
   fi
-  echo "setup: cargo install naga-cli $NAGA_VERSION (about a minute)"
+  echo "setup: cargo install naga-cli $NAGA_VERSION into .tools (about a minute)"
   cargo install naga-cli --locked --version "$NAGA_VERSION" --root "$PWD/.tools" -q
 fi
 
 # Python environment in .venv with the package installed editable.
 PY=${PYTHON:-python3}
 if [[ ! -x .venv/bin/python ]]; then
+  if ! "$PY" -c 'import ensurepip, venv' >/dev/null 2>&1; then  # Debian splits venv out
+    echo "setup: installing python3-venv"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq && apt-get install -y -qq --no-install-recommends python3-venv >/dev/null
+  fi
   "$PY" -m venv .venv
 fi
 stamp=.venv/.setup-stamp
@@ -48,6 +73,6 @@ want_stamp=$(cat requirements.lock pyproject.toml | sha256sum | cut -d' ' -f1)
 if [[ ! -f $stamp || "$(cat $stamp)" != "$want_stamp" ]]; then
   echo "setup: installing Python packages into .venv"
   .venv/bin/python -m pip install -q --disable-pip-version-check -r requirements.lock
-  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+  .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation --config-settings editable_mode=compat -e .
   echo "$want_stamp" > "$stamp"
 fi

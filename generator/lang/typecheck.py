@@ -47,6 +47,10 @@ class Checker:
     def function(self, f: ast.FunctionDef, sig) -> ir.Function:
         self.ret = sig.ret
         params = [ir.Param(n, t, self.loc(a)) for (n, t), a in zip(sig.params, f.args.args)]
+        for p, a in zip(params, f.args.args):
+            if p.name in self.sigs or p.name in self.structs or p.name in CONSTANTS or p.name in BUILTIN_TYPES or p.name in INTRINSICS:
+                raise self.err(a, f"parameter '{p.name}' shadows a function, type, intrinsic or constant",
+                               "rename the parameter")
         self.params = {p.name: p for p in params}
         self.scopes = [{p.name: (p.ty, "param") for p in params}]
         body_nodes = f.body
@@ -99,6 +103,8 @@ class Checker:
             if value.ty != target.ty:
                 raise self.err(n.value, f"cannot assign {value.ty} to {target.ty}",
                                "types never convert implicitly; use float(...), vec3(...) or another name")
+            if target.ty.kind == "texture":
+                raise self.err(t, "textures cannot be reassigned", "pass the texture you want directly")
             return ir.Assign(loc, target, None, value)
         if isinstance(n, ast.AugAssign):
             op = _ARITH.get(type(n.op))
@@ -132,7 +138,7 @@ class Checker:
         check_identifier(self.path, target, name)
         if self.lookup(name) is not None:
             raise self.err(target, f"'{name}' is already declared", "assign without an annotation, or use a new name")
-        if name in self.constants or name in CONSTANTS or name in BUILTIN_TYPES or name in INTRINSICS or name in self.sigs:
+        if name in self.constants or name in CONSTANTS or name in BUILTIN_TYPES or name in INTRINSICS or name in self.sigs or name in self.structs:
             raise self.err(target, f"'{name}' shadows a constant, type, intrinsic or function", "pick another name")
         value = self.expr(value_node)
         if ty is not None:
@@ -259,6 +265,9 @@ class Checker:
             if a.ty != b.ty:
                 raise self.err(n, f"the two sides of a conditional expression differ: {a.ty} and {b.ty}",
                                "make both sides the same type")
+            if a.ty.kind not in ("scalar", "vector"):
+                raise self.err(n, f"a conditional expression cannot choose between {a.ty} values (WGSL select)",
+                               "use an if/else statement that assigns a local")
             return ir.Select(a.ty, loc, c, a, b)
         if isinstance(n, ast.Call):
             return self.call(n)
@@ -455,8 +464,8 @@ class Checker:
                 raise fail("two vec3")
             return ir.Intrinsic(types[0], loc, name, args)
         if sig == "select":
-            if types[0] != BOOL or types[1] != types[2]:
-                raise fail("(bool, T, T)")
+            if types[0] != BOOL or types[1] != types[2] or types[1].kind not in ("scalar", "vector"):
+                raise fail("(bool, T, T) with T a scalar or vector (WGSL select)")
             return ir.Intrinsic(types[1], loc, name, args)
         if sig in ("sample", "sample_lod"):
             want = [TEXTURE2D, vector("float", 2)] + ([FLOAT] if sig == "sample_lod" else [])

@@ -60,4 +60,7 @@ def uints(a: uint, b: uint) -> uint:
 
 
 def choose_struct(x: float, p: Inner, q: Inner) -> Inner:
-    return p if x > 0.0 else q
+    # WGSL select() takes no structs, so the language asks for an if/else here.
+    if x > 0.0:
+        return p
+    return q

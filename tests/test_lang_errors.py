@@ -1,0 +1,77 @@
+"""The brick language rejects everything outside its subset with path:line:col and a hint."""
+import pytest
+
+from generator.lang import SourceError, parse_module
+
+HEAD = '"""A test brick."""\nBRICK = {"kind": "specular"}\n\n'
+
+
+def brick(body: str) -> str:
+    return HEAD + body
+
+
+CASES = [
+    # (source after the header, line, col, words the message must contain)
+    ("def f(x: float) -> float:\n    return 2 * x\n", 5, 12, "no implicit conversions"),
+    ("def f(x: float) -> float:\n    y = [x]\n    return x\n", 5, 9, "lists are not allowed"),
+    ("def f(x: float) -> float:\n    while x > 0.0:\n        x -= 1.0\n    return x\n", 5, 5, "'While' is not allowed"),
+    ("def f(x: float) -> float:\n    return x ** 2.0\n", 5, 12, "use pow"),
+    ("def f(x: float) -> float:\n    return foo(x)\n", 5, 12, "unknown function 'foo'"),
+    ("def f(x: float) -> float:\n    if x > 0.0:\n        return x\n", 4, 1, "can reach its end"),
+    ("def f(x) -> float:\n    return 1.0\n", 4, 7, "has no type"),
+    ("def f(x: float) -> vec3:\n    return x\n", 5, 12, "returns float"),
+    ("import os\n", 4, 1, "imports are not allowed"),
+    ("def f(x: float) -> float:\n    return f(x)\n", 4, 1, "recursion"),
+    ("def f(v: vec3) -> vec3:\n    v.xy = vec2(1.0)\n    return v\n", 5, 5, "multi-component swizzle"),
+    ("def f(v: vec3) -> float:\n    return v.q\n", 5, 12, "not a swizzle"),
+    ("def f(v: vec3) -> float:\n    return v.w\n", 5, 12, "reads past"),
+    ("def f(x: float) -> float:\n    for i in range(x):\n        x += 1.0\n    return x\n", 5, 20, "non-negative int constant"),
+    ("def f(x: float) -> float:\n    return dot(x, x)\n", 5, 12, "dot(float, float) is not defined"),
+    ("def f(x: float) -> float:\n    return x if x > 0 else 0.0\n", 5, 17, "cannot compare float with int"),
+    ("def f(__x: float) -> float:\n    return 1.0\n", 4, 7, "reserved for the generator"),
+    ("def f(x: float) -> float:\n    return clamp(x, 0.0)\n", 5, 12, "clamp takes 3 arguments"),
+    ("def f(x: float) -> float:\n    x\n    return x\n", 5, 5, "does nothing"),
+    ("x = 3\n", 4, 1, "not a constant"),
+    ("def f(x: float) -> float:\n    return x +\n", 5, 15, "syntax error"),
+]
+
+
+@pytest.mark.parametrize("body,line,col,words", CASES, ids=[c[3] for c in CASES])
+def test_rejected_with_location_and_hint(body, line, col, words):
+    with pytest.raises(SourceError) as e:
+        parse_module(brick(body), "bricks/test.py")
+    err = e.value
+    assert (err.path, err.line, err.col) == ("bricks/test.py", line, col), str(err)
+    assert words in str(err)
+    assert err.hint, "every language error says what to do instead"
+    assert str(err).startswith(f"bricks/test.py:{line}:{col}: ")
+
+
+def test_metadata_must_be_literal():
+    with pytest.raises(SourceError, match="BRICK must be a literal dict"):
+        parse_module('"""d"""\nBRICK = dict(kind="x")\n', "b.py")
+
+
+def test_brick_is_never_executed(tmp_path):
+    # A brick whose top level would have side effects if executed: it must be rejected, not run.
+    marker = tmp_path / "ran"
+    src = f'"""d"""\nBRICK = {{"kind": "diffuse"}}\nopen({str(marker)!r}, "w")\n'
+    with pytest.raises(SourceError):
+        parse_module(src, "evil.py")
+    assert not marker.exists()
+
+
+def test_valid_constructs_type_check():
+    m = parse_module(brick(
+        "K = 3\n"
+        "class S:\n    a: float\n    b: vec3\n"
+        "def g(x: float) -> float:\n    return x * 2.0\n"
+        "def f(x: float, v: vec3) -> vec3:\n"
+        "    acc = 0.0\n"
+        "    for i in range(K):\n        acc += float(i)\n"
+        "    s = S(g(x), v)\n"
+        "    w = clamp(v, 0.0, 1.0)\n"
+        "    return s.b * acc + w.zyx * (x if x > 0.0 else 1.0)\n"), "b.py")
+    f = m.functions["f"]
+    assert f.calls == ["g"]
+    assert str(f.ret) == "vec3"
