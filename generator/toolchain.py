@@ -1,0 +1,422 @@
+"""Compilers and validators: HLSL / GLSL / WGSL source -> validated SPIR-V.
+
+One call, :func:`compile_many`, takes any number of :class:`CompileJob` and
+returns one :class:`CompileResult` per job key. Every failing job carries at
+least one error :class:`Diagnostic`; no job fails silently.
+
+Pipeline per job (all SPIR-V is version 1.3, validated for ``vulkan1.1``):
+
+1. front end
+   - GLSL and HLSL: ``glslc --target-env=vulkan1.1 -c`` over a *batch* of
+     files in one process (``-x``/``-fshader-stage``/``-fentry-point`` apply
+     to the files after them, so GLSL and HLSL of all stages share a batch).
+     glslc carries on past a failing file and still writes the other outputs,
+     but its diagnostics name the ``#line`` path, not the input file. So when
+     a batch prints anything, it is rerun with a tiny *sentinel* file after
+     each input that always fails with ``#error SHADERMATRIX_SENTINEL``; the
+     sentinel's message closes the previous job's diagnostics. A job that has
+     no output and no parsed error (a crash, an unknown message format) is
+     recompiled alone.
+   - WGSL: ``naga --spirv-version 1.3 in.wgsl out.spv``, one process per file
+     (naga converts one input per run); about 2 ms each.
+2. ``spirv-val --target-env vulkan1.1`` on the front end's output;
+3. with ``optimize``: ``spirv-opt --target-env=vulkan1.1 -O`` and
+   ``spirv-val`` again on the result.
+
+Batches and per-file steps run on a thread pool of ``os.cpu_count()``
+workers; GLSL/HLSL jobs are dealt into one glslc batch per worker (at least
+8 and at most 256 jobs per batch). Sentinels are in the job's language, so
+glslang does not switch front ends; a GLSL sentinel costs ~1 ms.
+
+Measured on the 2-core development machine (Debian glslc 2023.2, 50 small
+Blinn-Phong fragment shaders, best of 3, wall clock)::
+
+    step                                        GLSL      HLSL      WGSL
+    one glslc process per shader (sequential)   5.4 s     1.3 s      -
+      = per shader (process start-up dominates) ~110 ms   ~27 ms     -
+    one glslc process for all 50                0.16 s    0.12 s     -
+      the same with a sentinel after each job   0.20 s    0.14 s     -
+    compile_many, front end only                0.14 s    0.11 s    0.08 s (naga x50)
+    compile_many, + spirv-val, spirv-opt -O,    0.38 s    0.30 s    0.31 s
+      spirv-val (3 processes per shader)
+
+Batching makes the GLSL front end ~35x and the HLSL one ~10x faster; after
+it, the three per-shader SPIR-V steps (~2-3 ms each) dominate.
+
+Error mapping: GLSL/HLSL sources carry ``#line N "bricks/x.py"`` (GLSL with
+``#extension GL_GOOGLE_cpp_style_line_directive : require``); glslc then
+reports ``bricks/x.py:N: error: ...`` (no column: col 0). Lines outside any
+``#line`` are reported against the job key. naga reports
+``┌─ file.wgsl:LINE:COL``; those lines go through ``CompileJob.line_map``.
+"""
+from __future__ import annotations
+
+import bisect
+import functools
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable
+
+__all__ = ["Diagnostic", "CompileJob", "CompileResult", "ToolMissing",
+           "compile_many", "tool_versions", "find_tool",
+           "TARGET_ENV", "SPIRV_VERSION", "SPIRV_MAGIC"]
+
+TARGET_ENV = "vulkan1.1"      # every tool gets this target environment
+SPIRV_VERSION = "1.3"         # what glslc emits for vulkan1.1; naga is told the same
+SPIRV_MAGIC = 0x07230203
+REPO_ROOT = Path(__file__).resolve().parent.parent
+TOOLS_BIN = REPO_ROOT / ".tools" / "bin"
+LANGUAGES = ("glsl", "hlsl", "wgsl")
+STAGES = ("vert", "frag", "comp")
+_SENTINEL = "SHADERMATRIX_SENTINEL"
+_MAX_BATCH = 256  # jobs per glslc process
+_SENTINEL_SRC = {"glsl": f"#version 450\n#error {_SENTINEL}\n", "hlsl": f"#error {_SENTINEL}\n"}
+
+
+@dataclass(frozen=True)
+class Diagnostic:
+    path: str
+    line: int
+    col: int
+    severity: str  # "error" | "warning"
+    message: str
+    tool: str
+
+    def __str__(self) -> str:
+        return f"{self.path}:{self.line}:{self.col}: {self.severity}: {self.message} [{self.tool}]"
+
+
+@dataclass(frozen=True)
+class CompileJob:
+    key: str            # unique, filesystem-safe (e.g. "3fa9c2d1.frag.glsl")
+    language: str       # "glsl" | "hlsl" | "wgsl"
+    stage: str          # "vert" | "frag" | "comp"
+    source: str
+    entry: str = "main"
+    # (generated_line, path, line) sorted by generated_line, with #line
+    # semantics: generated line g >= generated_line maps to
+    # (path, line + g - generated_line) for the last such entry; lines before
+    # the first entry map to the job key itself.
+    line_map: tuple = ()
+
+
+@dataclass
+class CompileResult:
+    key: str
+    ok: bool
+    spirv: bytes | None        # validated SPIR-V (optimized when optimize=True); None unless ok
+    spirv_unopt: bytes | None  # front-end output, kept whenever the front end produced one
+    diagnostics: list[Diagnostic]
+
+
+class ToolMissing(Exception):
+    """A required external tool is not installed."""
+
+    def __init__(self, name: str):
+        super().__init__(f"{name} not found — run `make setup` (scripts/setup.sh)")
+        self.tool = name
+
+
+def find_tool(name: str) -> str | None:
+    """Path of an executable: ``<repo>/.tools/bin`` first, then ``PATH``."""
+    local = TOOLS_BIN / name
+    if local.is_file() and os.access(local, os.X_OK):
+        return str(local)
+    return shutil.which(name)
+
+
+def _need(name: str) -> str:
+    path = find_tool(name)
+    if path is None:
+        raise ToolMissing(name)
+    return path
+
+
+def _run(args: list[str], cwd: str | None = None, env: dict | None = None) -> tuple[int, str]:
+    """Run a tool; return (exit status, stdout+stderr decoded with errors=replace)."""
+    proc = subprocess.run(args, cwd=cwd, env=env, stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+    return proc.returncode, proc.stdout.decode("utf-8", errors="replace")
+
+
+def _version_of(name: str, parse) -> str:
+    path = find_tool(name)
+    if path is None:
+        return "missing"
+    try:
+        _, out = _run([path, "--version"])
+    except OSError as exc:
+        return f"unusable ({exc.strerror})"
+    if not out.strip():
+        return "unknown"
+    return parse(out) or out.strip().splitlines()[0]
+
+
+def _glslc_version(out: str) -> str | None:
+    parts = dict(line.split(None, 1) for line in out.splitlines() if len(line.split(None, 1)) == 2)
+    if "shaderc" not in parts:
+        return None
+    return f"{parts['shaderc']} (spirv-tools {parts.get('spirv-tools', '?')}, glslang {parts.get('glslang', '?')})"
+
+
+def _search(pattern: str):
+    return lambda out: (m.group(1) if (m := re.search(pattern, out)) else None)
+
+
+@functools.lru_cache(maxsize=1)
+def tool_versions() -> dict[str, str]:
+    """Stable version strings of the tools (for cache keys and provenance).
+
+    ``"missing"`` for a tool that is not installed. Computed once per process.
+    """
+    val = _version_of("spirv-val", _search(r"SPIRV-Tools v(\S+)"))
+    opt = _version_of("spirv-opt", _search(r"SPIRV-Tools v(\S+)"))
+    return {
+        "glslc": _version_of("glslc", _glslc_version),
+        "glslang": _version_of("glslangValidator", _search(r"Glslang Version: (?:\d+:)?(\S+)")),
+        "spirv-tools": val if val == opt else f"spirv-val {val}, spirv-opt {opt}",
+        "naga": _version_of("naga", _search(r"^(\S+)")),
+    }
+
+
+# ---------------------------------------------------------------- diagnostics
+
+def _map_line(job: CompileJob, line: int) -> tuple[str, int]:
+    """Generated line of ``job`` -> (path, line) through ``job.line_map``."""
+    if not job.line_map:
+        return job.key, line
+    idx = bisect.bisect_right([e[0] for e in job.line_map], line) - 1
+    if idx < 0:
+        return job.key, line
+    gen, path, src = job.line_map[idx]
+    return str(path), int(src) + line - int(gen)
+
+
+_GLSLC_DIAG = re.compile(r"^(?P<path>.+?):(?:(?P<line>\d+):)? (?P<sev>(?:fatal )?error|warning): (?P<msg>.*)$")
+_GLSLC_SUMMARY = re.compile(r"^\d+ (?:errors?|warnings?)( and \d+ warnings?)? generated\.$")
+
+
+def _parse_glslc(text: str, job: CompileJob, src_name: str) -> list[Diagnostic]:
+    diags: list[dict] = []
+    for raw in text.splitlines():
+        line = raw.rstrip()
+        if not line or _GLSLC_SUMMARY.match(line):
+            continue
+        m = _GLSLC_DIAG.match(line)
+        if not m:
+            if diags:
+                diags[-1]["message"] += " | " + line.strip()
+            continue
+        path, lineno = m["path"], int(m["line"] or 0)
+        if path in (src_name, "glslc") or path.endswith("/" + src_name):
+            path, lineno = _map_line(job, lineno)
+        sev = "warning" if m["sev"] == "warning" else "error"
+        msg = re.sub(r"^'' :\s+", "", m["msg"].strip())  # glslang's empty-token prefix
+        diags.append(dict(path=path, line=lineno, col=0, severity=sev, message=msg, tool="glslc"))
+    return [Diagnostic(**d) for d in diags]
+
+
+_ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+_NAGA_HEAD = re.compile(r"^(?P<sev>error|warning)(?:\[[^\]]*\])?: (?P<msg>.*)$")
+_NAGA_LOC = re.compile(r"^\s*┌─\s*(?P<path>.+?):(?P<line>\d+):(?P<col>\d+)")
+_NAGA_NOTE = re.compile(r"^\s*= (?P<note>.*)$")
+
+
+def _parse_naga(text: str, job: CompileJob) -> list[Diagnostic]:
+    diags: list[dict] = []
+    for raw in _ANSI.sub("", text).splitlines():
+        if m := _NAGA_HEAD.match(raw):
+            diags.append(dict(path=job.key, line=0, col=0, severity=m["sev"], message=m["msg"].strip(), tool="naga"))
+        elif diags and (m := _NAGA_LOC.match(raw)) and diags[-1]["line"] == 0:
+            path, line = _map_line(job, int(m["line"]))
+            diags[-1].update(path=path, line=line, col=int(m["col"]))
+        elif diags and (m := _NAGA_NOTE.match(raw)):
+            diags[-1]["message"] += ": " + m["note"].strip()
+    return [Diagnostic(**d) for d in diags]
+
+
+def _parse_spirv_tool(text: str, job: CompileJob, tool: str) -> list[Diagnostic]:
+    diags = []
+    for line in text.splitlines():
+        if m := re.match(r"^(error|warning): (.*)$", line.strip()):
+            diags.append(Diagnostic(job.key, 0, 0, m[1], m[2].strip(), tool))
+        elif diags and line.strip():
+            d = diags[-1]
+            diags[-1] = Diagnostic(d.path, d.line, d.col, d.severity, f"{d.message} | {line.strip()}", tool)
+    return diags
+
+
+def _failure(job: CompileJob, tool: str, rc: int, text: str) -> Diagnostic:
+    tail = " | ".join(_ANSI.sub("", text).strip().splitlines()[-5:]) or "no output"
+    return Diagnostic(job.key, 0, 0, "error", f"{tool} failed (exit status {rc}): {tail}", tool)
+
+
+def _has_error(diags: list[Diagnostic]) -> bool:
+    return any(d.severity == "error" for d in diags)
+
+
+# ---------------------------------------------------------------- front ends
+
+_Front = tuple[CompileJob, "bytes | None", list[Diagnostic]]
+
+
+def _glslc_batch(glslc: str, tmp: str, items: list[tuple[int, CompileJob]],
+                 sentinels: bool = False) -> list[_Front]:
+    """Compile GLSL/HLSL jobs with one glslc process.
+
+    Optimistic: without sentinels first. Only when glslc printed diagnostics
+    for a batch of several jobs is the batch run again with a sentinel after
+    every job, so that each message can be given to its job.
+    """
+    args = [glslc, f"--target-env={TARGET_ENV}", "-c"]
+    names: list[tuple[str, str, str]] = []
+    for idx, job in items:
+        src, out = f"j{idx:06d}.{job.language}", f"j{idx:06d}.spv"  # glslc: x.glsl -> x.spv
+        sentinel = f"s{idx:06d}.{job.language}"  # same language: no front-end switch
+        Path(tmp, src).write_text(job.source, encoding="utf-8")
+        args += ["-x", job.language, f"-fshader-stage={job.stage}", f"-fentry-point={job.entry}", src]
+        if sentinels:
+            Path(tmp, sentinel).write_text(_SENTINEL_SRC[job.language])
+            args.append(sentinel)
+        names.append((src, out, sentinel))
+    rc, text = _run(args, cwd=tmp)
+    lines = text.splitlines()
+    if not sentinels and len(items) > 1 and any(_GLSLC_DIAG.match(x) for x in lines):
+        return _glslc_batch(glslc, tmp, items, sentinels=True)
+
+    # Give each job its lines: job i's messages precede sentinel i's.
+    chunks: list[list[str]] = [[] for _ in items]
+    if sentinels:
+        pos = 0
+        for line in lines:
+            if pos < len(items) and line.startswith(names[pos][2] + ":") and _SENTINEL in line:
+                pos += 1
+            elif pos < len(items):
+                chunks[pos].append(line)
+    elif len(items) == 1:
+        chunks[0] = lines
+
+    results: list[_Front] = []
+    for (idx, job), (src, out, _), job_lines in zip(items, names, chunks):
+        out_path = Path(tmp, out)
+        spv = out_path.read_bytes() if out_path.is_file() else None
+        diags = _parse_glslc("\n".join(job_lines), job, src)
+        if spv is None and not _has_error(diags):
+            if len(items) > 1:  # failed inside a batch with nothing said about it: retry alone
+                results.extend(_glslc_batch(glslc, tmp, [(idx, job)]))
+                continue
+            diags.append(_failure(job, "glslc", rc, text))
+        results.append((job, spv, diags))
+    return results
+
+
+def _naga_one(naga: str, tmp: str, idx: int, job: CompileJob) -> _Front:
+    src, out = f"j{idx:06d}.wgsl", f"j{idx:06d}.spv"
+    Path(tmp, src).write_text(job.source, encoding="utf-8")
+    env = dict(os.environ, NO_COLOR="1", RUST_LOG="off")
+    rc, text = _run([naga, "--spirv-version", SPIRV_VERSION, "--entry-point", job.entry, src, out],
+                    cwd=tmp, env=env)
+    out_path = Path(tmp, out)
+    spv = out_path.read_bytes() if rc == 0 and out_path.is_file() else None
+    diags = _parse_naga(text, job)
+    if spv is None and not _has_error(diags):
+        diags.append(_failure(job, "naga", rc, text))
+    return job, spv, diags
+
+
+# ---------------------------------------------------------------- SPIR-V steps
+
+def _spirv_steps(tools: dict, tmp: str, idx: int, job: CompileJob, spv: bytes,
+                 diags: list[Diagnostic], optimize: bool, validate: bool) -> CompileResult:
+    diags = list(diags)
+    unopt = Path(tmp, f"j{idx:06d}.spv")
+    unopt.write_bytes(spv)
+
+    def val(path: Path) -> bool:
+        if not validate:
+            return True
+        rc, text = _run([tools["spirv-val"], "--target-env", TARGET_ENV, str(path)])
+        if rc == 0:
+            return True
+        found = _parse_spirv_tool(text, job, "spirv-val")
+        diags.extend(found if _has_error(found) else [_failure(job, "spirv-val", rc, text)])
+        return False
+
+    if not val(unopt):
+        return CompileResult(job.key, False, None, spv, diags)
+    if not optimize:
+        return CompileResult(job.key, True, spv, spv, diags)
+    opt = Path(tmp, f"j{idx:06d}.opt.spv")
+    rc, text = _run([tools["spirv-opt"], f"--target-env={TARGET_ENV}", "-O", str(unopt), "-o", str(opt)])
+    if rc != 0 or not opt.is_file():
+        found = _parse_spirv_tool(text, job, "spirv-opt")
+        diags.extend(found if _has_error(found) else [_failure(job, "spirv-opt", rc, text)])
+        return CompileResult(job.key, False, None, spv, diags)
+    if not val(opt):
+        return CompileResult(job.key, False, None, spv, diags)
+    return CompileResult(job.key, True, opt.read_bytes(), spv, diags)
+
+
+# ---------------------------------------------------------------- driver
+
+def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate: bool = True,
+                 progress: bool = False) -> dict[str, CompileResult]:
+    """Compile and validate every job; returns {key: CompileResult} in input order.
+
+    Raises ToolMissing if a tool the jobs need is absent, ValueError on a
+    malformed job (duplicate key, unknown language or stage).
+    """
+    jobs = list(jobs)
+    seen: set[str] = set()
+    for job in jobs:
+        if job.key in seen:
+            raise ValueError(f"duplicate compile job key {job.key!r}")
+        if job.language not in LANGUAGES or job.stage not in STAGES:
+            raise ValueError(f"{job.key}: unknown language/stage {job.language!r}/{job.stage!r}")
+        seen.add(job.key)
+    if not jobs:
+        return {}
+    tools: dict[str, str] = {}
+    if any(j.language in ("glsl", "hlsl") for j in jobs):
+        tools["glslc"] = _need("glslc")
+    if any(j.language == "wgsl" for j in jobs):
+        tools["naga"] = _need("naga")
+    if validate:
+        tools["spirv-val"] = _need("spirv-val")
+    if optimize:
+        tools["spirv-opt"] = _need("spirv-opt")
+
+    from tqdm import tqdm
+
+    workers = max(1, os.cpu_count() or 1)
+    index = {job.key: i for i, job in enumerate(jobs)}
+    results: dict[str, CompileResult] = {}
+    batchable = [(i, j) for i, j in enumerate(jobs) if j.language != "wgsl"]
+    n_chunks = max(min(workers, len(batchable) // 8), -(-len(batchable) // _MAX_BATCH), 1 if batchable else 0)
+    with tempfile.TemporaryDirectory(prefix="shadermatrix-") as tmp, \
+            ThreadPoolExecutor(max_workers=workers) as pool, \
+            tqdm(total=len(jobs), disable=not progress, unit="shader", leave=False) as bar:
+        front = [pool.submit(_glslc_batch, tools["glslc"], tmp, batchable[k::n_chunks])
+                 for k in range(n_chunks)]
+        front += [pool.submit(lambda i, j: [_naga_one(tools["naga"], tmp, i, j)], i, j)
+                  for i, j in enumerate(jobs) if j.language == "wgsl"]
+        back = []
+        for fut in as_completed(front):
+            for job, spv, diags in fut.result():
+                if spv is None:
+                    results[job.key] = CompileResult(job.key, False, None, None, diags)
+                    bar.update()
+                else:
+                    back.append(pool.submit(_spirv_steps, tools, tmp, index[job.key], job, spv,
+                                            diags, optimize, validate))
+        for fut in as_completed(back):
+            res = fut.result()
+            results[res.key] = res
+            bar.update()
+    return {job.key: results[job.key] for job in jobs}
