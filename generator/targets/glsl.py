@@ -1,0 +1,31 @@
+"""GLSL 4.50 for Vulkan (glslang): column-major matrices and combined image samplers, as in the IR."""
+from __future__ import annotations
+
+from .clike import CLikeTarget
+
+
+class GlslTarget(CLikeTarget):
+    name = "glsl"
+    ext = "glsl"
+
+    SCALARS = {"float": "float", "int": "int", "uint": "uint", "bool": "bool"}
+    VECTORS = {"float": "vec{n}", "int": "ivec{n}", "uint": "uvec{n}", "bool": "bvec{n}"}
+    MATRIX = "mat{n}"
+    TEXTURE = "sampler2D"
+    SAMPLER = ""  # combined image sampler: one parameter, one binding
+    INTRINSICS = {
+        "rsqrt": "inversesqrt({0})",
+        "saturate": "clamp({0}, 0.0, 1.0)",  # GLSL clamp takes float bounds for any genFType
+        "atan2": "atan({0}, {1})",
+        "select": "({0} ? {1} : {2})",
+        "sample": "texture({0}, {1})",
+        "sample_level": "textureLod({0}, {1}, {2})",
+    }
+
+    def header(self) -> str:
+        """`#line N "path"` with a file name needs this extension in glslang."""
+        return "#extension GL_GOOGLE_cpp_style_line_directive : require"
+
+    def declare_texture(self, name: str, set: int, binding: int) -> str:
+        """One combined sampler2D at binding B; B+1 stays free so all targets number alike."""
+        return f"layout(set = {int(set)}, binding = {int(binding)}) uniform sampler2D {self.ident(name)};"

@@ -1,0 +1,121 @@
+"""HLSL through glslang's HLSL front end (glslc -x hlsl) and, in spirit, DXC.
+
+IR matrices are column-major like GLSL and their HLSL values are the same
+mathematical matrices: a column list becomes transpose(floatNxN(rows...)),
+products become mul(), and column i of m is read as transpose(m)[i] (written
+component by component, m[r][i]). Structs get a `_make_S(...)` constructor
+function, since HLSL has no struct constructor expression.
+"""
+from __future__ import annotations
+
+from ..lang import ir
+from ..lang.types import Type
+from .clike import CLikeTarget, Writer
+
+_COMPONENT = {"x": 0, "y": 1, "z": 2, "w": 3}
+
+
+class HlslTarget(CLikeTarget):
+    name = "hlsl"
+    ext = "hlsl"
+
+    SCALARS = {"float": "float", "int": "int", "uint": "uint", "bool": "bool"}
+    VECTORS = {"float": "float{n}", "int": "int{n}", "uint": "uint{n}", "bool": "bool{n}"}
+    MATRIX = "float{n}x{n}"
+    TEXTURE = "Texture2D"
+    SAMPLER = "SamplerState"
+    INTRINSICS = {
+        "fract": "frac({0})",
+        "mix": "lerp({0}, {1}, {2})",
+        "select": "({0} ? {1} : {2})",
+        "sample": "{0}.Sample({smp}, {1})",
+        "sample_level": "{0}.SampleLevel({smp}, {1}, {2})",
+    }
+
+    def declare_texture(self, name: str, set: int, binding: int) -> str:
+        """Texture2D NAME at binding B and SamplerState NAME_smp at B+1 of set S (t/s registers alike)."""
+        s, b = int(set), int(binding)
+        return (f"[[vk::binding({b}, {s})]] Texture2D {self.ident(name)} : register(t{b}, space{s});\n"
+                f"[[vk::binding({b + 1}, {s})]] SamplerState {self.sampler_name(name)} : "
+                f"register(s{b + 1}, space{s});")
+
+    # ------------------------------------------------------------ structs
+    def struct_decl(self, w: Writer, s: Type) -> None:
+        super().struct_decl(w, s)
+        name = self.ident(s.name)
+        fields = [self.ident(f) for f, _ in s.fields]
+        params = ", ".join(self.var_decl(f, t) for f, (_, t) in zip(fields, s.fields))
+        w.line(f"{name} {self.maker(s)}({params}) {{")
+        w.depth += 1
+        w.line(f"{name} _s;")
+        for f in fields:
+            w.line(f"_s.{f} = {f};")
+        w.line("return _s;")
+        w.depth -= 1
+        w.line("}")
+
+    def maker(self, s: Type) -> str:
+        return "_make_" + self.ident(s.name)
+
+    def struct_value(self, t: Type, args: list[str]) -> str:
+        return f"{self.maker(t)}({', '.join(args)})"
+
+    # ------------------------------------------------------------ matrices
+    def splat(self, t: Type, x: str) -> str:
+        return f"(({self.type_name(t)})({x}))"  # HLSL has no one-scalar vector constructor
+
+    def matrix(self, t: Type, columns: list[str]) -> str:
+        return f"transpose({self.type_name(t)}({', '.join(columns)}))"
+
+    def expr_binary(self, e: ir.Binary) -> str:
+        if e.op == "*" and _is_product(e.lhs.ty, e.rhs.ty):
+            return f"mul({self.expr(e.lhs)}, {self.expr(e.rhs)})"
+        return super().expr_binary(e)
+
+    def expr_index(self, e: ir.Index) -> str:
+        col = _column(e.base)
+        if col is not None:  # m[i][j]: row j, column i
+            return f"{self.expr(col.base)}[{self.expr(e.index)}][{self.expr(col.index)}]"
+        if e.base.ty.kind == "matrix":
+            return f"transpose({self.expr(e.base)})[{self.expr(e.index)}]"
+        return super().expr_index(e)
+
+    def expr_swizzle(self, e: ir.Swizzle) -> str:
+        col = _column(e.base)
+        if col is not None and len(e.components) == 1:  # m[i].y: row 1, column i
+            return f"{self.expr(col.base)}[{_COMPONENT[e.components]}][{self.expr(col.index)}]"
+        return super().expr_swizzle(e)
+
+    def expr_intrinsic(self, e: ir.Intrinsic) -> str:
+        if e.name == "sign" and e.ty.scalar == "float":  # HLSL sign() returns int
+            return f"{self.type_name(e.ty)}(sign({self.expr(e.args[0])}))"
+        return super().expr_intrinsic(e)
+
+    # ------------------------------------------------------------ assignment
+    def assign(self, w: Writer, s: ir.Assign) -> None:
+        col = _column(s.target)
+        if col is not None:  # m[i] = v: write column i one row at a time, on one line for #line
+            m, i, op = self.expr(col.base), self.expr(col.index), s.op or ""
+            scalar = s.value.ty.kind == "scalar"
+            rows = " ".join(f"{m}[{r}][{i}] {op}= {'_c' if scalar else '_c.' + 'xyzw'[r]};"
+                            for r in range(col.ty.size))
+            w.line(f"{{ {self.type_name(s.value.ty)} _c = {self.expr(s.value)}; {rows} }}", s.loc)
+            return
+        if s.op == "*" and _is_product(s.target.ty, s.value.ty):  # HLSL *= is component-wise
+            t = self.expr(s.target)
+            w.line(f"{t} = mul({t}, {self.expr(s.value)});", s.loc)
+            return
+        super().assign(w, s)
+
+
+def _is_product(a: Type, b: Type) -> bool:
+    """A matrix product (matrix with matrix or vector), not scaling by a scalar."""
+    kinds = {a.kind, b.kind}
+    return "matrix" in kinds and "scalar" not in kinds
+
+
+def _column(e: ir.Expr) -> ir.Index | None:
+    """e as `m[i]`, a column of a matrix, or None."""
+    if isinstance(e, ir.Index) and e.base.ty.kind == "matrix":
+        return e
+    return None

@@ -1,0 +1,100 @@
+"""WGSL as naga accepts it: typed literals, immutable parameters, select() for conditionals."""
+from __future__ import annotations
+
+from ..lang import ir
+from ..lang.types import Type
+from .clike import CLikeTarget, Writer
+
+PARAM_COPY_SUFFIX = "_in"
+
+
+class WgslTarget(CLikeTarget):
+    name = "wgsl"
+    ext = "wgsl"
+    line_directives = False  # WGSL has no #line; toolchain maps naga's lines through line_map
+
+    SCALARS = {"float": "f32", "int": "i32", "uint": "u32", "bool": "bool"}
+    VECTORS = {"float": "vec{n}<f32>", "int": "vec{n}<i32>", "uint": "vec{n}<u32>", "bool": "vec{n}<bool>"}
+    MATRIX = "mat{n}x{n}<f32>"
+    TEXTURE = "texture_2d<f32>"
+    SAMPLER = "sampler"
+    # Typed literals keep constant folding in f32/i32, as GLSL and HLSL do (abstract numbers fold in f64).
+    FLOAT_SUFFIX = "f"
+    INT_SUFFIX = "i"
+    INTRINSICS = {
+        "rsqrt": "inverseSqrt({0})",
+        "select": "select({2}, {1}, {0})",  # WGSL: select(if_false, if_true, cond)
+        "sample": "textureSample({0}, {smp}, {1})",
+        "sample_level": "textureSampleLevel({0}, {smp}, {1}, {2})",
+    }
+
+    def declare_texture(self, name: str, set: int, binding: int) -> str:
+        """texture_2d<f32> NAME at binding B and sampler NAME_smp at B+1 of group S."""
+        s, b = int(set), int(binding)
+        return (f"@group({s}) @binding({b}) var {self.ident(name)}: texture_2d<f32>;\n"
+                f"@group({s}) @binding({b + 1}) var {self.sampler_name(name)}: sampler;")
+
+    def var_decl(self, name: str, t: Type | None) -> str:
+        return f"{name}: {self.type_name(t) if t is not None else self.SAMPLER}"
+
+    def struct_decl(self, w: Writer, s: Type) -> None:
+        w.line(f"struct {self.ident(s.name)} {{")
+        w.depth += 1
+        for f, t in s.fields:
+            w.line(f"{self.var_decl(self.ident(f), t)},")
+        w.depth -= 1
+        w.line("}")
+
+    # ------------------------------------------------------------ functions
+    def param_list(self, f: ir.Function) -> list[str]:
+        copies = _param_copies(f, self.ident)
+        out = []
+        for p in f.params:
+            out += [self.var_decl(copies[p.name], p.ty)] if p.name in copies else self.params(p)
+        return out
+
+    def signature(self, f: ir.Function, params: str) -> str:
+        return f"fn {self.ident(f.name)}({params}) -> {self.type_name(f.ret)} {{"
+
+    def prologue(self, w: Writer, f: ir.Function) -> None:
+        """WGSL parameters are immutable: an assigned one is copied into a var of its name."""
+        copies = _param_copies(f, self.ident)
+        for p in f.params:
+            if p.name in copies:
+                w.line(self.decl(self.ident(p.name), p.ty, copies[p.name]), f.loc)
+
+    # ------------------------------------------------------------ statements
+    def decl(self, name: str, t: Type, value: str) -> str:
+        return f"var {self.var_decl(name, t)} = {value};"
+
+    def for_head(self, var: str, count: int) -> str:
+        return (f"for (var {var}: i32 = {self.int_literal(0)}; {var} < {self.int_literal(count)}; "
+                f"{var}++) {{")
+
+    def if_head(self, cond: str) -> str:
+        return f"if {cond} {{"
+
+    # ------------------------------------------------------------ expressions
+    def expr_unary(self, e: ir.Unary) -> str:
+        if e.op == "-" and e.ty.kind == "matrix":  # WGSL has no matrix negation
+            return f"({self.literal(e.ty, -1.0)} * {self.expr(e.operand)})"
+        return super().expr_unary(e)
+
+    def select(self, cond: str, if_true: str, if_false: str) -> str:
+        return f"select({if_false}, {if_true}, {cond})"
+
+
+def _param_copies(f: ir.Function, ident) -> dict[str, str]:
+    """Signature names for assigned parameters: `<name>_in`, plus '_' while that is taken."""
+    taken = {ident(p.name) for p in f.params}
+    taken |= {ident(s.name) for s in ir.walk_body(f.body) if isinstance(s, ir.Decl)}
+    taken |= {ident(s.var) for s in ir.walk_body(f.body) if isinstance(s, ir.For)}
+    out = {}
+    for p in f.params:
+        if p.assigned:
+            name = ident(p.name) + PARAM_COPY_SUFFIX
+            while name in taken:
+                name += "_"
+            taken.add(name)
+            out[p.name] = name
+    return out
