@@ -99,6 +99,12 @@ def _template_hash(name: str) -> str:
     return hashlib.sha256((TEMPLATES / name).read_bytes()).hexdigest()[:12]
 
 
+def _templates_used(lang: str, main: str) -> dict[str, str]:
+    """The template and the macros it imports, with their hashes (for provenance and cache keys)."""
+    names = [main, f"{lang}/macros.{lang}.j2"]
+    return {n: _template_hash(n) for n in names}
+
+
 def brdf_params(nodes: list[Node]) -> dict[str, Type]:
     """Material parameters of a BRDF (union over its bricks; a shared name must agree on type)."""
     out: dict[str, Type] = {}
@@ -153,13 +159,15 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
     tangent = any(name == "T" for name, _ in sig)
     h = hashlib.sha256(("eval:" + canon).encode()).hexdigest()[:12]
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
-    templates = {f"{lang}/eval.{lang}.j2": _template_hash(f"{lang}/eval.{lang}.j2") for lang in languages}
+    templates = {}
     sources = []
     for lang in languages:
         target = get_target(lang)
         emitted = target.emit(prog.structs, prog.functions)
         tname = f"{lang}/eval.{lang}.j2"
-        ctx = {"provenance": _provenance("eval", canon, h, bricks, {tname: templates[tname]}),
+        used = _templates_used(lang, tname)
+        templates.update(used)
+        ctx = {"provenance": _provenance("eval", canon, h, bricks, used),
                "params": slots, "param_vec4s": max(count, 1), "tangent": tangent,
                "brdf": target.ident("brdf")}
         sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
@@ -331,8 +339,9 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
         emitted = target.emit(prog.structs, prog.functions)
         for stage in ("vertex", "fragment"):
             tname = f"{lang}/{stage}.{lang}.j2"
-            templates[tname] = _template_hash(tname)
-            ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, {tname: templates[tname]}),
+            used = _templates_used(lang, tname)
+            templates.update(used)
+            ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, used),
                    "inputs": inputs, "material_vec4s": mat_count, "light_vec4s": light_count,
                    "textures": textures, "call_args": call_args, "shade": target.ident("shade")}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else _EMPTY,

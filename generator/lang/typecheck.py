@@ -15,6 +15,7 @@ from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, TEXTURE2D, Type, vector
 
 _ARITH = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Mod: "%"}
 _CMP = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
+F32_MAX = 3.4028234663852886e38
 _SWZ = {"x": "x", "y": "y", "z": "z", "w": "w", "r": "x", "g": "y", "b": "z", "a": "w"}
 
 
@@ -211,8 +212,12 @@ class Checker:
             if type(v) is bool:
                 return ir.Const(BOOL, loc, v)
             if type(v) is int:
+                if not -2**31 <= v < 2**31:
+                    raise self.err(n, f"int literal {v} does not fit in 32 bits", "use a smaller value or a float")
                 return ir.Const(INT, loc, v)
             if type(v) is float:
+                if not abs(v) <= F32_MAX:
+                    raise self.err(n, f"float literal {v!r} is outside the fp32 range", "use a value below 3.4e38")
                 return ir.Const(FLOAT, loc, v)
             raise self.err(n, f"literal {v!r} is not allowed", "bricks use numbers and True/False only")
         if isinstance(n, ast.Name):
@@ -390,7 +395,11 @@ class Checker:
             if args[0].ty == ty:
                 return args[0]
             if isinstance(args[0], ir.Const) and ty != BOOL and args[0].ty != BOOL:
-                return ir.Const(ty, loc, float(args[0].value) if ty == FLOAT else int(args[0].value))
+                value = float(args[0].value) if ty == FLOAT else int(args[0].value)
+                lo, hi = {"int": (-2**31, 2**31 - 1), "uint": (0, 2**32 - 1), "float": (-F32_MAX, F32_MAX)}[ty.name]
+                if not lo <= value <= hi:
+                    raise self.err(n, f"{ty}({args[0].value!r}) is outside the range of {ty}", "use a value that fits")
+                return ir.Const(ty, loc, value)
             return ir.Construct(ty, loc, args)
         if ty.kind == "vector":
             if len(args) == 1 and args[0].ty.kind == "scalar":

@@ -4,7 +4,8 @@
 // eval: lambert
 // hash: 55679a70c070
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
-// template glsl/eval.glsl.j2 sha256:cf39db123b26
+// template glsl/eval.glsl.j2 sha256:ed7ce805ecd3
+// template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.
@@ -28,7 +29,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d) {
 }
 
 
-#line 32 "55679a70c070.comp.glsl"
+#line 33 "55679a70c070.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -5,7 +5,8 @@
 // hash: 4db92c6b384d
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // brick bricks/brdf/specular/blinn_phong_normalized.py sha256:e0c2f79cd030
-// template glsl/eval.glsl.j2 sha256:cf39db123b26
+// template glsl/eval.glsl.j2 sha256:ed7ce805ecd3
+// template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.
@@ -37,7 +38,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
 }
 
 
-#line 41 "4db92c6b384d.comp.glsl"
+#line 42 "4db92c6b384d.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -7,7 +7,8 @@
 // brick bricks/brdf/microfacet/ndf/ggx.py sha256:e52a1f7cdaf9
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:0da016ec3aec
 // brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
-// template glsl/eval.glsl.j2 sha256:cf39db123b26
+// template glsl/eval.glsl.j2 sha256:ed7ce805ecd3
+// template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.
@@ -65,7 +66,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
 }
 
 
-#line 69 "f637b5a924b5.comp.glsl"
+#line 70 "f637b5a924b5.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -4,7 +4,8 @@
 // eval: phong_normalized
 // hash: bcf91138f6f2
 // brick bricks/brdf/specular/phong_normalized.py sha256:81d46719a0f0
-// template glsl/eval.glsl.j2 sha256:cf39db123b26
+// template glsl/eval.glsl.j2 sha256:ed7ce805ecd3
+// template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.
@@ -30,7 +31,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float n, vec3 f0) {
 }
 
 
-#line 34 "bcf91138f6f2.comp.glsl"
+#line 35 "bcf91138f6f2.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -13,7 +13,8 @@
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
-// template glsl/fragment.glsl.j2 sha256:b431edbee193
+// template glsl/fragment.glsl.j2 sha256:524de2f76a5a
+// template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 camera_pos; } frame;
 
@@ -117,7 +118,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3
 }
 
 
-#line 121 "3492f48173ec.frag.glsl"
+#line 122 "3492f48173ec.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

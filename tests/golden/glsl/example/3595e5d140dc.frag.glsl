@@ -14,7 +14,8 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template glsl/fragment.glsl.j2 sha256:b431edbee193
+// template glsl/fragment.glsl.j2 sha256:524de2f76a5a
+// template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 camera_pos; } frame;
 
@@ -141,7 +142,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, float m_alpha, vec3 m_f0, vec3 l0_direction,
 }
 
 
-#line 145 "3595e5d140dc.frag.glsl"
+#line 146 "3595e5d140dc.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

@@ -12,7 +12,8 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template glsl/fragment.glsl.j2 sha256:b431edbee193
+// template glsl/fragment.glsl.j2 sha256:524de2f76a5a
+// template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 camera_pos; } frame;
 
@@ -120,7 +121,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec2 uv, vec3 m_rho_d, float m_n, vec3 m_f0,
 }
 
 
-#line 124 "fa18c646f579.frag.glsl"
+#line 125 "fa18c646f579.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

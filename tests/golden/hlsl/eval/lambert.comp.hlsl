@@ -3,7 +3,8 @@
 // eval: lambert
 // hash: 55679a70c070
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
-// template hlsl/eval.hlsl.j2 sha256:f5cd20d7e24a
+// template hlsl/eval.hlsl.j2 sha256:ecbddf1700fc
+// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per
 // sample: L, V, N (xyz; w unused). info.x = sample count.
@@ -26,7 +27,7 @@ float3 brdf(float3 L, float3 V, float3 N, float3 rho_d) {
 }
 
 
-#line 30 "55679a70c070.comp.hlsl"
+#line 31 "55679a70c070.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

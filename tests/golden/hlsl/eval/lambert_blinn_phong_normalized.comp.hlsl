@@ -4,7 +4,8 @@
 // hash: 4db92c6b384d
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // brick bricks/brdf/specular/blinn_phong_normalized.py sha256:e0c2f79cd030
-// template hlsl/eval.hlsl.j2 sha256:f5cd20d7e24a
+// template hlsl/eval.hlsl.j2 sha256:ecbddf1700fc
+// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per
 // sample: L, V, N (xyz; w unused). info.x = sample count.
@@ -35,7 +36,7 @@ float3 brdf(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
 }
 
 
-#line 39 "4db92c6b384d.comp.hlsl"
+#line 40 "4db92c6b384d.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

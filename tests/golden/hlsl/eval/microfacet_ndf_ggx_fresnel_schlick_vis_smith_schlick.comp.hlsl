@@ -6,7 +6,8 @@
 // brick bricks/brdf/microfacet/ndf/ggx.py sha256:e52a1f7cdaf9
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:0da016ec3aec
 // brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
-// template hlsl/eval.hlsl.j2 sha256:f5cd20d7e24a
+// template hlsl/eval.hlsl.j2 sha256:ecbddf1700fc
+// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per
 // sample: L, V, N (xyz; w unused). info.x = sample count.
@@ -63,7 +64,7 @@ float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
 }
 
 
-#line 67 "f637b5a924b5.comp.hlsl"
+#line 68 "f637b5a924b5.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

@@ -3,7 +3,8 @@
 // eval: phong_normalized
 // hash: bcf91138f6f2
 // brick bricks/brdf/specular/phong_normalized.py sha256:81d46719a0f0
-// template hlsl/eval.hlsl.j2 sha256:f5cd20d7e24a
+// template hlsl/eval.hlsl.j2 sha256:ecbddf1700fc
+// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per
 // sample: L, V, N (xyz; w unused). info.x = sample count.
@@ -28,7 +29,7 @@ float3 brdf(float3 L, float3 V, float3 N, float n, float3 f0) {
 }
 
 
-#line 32 "bcf91138f6f2.comp.hlsl"
+#line 33 "bcf91138f6f2.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

@@ -13,7 +13,8 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template hlsl/fragment.hlsl.j2 sha256:5efa8570a730
+// template hlsl/fragment.hlsl.j2 sha256:e2d6606ea30a
+// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };
 
@@ -143,7 +144,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float m_alpha, float3 m_f0, float3 l
 }
 
 
-#line 147 "3595e5d140dc.frag.hlsl"
+#line 148 "3595e5d140dc.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

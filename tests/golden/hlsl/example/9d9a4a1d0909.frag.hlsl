@@ -9,7 +9,8 @@
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
-// template hlsl/fragment.hlsl.j2 sha256:5efa8570a730
+// template hlsl/fragment.hlsl.j2 sha256:e2d6606ea30a
+// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };
 
@@ -92,7 +93,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_n, float3 m_
 }
 
 
-#line 96 "9d9a4a1d0909.frag.hlsl"
+#line 97 "9d9a4a1d0909.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

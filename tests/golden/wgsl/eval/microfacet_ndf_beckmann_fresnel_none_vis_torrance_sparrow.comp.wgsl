@@ -6,7 +6,8 @@
 // brick bricks/brdf/microfacet/ndf/beckmann.py sha256:a19bd1ffdea3
 // brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:4182047e2a9c
 // brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
-// template wgsl/eval.wgsl.j2 sha256:ecdf106195b2
+// template wgsl/eval.wgsl.j2 sha256:496836b005df
+// template wgsl/macros.wgsl.j2 sha256:80e35411c40a
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

@@ -6,7 +6,8 @@
 // brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:9a76bc833beb
 // brick bricks/brdf/microfacet/visibility/implicit.py sha256:7042a3d619ce
 // brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
-// template wgsl/eval.wgsl.j2 sha256:ecdf106195b2
+// template wgsl/eval.wgsl.j2 sha256:496836b005df
+// template wgsl/macros.wgsl.j2 sha256:80e35411c40a
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

@@ -14,7 +14,8 @@
 // brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template wgsl/fragment.wgsl.j2 sha256:e91fb2a7180e
+// template wgsl/fragment.wgsl.j2 sha256:fbd4aa5a6a8d
+// template wgsl/macros.wgsl.j2 sha256:80e35411c40a
 
 struct Frame { view_proj: mat4x4<f32>, model: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;
