@@ -7,7 +7,7 @@
 // brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:9a76bc833beb
 // brick bricks/brdf/microfacet/visibility/implicit.py sha256:7042a3d619ce
 // brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
-// template glsl/eval.glsl.j2 sha256:ed7ce805ecd3
+// template glsl/eval.glsl.j2 sha256:184a01d74c8a
 // template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
