@@ -1,0 +1,45 @@
+"""`shadermatrix bricks`: every brick with kind, slots, parameters and citation."""
+from __future__ import annotations
+
+import json
+
+HELP = "list every brick: kind, slots, parameters (type, range, default), citation"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("--bricks", action="append", metavar="DIR", help="an extra brick directory (repeatable)")
+    p.add_argument("--json", action="store_true", help="machine-readable output")
+
+
+def rows(lib) -> list[dict]:
+    out = []
+    for (kind, bid), b in sorted(lib.bricks.items()):
+        out.append({
+            "id": bid, "kind": kind, "path": b.display_path, "cite": b.cite,
+            "summary": b.doc.splitlines()[0] if b.doc else "",
+            "slots": {s: {"kind": v["kind"], "default": v["default"],
+                          "fillers": [x.id for x in lib.of_kind(v["kind"])]} for s, v in b.slots.items()},
+            "params": {p.name: {"type": str(p.ty), "range": list(p.range) if p.range else None,
+                                "default": p.default, "doc": p.doc} for p in b.params.values()},
+            "textures": sorted(b.textures),
+        })
+    return out
+
+
+def run(args) -> int:
+    from ..bricks import load_library
+    table = rows(load_library(args.bricks or ()))
+    if args.json:
+        print(json.dumps(table, indent=2))
+        return 0
+    for r in table:
+        print(f"{r['kind']:<10} {r['id']:<24} {r['summary']}")
+        print(f"{'':<35}cite: {r['cite']}")
+        for s, v in r["slots"].items():
+            print(f"{'':<35}slot {s} ({v['kind']}, default {v['default']}): {', '.join(v['fillers'])}")
+        for name, p in r["params"].items():
+            rng = f" in [{p['range'][0]}, {p['range'][1]}]" if p["range"] else ""
+            print(f"{'':<35}param {name}: {p['type']}{rng}, default {p['default']}")
+        for t in r["textures"]:
+            print(f"{'':<35}texture {t}")
+    return 0
