@@ -145,8 +145,48 @@ def _provenance(kind: str, key: str, h: str, bricks: dict, templates: dict) -> l
 
 # ------------------------------------------------------------------ eval kernel
 
-def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
-    """The compute eval kernel of one BRDF spec: f_r for each (L, V, N[, T]) sample."""
+@dataclass
+class EvalProgram:
+    """The linked program of one BRDF spec's eval kernel: brick functions plus the brdf() glue."""
+
+    spec: str  # canonical spec
+    nodes: list[Node]
+    program: Program
+    params: dict[str, Type]  # material parameters in kernel order
+    signature: list[tuple[str, Type]]  # brdf()'s parameters: L, V, N[, T, B], params...
+    slots: list[Slot]  # params in the vec4 parameter array
+    param_vec4s: int
+    tangent: bool  # brdf() reads T and B
+
+    @property
+    def hash(self) -> str:
+        return hashlib.sha256(("eval:" + self.spec).encode()).hexdigest()[:12]
+
+    def defaults(self) -> dict[str, object]:
+        """Each parameter's default, from the first brick of the spec that declares it."""
+        out: dict[str, object] = {}
+        for top in self.nodes:
+            for n in top.walk():
+                for name, p in n.brick.params.items():
+                    out.setdefault(name, p.default)
+        return out
+
+    def ranges(self) -> dict[str, tuple | None]:
+        """Each parameter's allowed range (the narrowest over the bricks that declare it)."""
+        out: dict[str, tuple | None] = {}
+        for top in self.nodes:
+            for n in top.walk():
+                for name, p in n.brick.params.items():
+                    old = out.get(name)
+                    if p.range is None or old is None:
+                        out[name] = old or p.range
+                    else:
+                        out[name] = (max(old[0], p.range[0]), min(old[1], p.range[1]))
+        return out
+
+
+def eval_program(spec: str, lib: Library) -> EvalProgram:
+    """Link a BRDF spec into the program its eval kernel runs (every target emits this IR)."""
     nodes = parse_brdf(spec, lib)
     canon = "+".join(n.canonical() for n in nodes)
     prog = Program()
@@ -157,7 +197,13 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
     prog.add_glue(glue_header("BRDF glue") + text)
     slots, count = layout(list(params.items()))
     tangent = any(name == "T" for name, _ in sig)
-    h = hashlib.sha256(("eval:" + canon).encode()).hexdigest()[:12]
+    return EvalProgram(canon, nodes, prog, params, sig, slots, count, tangent)
+
+
+def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
+    """The compute eval kernel of one BRDF spec: f_r for each (L, V, N[, T]) sample."""
+    ep = eval_program(spec, lib)
+    prog, canon, h = ep.program, ep.spec, ep.hash
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
     sources = []
@@ -168,11 +214,11 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
         used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance("eval", canon, h, bricks, used),
-               "params": slots, "param_vec4s": max(count, 1), "tangent": tangent,
+               "params": ep.slots, "param_vec4s": max(ep.param_vec4s, 1), "tangent": ep.tangent,
                "brdf": target.ident("brdf")}
         sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
-    return Composed(canon, h, sources, bricks, templates, material=slots,
-                    inputs=["L", "V", "N"] + (["T"] if tangent else []))
+    return Composed(canon, h, sources, bricks, templates, material=ep.slots,
+                    inputs=["L", "V", "N"] + (["T"] if ep.tangent else []))
 
 
 # ------------------------------------------------------------------ permutation
