@@ -1,0 +1,244 @@
+"""Evaluate a BRDF spec on samples: float64 reference, NumPy emission, or a GPU eval kernel on lavapipe.
+
+``evaluate(spec, L, V, N, T=None, params=None, target=..., dtype=...)`` returns
+f_r as float64 (N, 3): the bare BRDF in 1/sr, no cosine, no π. Directions are
+used as given (nothing is normalized unless a brick does it).
+
+- ``reference``: generator.reference.reference_brdf, float64 only.
+- ``numpy``: the NumPy emission of the same linked IR the eval kernels run, at
+  float64, float32 or float16 (inputs and parameters are rounded to that dtype).
+- ``glsl`` / ``hlsl`` / ``wgsl``: that language's eval kernel (compose_eval),
+  compiled with the project toolchain (validated, spirv-opt -O) and dispatched
+  on lavapipe, float32 only. The device, compiled pipelines and loaded NumPy
+  programs are cached per process, so sweeps pay for compilation once.
+
+Parameters default to the bricks' defaults; a scalar for a vector parameter
+splats. Every bad input raises :class:`EvalError` ("what — what to do").
+"""
+from __future__ import annotations
+
+import sys
+import types
+
+import numpy as np
+
+from .compose import EvalProgram, compose_eval, eval_program
+
+TARGETS = ("reference", "numpy", "glsl", "hlsl", "wgsl")
+GPU_TARGETS = ("glsl", "hlsl", "wgsl")
+DTYPES = ("float64", "float32", "float16")
+
+
+class EvalError(ValueError):
+    """A bad argument to evaluate(); the message says what is wrong and what to do."""
+
+    def __init__(self, what: str, todo: str):
+        self.what, self.todo = what, todo
+        super().__init__(f"{what} — {todo}")
+
+
+# ------------------------------------------------------------------ caches
+
+_LIB = None
+_PROGRAMS: dict = {}  # (id(lib), spec) -> (lib, EvalProgram)
+_NUMPY: dict = {}     # (id(lib), spec, dtype) -> (lib, brdf function)
+
+
+def _library(lib):
+    global _LIB
+    if lib is not None:
+        return lib
+    if _LIB is None:
+        from .bricks import load_library
+        _LIB = load_library()
+    return _LIB
+
+
+def program(spec: str, lib=None) -> EvalProgram:
+    """The linked eval program of a spec (cached per library and spec string)."""
+    lib = _library(lib)
+    hit = _PROGRAMS.get((id(lib), spec))
+    if hit is None or hit[0] is not lib:
+        hit = _PROGRAMS[(id(lib), spec)] = (lib, eval_program(spec, lib))
+    return hit[1]
+
+
+# ------------------------------------------------------------------ inputs
+
+def resolve_params(ep: EvalProgram, params: dict | None) -> dict[str, list[float]]:
+    """Every parameter of the BRDF as a flat list of floats (defaults filled in, ranges checked)."""
+    from .bricks import check_value
+
+    params = dict(params or {})
+    unknown = sorted(set(params) - set(ep.params))
+    if unknown:
+        known = ", ".join(ep.params) or "none"
+        raise EvalError(f"unknown parameter{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
+                        f"for BRDF '{ep.spec}'", f"use its parameters: {known} (see `shadermatrix bricks`)")
+    defaults, ranges = ep.defaults(), ep.ranges()
+    out = {}
+    for name, ty in ep.params.items():
+        raw = params.get(name, defaults[name])
+        try:
+            vals = np.asarray(raw, dtype=np.float64).reshape(-1).tolist()
+        except (TypeError, ValueError):
+            raise EvalError(f"parameter '{name}' = {raw!r} is not numeric",
+                            f"give {ty} as numbers, RGB as f0=0.9,0.6,0.3") from None
+        problem = check_value(ty, ranges[name], vals if ty.kind != "scalar" or len(vals) != 1 else vals[0])
+        if problem:
+            rng = ranges[name]
+            hint = f"give {ty} values in [{rng[0]}, {rng[1]}]" if rng else f"give {ty.components} number(s) for {ty}"
+            raise EvalError(f"parameter '{name}' of '{ep.spec}': {problem}", hint)
+        if len(vals) == 1 and ty.components > 1:
+            vals = vals * ty.components
+        out[name] = vals
+    return out
+
+
+def _vectors(L, V, N, T, tangent: bool, spec: str) -> list[np.ndarray]:
+    """[L, V, N] (+ T when the BRDF reads the tangent frame) as float64 (n, 3) arrays of one length."""
+    named = [("L", L), ("V", V), ("N", N)] + ([("T", T)] if T is not None else [])
+    out = []
+    for name, a in named:
+        arr = np.asarray(a)
+        if arr.dtype.kind not in "fiu" or arr.ndim != 2 or arr.shape[1] != 3:
+            raise EvalError(f"{name} has shape {arr.shape} and dtype {arr.dtype}",
+                            f"pass {name} as a float array of shape (N, 3)")
+        out.append(arr.astype(np.float64, copy=False))
+    if len({len(a) for a in out}) != 1:
+        raise EvalError(f"L, V, N{', T' if T is not None else ''} have different lengths "
+                        f"{[len(a) for a in out]}", "pass the same number of samples for each")
+    if tangent and T is None:
+        raise EvalError(f"BRDF '{spec}' reads the tangent frame but no T was given",
+                        "pass T (samples of shape (N, 12) = [L, V, N, T])")
+    return out if tangent else out[:3]
+
+
+def _param_block(ep: EvalProgram, values: dict[str, list[float]]) -> np.ndarray:
+    """The kernel's vec4 parameter array (one vec4 per scalar/vector, four per mat4, column-major)."""
+    block = np.zeros((max(ep.param_vec4s, 1), 4), np.float32)
+    for slot in ep.slots:
+        vals = values[slot.name]
+        if slot.width == 4:
+            block[slot.index: slot.index + 4] = np.asarray(vals, np.float32).reshape(4, 4)
+        else:
+            block[slot.index, : len(vals)] = vals
+    return block
+
+
+def _numpy_arg(ty, vals: list[float], dtype) -> np.ndarray:
+    a = np.asarray(vals, dtype)
+    if ty.kind == "scalar":
+        return a[0]
+    if ty.kind == "matrix":
+        return a.reshape(4, 4).T  # columns were listed first; numpy matrices are m[..., :, j]
+    return a
+
+
+# ------------------------------------------------------------------ targets
+
+def _run_reference(ep: EvalProgram, vecs, values, n: int) -> np.ndarray:
+    try:
+        from .reference import reference_brdf
+    except ImportError:
+        raise EvalError("the float64 reference is not available (generator.reference.reference_brdf "
+                        "is missing)", "use --target numpy --dtype float64 meanwhile") from None
+    ref_params = {k: (v[0] if ep.params[k].kind == "scalar" else list(v)) for k, v in values.items()}
+    T = vecs[3] if len(vecs) > 3 else None
+    out = reference_brdf(ep.spec, vecs[0], vecs[1], vecs[2], T=T, params=ref_params)
+    return np.asarray(out, np.float64).reshape(n, 3)
+
+
+def _numpy_brdf(ep: EvalProgram, lib, dtype: str):
+    from .targets.numpy import NumpyTarget
+
+    key = (id(lib), ep.spec, dtype)
+    hit = _NUMPY.get(key)
+    if hit is None or hit[0] is not lib:
+        t = NumpyTarget()
+        fns = t.load(t.emit(ep.program.structs, ep.program.functions), np.dtype(dtype))
+        hit = _NUMPY[key] = (lib, fns["brdf"])
+    return hit[1]
+
+
+def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int) -> np.ndarray:
+    f = np.dtype(dtype).type
+    args = [v.astype(f) for v in vecs[:3]]
+    if ep.tangent:
+        T = vecs[3].astype(f)
+        with np.errstate(all="ignore"):
+            args += [T, np.cross(args[2], T).astype(f)]  # B = cross(N, T), as in the eval kernels
+    args += [_numpy_arg(ep.params[k], values[k], f) for k in ep.params]
+    out = _numpy_brdf(ep, lib, dtype)(*args)
+    return np.broadcast_to(np.asarray(out, np.float64), (n, 3)).copy()
+
+
+def gpu_kernel(spec: str, language: str, lib=None, device=None):
+    """The cached EvalKernel of a spec in one language on `device` (default: the shared lavapipe device)."""
+    from .runtime.eval_kernel import compile_kernel, shared_device
+
+    lib = _library(lib)
+    ep = program(spec, lib)
+    device = device or shared_device()
+    key = ("eval", id(lib), ep.spec, language)
+    hit = device.cache.get(key)
+    if hit is None or hit[0] is not lib:
+        src = compose_eval(ep.spec, lib, (language,)).sources[0]
+        hit = device.cache[key] = (lib, compile_kernel(src, device, ep.tangent, ep.param_vec4s))
+    return hit[1]
+
+
+def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values) -> np.ndarray:
+    kernel = gpu_kernel(ep.spec, language, lib)
+    f32 = [v.astype(np.float32) for v in vecs]
+    return kernel.run(f32, _param_block(ep, values)).astype(np.float64)
+
+
+def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str = "reference",
+             dtype: str | None = None, lib=None) -> np.ndarray:
+    """f_r (N, 3) float64 of BRDF `spec` for unit vectors L, V, N (and T) of shape (N, 3).
+
+    dtype: float64 (default) for reference and numpy; float32/float16 for numpy;
+    GPU targets compute in float32 (the default for them; any other is an error).
+    """
+    if target not in TARGETS:
+        raise EvalError(f"unknown target {target!r}", f"use one of {', '.join(TARGETS)}")
+    if dtype is not None:
+        dtype = np.dtype(dtype).name if isinstance(dtype, type) or hasattr(dtype, "name") else str(dtype)
+    if target in GPU_TARGETS:
+        if dtype not in (None, "float32"):
+            raise EvalError(f"target {target} runs in float32 on lavapipe, not {dtype}",
+                            "pass --dtype float32 (or none) for GPU targets; numpy runs float16/float64")
+        dtype = "float32"
+    elif target == "reference":
+        if dtype not in (None, "float64"):
+            raise EvalError(f"the reference is float64 only, not {dtype}",
+                            "pass --dtype float64 (or none), or use --target numpy for other dtypes")
+        dtype = "float64"
+    else:
+        dtype = dtype or "float64"
+        if dtype not in DTYPES:
+            raise EvalError(f"unknown dtype {dtype!r}", f"use one of {', '.join(DTYPES)}")
+    lib = _library(lib)
+    ep = program(spec, lib)
+    values = resolve_params(ep, params)
+    vecs = _vectors(L, V, N, T, ep.tangent, ep.spec)
+    n = len(vecs[0])
+    if n == 0:
+        return np.zeros((0, 3), np.float64)
+    if target == "reference":
+        return _run_reference(ep, vecs, values, n)
+    if target == "numpy":
+        return _run_numpy(ep, lib, vecs, values, dtype, n)
+    return _run_gpu(ep, lib, target, vecs, values)
+
+
+class _CallableModule(types.ModuleType):
+    """Importing generator.evaluate sets the package attribute `evaluate` to this module, hiding
+    the wrapper function of generator/__init__.py; so the module itself calls evaluate()."""
+
+    def __call__(self, *args, **kwargs):
+        return evaluate(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _CallableModule

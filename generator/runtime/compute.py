@@ -1,0 +1,104 @@
+"""Compute pipelines from SPIR-V: descriptor set 0 of buffers, dispatch, timestamp queries.
+
+One :class:`ComputePipeline` holds its shader module, set layout, pipeline
+layout, pipeline, a descriptor pool with one set, and a timestamp query pool.
+``bind`` points the set at buffers; ``dispatch`` records, submits and waits,
+and with ``timed=True`` returns the device time between a timestamp written
+before the dispatch (top of pipe) and one after it (bottom of pipe).
+"""
+from __future__ import annotations
+
+from .device import Buffer, Device
+
+STORAGE = "storage"
+UNIFORM = "uniform"
+
+
+class ComputePipeline:
+    """A compute pipeline whose set 0 holds `bindings` (STORAGE / UNIFORM buffers at 0, 1, ...)."""
+
+    def __init__(self, device: Device, spirv: bytes, bindings: tuple[str, ...], entry: str = "main"):
+        vk = self.vk = device.vk
+        self.device, self.bindings = device, tuple(bindings)
+        self.handle = self.module = self.layout = self.set_layout = self.pool = self.queries = None
+        dev = device.handle
+        try:
+            kinds = {STORAGE: vk.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, UNIFORM: vk.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+            self._types = [kinds[b] for b in self.bindings]
+            self.module = vk.vkCreateShaderModule(dev, vk.VkShaderModuleCreateInfo(
+                codeSize=len(spirv), pCode=spirv), None)
+            self.set_layout = vk.vkCreateDescriptorSetLayout(dev, vk.VkDescriptorSetLayoutCreateInfo(
+                pBindings=[vk.VkDescriptorSetLayoutBinding(
+                    binding=i, descriptorType=t, descriptorCount=1, stageFlags=vk.VK_SHADER_STAGE_COMPUTE_BIT)
+                    for i, t in enumerate(self._types)]), None)
+            self.layout = vk.vkCreatePipelineLayout(dev, vk.VkPipelineLayoutCreateInfo(
+                pSetLayouts=[self.set_layout]), None)
+            # The entry-point name must outlive the call (TOOLCHAIN.md: the binding frees nested
+            # strings early, and vkCreateComputePipelines then finds no entry point named "").
+            name = vk.ffi.new("char[]", entry.encode())
+            stage = vk.VkPipelineShaderStageCreateInfo(stage=vk.VK_SHADER_STAGE_COMPUTE_BIT,
+                                                       module=self.module, pName=name)
+            info = vk.VkComputePipelineCreateInfo(stage=stage, layout=self.layout)
+            self.handle = vk.vkCreateComputePipelines(dev, None, 1, [info], None)[0]
+            counts = {}
+            for t in self._types:
+                counts[t] = counts.get(t, 0) + 1
+            self.pool = vk.vkCreateDescriptorPool(dev, vk.VkDescriptorPoolCreateInfo(
+                maxSets=1, pPoolSizes=[vk.VkDescriptorPoolSize(type=t, descriptorCount=n)
+                                       for t, n in counts.items()]), None)
+            self.set = vk.vkAllocateDescriptorSets(dev, vk.VkDescriptorSetAllocateInfo(
+                descriptorPool=self.pool, pSetLayouts=[self.set_layout]))[0]
+            self.queries = vk.vkCreateQueryPool(dev, vk.VkQueryPoolCreateInfo(
+                queryType=vk.VK_QUERY_TYPE_TIMESTAMP, queryCount=2), None)
+        except BaseException:
+            self.destroy()
+            raise
+        device.own(self)
+
+    def bind(self, buffers: list[Buffer]) -> None:
+        """Point binding i of set 0 at buffers[i] (whole buffer)."""
+        vk = self.vk
+        if len(buffers) != len(self.bindings):
+            raise ValueError(f"pipeline has {len(self.bindings)} bindings, got {len(buffers)} buffers")
+        # range = the byte size: VK_WHOLE_SIZE overflows the binding's conversion (TOOLCHAIN.md).
+        infos = [vk.VkDescriptorBufferInfo(buffer=b.handle, offset=0, range=b.size) for b in buffers]
+        writes = [vk.VkWriteDescriptorSet(dstSet=self.set, dstBinding=i, dstArrayElement=0, descriptorCount=1,
+                                          descriptorType=t, pBufferInfo=[info])
+                  for i, (t, info) in enumerate(zip(self._types, infos))]
+        vk.vkUpdateDescriptorSets(self.device.handle, len(writes), writes, 0, None)
+
+    def dispatch(self, groups_x: int, groups_y: int = 1, groups_z: int = 1, timed: bool = False) -> float | None:
+        """Run the pipeline over the given workgroup counts and wait; seconds of device time if `timed`."""
+        vk, dev = self.vk, self.device
+
+        def record(cmd):
+            if timed:
+                vk.vkCmdResetQueryPool(cmd, self.queries, 0, 2)
+                vk.vkCmdWriteTimestamp(cmd, vk.VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, self.queries, 0)
+            vk.vkCmdBindPipeline(cmd, vk.VK_PIPELINE_BIND_POINT_COMPUTE, self.handle)
+            vk.vkCmdBindDescriptorSets(cmd, vk.VK_PIPELINE_BIND_POINT_COMPUTE, self.layout, 0, 1, [self.set], 0, None)
+            vk.vkCmdDispatch(cmd, groups_x, groups_y, groups_z)
+            if timed:
+                vk.vkCmdWriteTimestamp(cmd, vk.VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, self.queries, 1)
+
+        dev.submit(record)
+        if not timed:
+            return None
+        data = vk.ffi.new("uint64_t[2]")
+        vk.vkGetQueryPoolResults(dev.handle, self.queries, 0, 2, vk.ffi.sizeof(data), data, 8,
+                                 vk.VK_QUERY_RESULT_64_BIT | vk.VK_QUERY_RESULT_WAIT_BIT)
+        mask = (1 << dev.timestamp_bits) - 1 if dev.timestamp_bits < 64 else (1 << 64) - 1
+        ticks = (int(data[1]) - int(data[0])) & mask
+        return ticks * dev.timestamp_period_ns * 1e-9
+
+    def destroy(self) -> None:
+        vk, dev = self.vk, self.device.handle
+        if dev is None:
+            return
+        for attr, fn in (("queries", vk.vkDestroyQueryPool), ("pool", vk.vkDestroyDescriptorPool),
+                         ("handle", vk.vkDestroyPipeline), ("layout", vk.vkDestroyPipelineLayout),
+                         ("set_layout", vk.vkDestroyDescriptorSetLayout), ("module", vk.vkDestroyShaderModule)):
+            obj = getattr(self, attr)
+            if obj is not None:
+                fn(dev, obj, None)
+                setattr(self, attr, None)

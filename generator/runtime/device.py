@@ -1,0 +1,258 @@
+"""A Vulkan device on Mesa lavapipe: instance, validation messages, queue, memory, buffers.
+
+A small layer over the `vulkan` PyPI binding (cffi), meant to grow from compute
+to graphics: :class:`Device` owns the instance, the logical device, one queue
+(graphics+compute when the family has both), a command pool and the list of
+validation messages; :mod:`.compute` builds pipelines on top of it.
+
+With ``validation=True`` the Khronos validation layer is enabled and a
+VK_EXT_debug_utils messenger (also chained into instance creation, so messages
+from vkCreateInstance/vkDestroyInstance are caught) appends every warning and
+error to :attr:`Device.messages`. Tests assert that list stays empty.
+
+Pitfalls of the binding (../shared/TOOLCHAIN.md) handled here: the binding keeps
+ONE debug-utils callback per process (a module global), so the callback is
+one module-level function that routes by ``pUserData`` to its device;
+``vkMapMemory`` returns a cffi buffer, which numpy views without a copy.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+VALIDATION_LAYER = "VK_LAYER_KHRONOS_validation"
+
+
+class VulkanUnavailable(RuntimeError):
+    """No usable Vulkan loader, lavapipe device or validation layer; the message says why and what to do."""
+
+
+@dataclass(frozen=True)
+class ValidationMessage:
+    severity: str  # "warning" | "error"
+    kind: str      # "general" | "validation" | "performance"
+    id_name: str
+    text: str
+
+    def __str__(self) -> str:
+        return f"[{self.severity}/{self.kind}] {self.id_name}: {self.text}"
+
+
+def _vk():
+    try:
+        import vulkan as vk
+    except Exception as exc:  # OSError without libvulkan; cffi errors otherwise
+        raise VulkanUnavailable(f"Vulkan loader not usable: {exc} — install libvulkan1 (`make setup`)") from None
+    return vk
+
+
+_DEVICES: dict[int, "Device"] = {}  # id -> open device, for the one debug callback the binding allows
+
+
+def _on_message(severity, types, data, user_data):
+    vk = _vk()
+    dev = _DEVICES.get(int(vk.ffi.cast("uintptr_t", user_data)))
+    if dev is not None:
+        sev = "error" if severity & vk.VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT else "warning"
+        kind = ("validation" if types & vk.VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT else
+                "performance" if types & vk.VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT else "general")
+        name = vk.ffi.string(data.pMessageIdName).decode(errors="replace") if data.pMessageIdName else ""
+        text = vk.ffi.string(data.pMessage).decode(errors="replace") if data.pMessage else ""
+        dev.messages.append(ValidationMessage(sev, kind, name, text))
+    return 0  # VK_FALSE: never abort the call
+
+
+class Buffer:
+    """A host-visible, coherent buffer, mapped for its whole life; `.array(dtype)` views it without a copy."""
+
+    def __init__(self, device: "Device", size: int, usage: int):
+        vk = device.vk
+        self.device, self.size = device, int(size)
+        self.handle = vk.vkCreateBuffer(device.handle, vk.VkBufferCreateInfo(
+            size=self.size, usage=usage, sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE), None)
+        req = vk.vkGetBufferMemoryRequirements(device.handle, self.handle)
+        self.memory = vk.vkAllocateMemory(device.handle, vk.VkMemoryAllocateInfo(
+            allocationSize=req.size, memoryTypeIndex=device.host_memory_type(req.memoryTypeBits)), None)
+        vk.vkBindBufferMemory(device.handle, self.handle, self.memory, 0)
+        self._mapped = vk.vkMapMemory(device.handle, self.memory, 0, self.size, 0)
+
+    def array(self, dtype=np.uint8) -> np.ndarray:
+        """The mapped memory as a writable 1-D numpy array (a view: valid until destroy())."""
+        return np.frombuffer(self._mapped, dtype=dtype)
+
+    def write(self, data) -> None:
+        raw = np.ascontiguousarray(data).view(np.uint8).reshape(-1)
+        if raw.size > self.size:
+            raise ValueError(f"{raw.size} bytes do not fit a buffer of {self.size}")
+        self.array()[: raw.size] = raw
+
+    def destroy(self) -> None:
+        if self.handle is None:
+            return
+        vk, dev = self.device.vk, self.device.handle
+        if self in self.device._owned:
+            self.device._owned.remove(self)
+        self._mapped = None
+        vk.vkUnmapMemory(dev, self.memory)
+        vk.vkDestroyBuffer(dev, self.handle, None)
+        vk.vkFreeMemory(dev, self.memory, None)
+        self.handle = None
+
+
+class Device:
+    """Instance + lavapipe logical device + one queue and command pool; collects validation messages."""
+
+    def __init__(self, validation: bool = False, prefer: str = "llvmpipe"):
+        vk = self.vk = _vk()
+        self.validation = validation
+        self.messages: list[ValidationMessage] = []
+        self.handle = self.instance = self._messenger = self.command_pool = self.fence = None
+        self._owned: list = []  # objects with destroy(), released in reverse order by close()
+        self.cache: dict = {}  # objects callers keep per device (compiled eval kernels)
+        self._user = vk.ffi.cast("void *", id(self))
+        _DEVICES[id(self)] = self
+        try:
+            self._open(prefer)
+        except BaseException:
+            self.close()
+            raise
+
+    # ------------------------------------------------------------ set-up
+    def _open(self, prefer: str) -> None:
+        vk = self.vk
+        layers, exts, pnext = [], [], None
+        if self.validation:
+            have = {p.layerName for p in vk.vkEnumerateInstanceLayerProperties()}
+            if VALIDATION_LAYER not in have:
+                raise VulkanUnavailable(f"{VALIDATION_LAYER} not installed — install vulkan-validationlayers "
+                                        "(`make setup`)")
+            layers, exts = [VALIDATION_LAYER], ["VK_EXT_debug_utils"]
+            pnext = self._messenger_info = vk.VkDebugUtilsMessengerCreateInfoEXT(
+                messageSeverity=(vk.VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT
+                                 | vk.VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT),
+                messageType=(vk.VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT
+                             | vk.VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT
+                             | vk.VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT),
+                pfnUserCallback=_on_message, pUserData=self._user)
+        app = vk.VkApplicationInfo(pApplicationName="shadermatrix", applicationVersion=1,
+                                   pEngineName="shadermatrix", engineVersion=1,
+                                   apiVersion=vk.VK_MAKE_VERSION(1, 1, 0))
+        try:
+            self.instance = vk.vkCreateInstance(vk.VkInstanceCreateInfo(
+                pNext=pnext, pApplicationInfo=app, ppEnabledLayerNames=layers,
+                ppEnabledExtensionNames=exts), None)
+        except vk.VkError as exc:
+            raise VulkanUnavailable(f"vkCreateInstance failed ({type(exc).__name__}) — install "
+                                    "mesa-vulkan-drivers for lavapipe (`make setup`)") from None
+        if self.validation:
+            create = vk.vkGetInstanceProcAddr(self.instance, "vkCreateDebugUtilsMessengerEXT")
+            self._destroy_messenger = vk.vkGetInstanceProcAddr(self.instance, "vkDestroyDebugUtilsMessengerEXT")
+            self._messenger = create(self.instance, self._messenger_info, None)
+
+        found = []
+        for phys in vk.vkEnumeratePhysicalDevices(self.instance):
+            props = vk.vkGetPhysicalDeviceProperties(phys)
+            found.append(str(props.deviceName))
+            if str(props.deviceName).startswith(prefer):
+                self.physical, self.properties = phys, props
+                break
+        else:
+            raise VulkanUnavailable(f"no '{prefer}' Vulkan device (found: {', '.join(found) or 'none'}) — "
+                                    "install mesa-vulkan-drivers (`make setup`)")
+        self.name = str(self.properties.deviceName)
+        self.limits = self.properties.limits
+        self.timestamp_period_ns = float(self.limits.timestampPeriod)
+        families = vk.vkGetPhysicalDeviceQueueFamilyProperties(self.physical)
+        want = vk.VK_QUEUE_COMPUTE_BIT
+        self.queue_family = next(i for i, f in enumerate(families) if f.queueFlags & want)
+        self.timestamp_bits = int(families[self.queue_family].timestampValidBits)
+        self.memory_properties = vk.vkGetPhysicalDeviceMemoryProperties(self.physical)
+
+        queue_info = vk.VkDeviceQueueCreateInfo(queueFamilyIndex=self.queue_family, queueCount=1,
+                                                pQueuePriorities=[1.0])
+        self.handle = vk.vkCreateDevice(self.physical, vk.VkDeviceCreateInfo(
+            pQueueCreateInfos=[queue_info], pEnabledFeatures=vk.VkPhysicalDeviceFeatures()), None)
+        self.queue = vk.vkGetDeviceQueue(self.handle, self.queue_family, 0)
+        self.command_pool = vk.vkCreateCommandPool(self.handle, vk.VkCommandPoolCreateInfo(
+            flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, queueFamilyIndex=self.queue_family), None)
+        self.fence = vk.vkCreateFence(self.handle, vk.VkFenceCreateInfo(), None)
+
+    def host_memory_type(self, type_bits: int) -> int:
+        """A memory type the host can map coherently (device-local too when there is one: lavapipe)."""
+        vk, mp = self.vk, self.memory_properties
+        host = vk.VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | vk.VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+        best = None
+        for i in range(mp.memoryTypeCount):
+            flags = mp.memoryTypes[i].propertyFlags
+            if type_bits & (1 << i) and flags & host == host:
+                if flags & vk.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT:
+                    return i
+                best = i if best is None else best
+        if best is None:
+            raise VulkanUnavailable(f"{self.name} has no host-visible coherent memory")
+        return best
+
+    # ------------------------------------------------------------ objects
+    def buffer(self, size: int, usage: int) -> Buffer:
+        """A mapped buffer owned by this device (released by close() unless destroyed earlier)."""
+        b = Buffer(self, max(int(size), 16), usage)
+        self._owned.append(b)
+        return b
+
+    def own(self, obj):
+        """Release `obj` (anything with destroy()) when the device closes."""
+        self._owned.append(obj)
+        return obj
+
+    def submit(self, record) -> None:
+        """Record commands with `record(command_buffer)`, submit them, wait for completion."""
+        vk = self.vk
+        cmd = vk.vkAllocateCommandBuffers(self.handle, vk.VkCommandBufferAllocateInfo(
+            commandPool=self.command_pool, level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY, commandBufferCount=1))[0]
+        try:
+            vk.vkBeginCommandBuffer(cmd, vk.VkCommandBufferBeginInfo(
+                flags=vk.VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT))
+            record(cmd)
+            vk.vkEndCommandBuffer(cmd)
+            vk.vkResetFences(self.handle, 1, [self.fence])
+            vk.vkQueueSubmit(self.queue, 1, [vk.VkSubmitInfo(pCommandBuffers=[cmd])], self.fence)
+            vk.vkWaitForFences(self.handle, 1, [self.fence], vk.VK_TRUE, 0xFFFFFFFFFFFFFFFF)
+        finally:
+            vk.vkFreeCommandBuffers(self.handle, self.command_pool, 1, [cmd])
+
+    # ------------------------------------------------------------ tear-down
+    def close(self) -> None:
+        """Destroy everything this device created; validation messages of the tear-down are still collected."""
+        vk = self.vk
+        if self.handle is not None:
+            vk.vkDeviceWaitIdle(self.handle)
+            for obj in reversed(list(self._owned)):
+                obj.destroy()
+            self._owned.clear()
+            self.cache.clear()
+            if self.fence is not None:
+                vk.vkDestroyFence(self.handle, self.fence, None)
+            if self.command_pool is not None:
+                vk.vkDestroyCommandPool(self.handle, self.command_pool, None)
+            vk.vkDestroyDevice(self.handle, None)
+            self.handle = None
+        if self._messenger is not None:
+            self._destroy_messenger(self.instance, self._messenger, None)
+            self._messenger = None
+        if self.instance is not None:
+            vk.vkDestroyInstance(self.instance, None)
+            self.instance = None
+        _DEVICES.pop(id(self), None)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def validation_requested() -> bool:
+    """SHADERMATRIX_VALIDATION=1 turns the validation layer on for the process-wide device."""
+    return os.environ.get("SHADERMATRIX_VALIDATION", "").strip().lower() in ("1", "true", "yes")
