@@ -87,7 +87,12 @@ def resolve_params(ep: EvalProgram, params: dict | None) -> dict[str, list[float
         problem = check_value(ty, ranges[name], vals if ty.kind != "scalar" or len(vals) != 1 else vals[0])
         if problem:
             rng = ranges[name]
-            hint = f"give {ty} values in [{rng[0]}, {rng[1]}]" if rng else f"give {ty.components} number(s) for {ty}"
+            if "outside the range" in problem:
+                hint = f"give values in [{rng[0]}, {rng[1]}]"
+            elif ty.kind == "vector":
+                hint = f"give {ty.components} numbers for {ty}, or one number to splat"
+            else:
+                hint = f"give {ty.components} number{'s' if ty.components > 1 else ''} for {ty}"
             raise EvalError(f"parameter '{name}' of '{ep.spec}': {problem}", hint)
         if len(vals) == 1 and ty.components > 1:
             vals = vals * ty.components
