@@ -131,3 +131,22 @@ def test_eval_kernel_chunks_large_inputs(device):
         kernel.max_samples = limit
     np.testing.assert_array_equal(chunked, whole)
 
+
+
+def test_eval_kernel_times_loaded_samples_and_releases_buffers(device):
+    for t in ("glslc", "spirv-val", "spirv-opt"):
+        require_tool(t)
+    from generator.evaluate import _param_block, gpu_kernel, program, resolve_params
+
+    spec = "lambert"
+    ep = program(spec)
+    kernel = gpu_kernel(spec, "wgsl", device=device)
+    block = _param_block(ep, resolve_params(ep, {}))
+    vecs = [np.tile(np.float32([0.0, 0.0, 1.0]), (4096, 1))] * 3
+    kernel.load(vecs, block)
+    times = kernel.time(3)
+    assert len(times) == 3 and all(0.0 < t < 60.0 for t in times), times
+    kernel.release()
+    with pytest.raises(ValueError, match="load"):
+        kernel.time()
+    np.testing.assert_allclose(kernel.run(vecs, block), np.full((4096, 3), 0.5 / np.pi), rtol=1e-6)

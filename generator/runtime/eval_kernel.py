@@ -39,23 +39,25 @@ class EvalKernel:
         self.max_samples = int(device.limits.maxComputeWorkGroupCount[0]) * WORKGROUP
         self.params = device.buffer(16 * (1 + self.param_vec4s), vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
         self.samples = self.result = None
-        self.capacity = 0
+        self.capacity = self.count = 0
 
     def _reserve(self, n: int) -> None:
         if n <= self.capacity:
             return
         vk = self.device.vk
-        for b in (self.samples, self.result):
-            if b is not None:
-                b.destroy()
+        self.release()
         usage = vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
         self.samples = self.device.buffer(16 * self.vec4s_per_sample * n, usage)
         self.result = self.device.buffer(16 * n, usage)
         self.capacity = n
         self.pipeline.bind([self.samples, self.result, self.params])
 
-    def _load(self, vectors: list[np.ndarray], block: np.ndarray, lo: int, hi: int) -> None:
+    def load(self, vectors: list[np.ndarray], block: np.ndarray, lo: int = 0, hi: int | None = None) -> None:
+        """Copy samples lo:hi of float32 arrays [L, V, N(, T)] (N, 3) and the parameter block to the device."""
+        hi = len(vectors[0]) if hi is None else hi
         n = hi - lo
+        if n > self.max_samples:
+            raise ValueError(f"one dispatch takes at most {self.max_samples} samples, got {n}")
         self._reserve(n)
         s = self.samples.array(np.float32)[: n * self.vec4s_per_sample * 4].reshape(n, self.vec4s_per_sample, 4)
         for k, v in enumerate(vectors[: self.vec4s_per_sample]):
@@ -64,6 +66,7 @@ class EvalKernel:
         p = self.params.array(np.uint32)
         p[:4] = (n, 0, 0, 0)
         self.params.array(np.float32)[4: 4 + block.size] = block.reshape(-1)
+        self.count = n
 
     def run(self, vectors: list[np.ndarray], block: np.ndarray) -> np.ndarray:
         """f_r (N, 3) float32 for float32 arrays [L, V, N(, T)] of shape (N, 3) and a parameter block."""
@@ -71,19 +74,25 @@ class EvalKernel:
         out = np.empty((count, 3), np.float32)
         for lo in range(0, count, self.max_samples):
             hi = min(count, lo + self.max_samples)
-            self._load(vectors, block, lo, hi)
+            self.load(vectors, block, lo, hi)
             self.pipeline.dispatch(-(-(hi - lo) // WORKGROUP))
             out[lo:hi] = self.result.array(np.float32)[: 4 * (hi - lo)].reshape(-1, 4)[:, :3]
         return out
 
-    def time(self, vectors: list[np.ndarray], block: np.ndarray, repeats: int) -> list[float]:
-        """Device seconds of `repeats` dispatches over the same samples (timestamp queries)."""
-        count = len(vectors[0])
-        if count > self.max_samples:
-            raise ValueError(f"time at most {self.max_samples} samples per dispatch, got {count}")
-        self._load(vectors, block, 0, count)
-        groups = -(-count // WORKGROUP)
+    def time(self, repeats: int = 1) -> list[float]:
+        """Device seconds of `repeats` dispatches over the loaded samples (timestamp queries)."""
+        if not self.count:
+            raise ValueError("load() samples before timing")
+        groups = -(-self.count // WORKGROUP)
         return [self.pipeline.dispatch(groups, timed=True) for _ in range(repeats)]
+
+    def release(self) -> None:
+        """Free the sample and result buffers (the pipeline stays; the next load allocates again)."""
+        for b in (self.samples, self.result):
+            if b is not None:
+                b.destroy()
+        self.samples = self.result = None
+        self.capacity = self.count = 0
 
 
 def compile_kernel(source, device: Device, tangent: bool, param_vec4s: int) -> EvalKernel:
