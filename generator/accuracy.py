@@ -1,0 +1,325 @@
+"""Accuracy of the bricks against the float64 references: sample domains, the stress set, error metrics.
+
+Two sample sets per BRDF spec:
+- `hemisphere`: L and V stratified jointly over the upper hemisphere (uniform in
+  solid angle: cos θ and φ in a jittered k⁴ grid), with the bricks' default
+  parameters, in a rotated frame so that float32 directions carry rounding;
+- `stress`: the degenerate and extreme configurations of issue 3 (grazing cosines
+  0, 1e-7, 1e-4, 1e-2; L = V; L = -V; V below the horizon; the mirror direction,
+  also at grazing; h = n and 0.05° off it) crossed with parameter sweeps (alpha
+  0 … 1, exponents 1 … 1e5, f0 = 0 and 1, sigma 0 … 1.2 rad), in the canonical
+  frame (exact zeros) and in the rotated frame.
+
+Errors are per RGB component against the reference: absolute, and relative
+|f - f_ref| / max(|f_ref|, REL_FLOOR). NaN and Inf outputs are counted, not
+averaged; samples where the reference itself is not finite (a Dirac lobe at
+alpha = 0, exactly at h = n) are counted and left out.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+# Below 1e-6 sr⁻¹ an error is measured relative to 1e-6: at unit light such a value is
+# ~1e-3 of an 8-bit step (π f_r c cos θ with f_r ≈ 1.3e-3 per step).
+REL_FLOOR = 1e-6
+GRAZING = (0.0, 1e-7, 1e-4, 1e-2)
+SWEEPS = {
+    "alpha": (0.0, 1e-4, 1e-3, 1e-2, 0.3, 1.0),
+    "n": (1.0, 10.0, 100.0, 1e3, 1e4, 1e5),
+    "f0": (0.0, 0.04, 1.0),
+    "sigma": (0.0, 0.3, 0.6, 1.2),
+    "rho_d": (0.0, 1.0),
+}
+NUMPY_DTYPES = ("float64", "float32", "float16")
+GPU = ("glsl", "hlsl", "wgsl")
+
+
+# ------------------------------------------------------------------ sample domains
+
+@dataclass
+class SampleSet:
+    """Samples of one parameter set: unit vectors (n, 3) in float64 and a label per sample."""
+
+    name: str
+    params: dict
+    L: np.ndarray
+    V: np.ndarray
+    N: np.ndarray
+    T: np.ndarray
+    labels: list[str]
+
+
+def rotation() -> np.ndarray:
+    """A fixed rotation that makes no frame axis representable exactly (rounding in float32)."""
+    axis = np.array([0.36, -0.48, 0.8])
+    axis /= np.linalg.norm(axis)
+    t = 0.7
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + math.sin(t) * K + (1.0 - math.cos(t)) * (K @ K)
+
+
+def direction(cos_theta, phi) -> np.ndarray:
+    """Unit vectors with polar cosine `cos_theta` (may be negative) and azimuth `phi`, frame N = z, T = x."""
+    c = np.asarray(cos_theta, np.float64)
+    s = np.sqrt(np.maximum(0.0, (1.0 - c) * (1.0 + c)))
+    p = np.asarray(phi, np.float64)
+    return np.stack(np.broadcast_arrays(s * np.cos(p), s * np.sin(p), c), axis=-1)
+
+
+def _polar(theta: float, phi: float) -> np.ndarray:
+    """The unit vector at polar angle theta (negative: the opposite azimuth) and azimuth phi."""
+    return np.array([math.sin(theta) * math.cos(phi), math.sin(theta) * math.sin(phi), math.cos(theta)])
+
+
+def _framed(name, params, L, V, labels, rotate: bool) -> SampleSet:
+    n = len(L)
+    N = np.broadcast_to([0.0, 0.0, 1.0], (n, 3))
+    T = np.broadcast_to([1.0, 0.0, 0.0], (n, 3))
+    if rotate:
+        R = rotation()
+        L, V, N, T = (np.asarray(x) @ R.T for x in (L, V, N, T))
+    return SampleSet(name, params, np.ascontiguousarray(L), np.ascontiguousarray(V),
+                     np.ascontiguousarray(N), np.ascontiguousarray(T), labels)
+
+
+def hemisphere(k: int = 12, seed: int = 0, params: dict | None = None) -> SampleSet:
+    """L and V jointly stratified over the hemisphere: a jittered k⁴ grid in (cos θ_l, φ_l, cos θ_v, φ_v)."""
+    rng = np.random.default_rng(seed)
+    cells = np.stack(np.meshgrid(*(np.arange(k),) * 4, indexing="ij"), -1).reshape(-1, 4)
+    u = (cells + rng.random(cells.shape)) / k
+    L = direction(u[:, 0], 2.0 * np.pi * u[:, 1])
+    V = direction(u[:, 2], 2.0 * np.pi * u[:, 3])
+    return _framed("hemisphere", dict(params or {}), L, V, ["hemisphere"] * len(L), rotate=True)
+
+
+def stress_geometry() -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """The degenerate and extreme (L, V) configurations in the canonical frame, with labels."""
+    rows: list[tuple[np.ndarray, np.ndarray, str]] = []
+    z = np.array([0.0, 0.0, 1.0])
+    c45 = math.sqrt(0.5)
+
+    def add(label, L, V):
+        rows.append((np.asarray(L, np.float64), np.asarray(V, np.float64), label))
+
+    for c in GRAZING:
+        gl = direction(c, 0.0)
+        add(f"grazing L (n·l={c:g}), V = n", gl, z)
+        add(f"grazing L (n·l={c:g}), V 45° mirror side", gl, direction(c45, np.pi))
+        add(f"grazing L (n·l={c:g}), V 45° same side", gl, direction(c45, 0.0))
+        add(f"grazing V (n·v={c:g}), L = n", z, gl)
+        add(f"grazing V (n·v={c:g}), L 45° mirror side", direction(c45, np.pi), gl)
+        add(f"mirror at grazing (cos={c:g})", gl, direction(c, np.pi))
+        add(f"L = V grazing (cos={c:g})", gl, gl)
+        add(f"grazing L and V 90° apart (cos={c:g})", gl, direction(c, np.pi / 2))
+    for c in (1.0, c45, 0.1):
+        add(f"L = V (cos={c:g})", direction(c, 0.3), direction(c, 0.3))
+    for c in (1.0, 0.8, 1e-4):
+        add(f"L = -V (n·l={c:g})", direction(c, 0.0), -direction(c, 0.0))
+    for c in (-1e-7, -1e-4, -0.164, -0.5, -1.0):
+        v = direction(c, 0.0)
+        add(f"V below horizon (n·v={c:g}), L = n", z, v)
+        add(f"V below horizon (n·v={c:g}), L 45° mirror side", direction(c45, np.pi), v)
+        add(f"V below horizon (n·v={c:g}), L 45° same side", direction(c45, 0.0), v)
+        add(f"V below horizon (n·v={c:g}), L grazing opposite", direction(1e-4, np.pi), v)
+    d = math.radians(0.05)
+    for deg in (0.0, 30.0, 60.0, 85.0):
+        t = math.radians(deg)
+        add(f"mirror, h = n (θ={deg:g}°)", _polar(t, 0.0), _polar(t, np.pi))
+        add(f"mirror, h 0.05° off n (θ={deg:g}°)", _polar(t + d, 0.0), _polar(t - d, np.pi))
+    L, V, labels = zip(*rows)
+    return np.stack(L), np.stack(V), list(labels)
+
+
+def stress_params(declared: dict) -> list[dict]:
+    """Parameter sets of the stress set: the product of the sweeps of the parameters a BRDF has.
+
+    declared: {name: (type, default, range)}; sweep values outside a parameter's range are skipped.
+    """
+    axes = []
+    for name, (ty, _default, rng) in declared.items():
+        values = [v for v in SWEEPS.get(name, ()) if rng is None or rng[0] <= v <= rng[1]]
+        if values:
+            axes.append([(name, [v] * ty.components if ty.kind == "vector" else v) for v in values])
+    combos = [{}]
+    for axis in axes:
+        combos = [dict(c, **{k: v}) for c in combos for k, v in axis]
+    return combos
+
+
+def stress_sets(declared: dict) -> list[SampleSet]:
+    """One SampleSet per parameter set, each holding every stress geometry in both frames."""
+    L, V, labels = stress_geometry()
+    L2, V2 = np.concatenate([L, L]), np.concatenate([V, V])
+    out = []
+    for p in stress_params(declared):
+        a = _framed("stress", p, L, V, labels, rotate=False)
+        b = _framed("stress", p, L2[len(L):], V2[len(V):], [f"{s} [rotated]" for s in labels], rotate=True)
+        out.append(SampleSet("stress", p, *(np.concatenate([getattr(a, f), getattr(b, f)])
+                                            for f in ("L", "V", "N", "T")), a.labels + b.labels))
+    return out
+
+
+# ------------------------------------------------------------------ error metrics
+
+@dataclass
+class Errors:
+    """Error statistics of one target × dtype on one sample set of one spec."""
+
+    samples: int = 0  # RGB components compared (finite reference)
+    nan: int = 0
+    inf: int = 0
+    ref_nonfinite: int = 0
+    max_abs: float = 0.0
+    mean_abs: float = 0.0
+    max_rel: float = 0.0
+    mean_rel: float = 0.0
+    worst: dict = field(default_factory=dict)  # the sample of max_rel: case, params, value, reference
+    by_param: dict = field(default_factory=dict)  # "alpha=0.001" -> max rel over the batches with that value
+
+    def add(self, got: np.ndarray, ref: np.ndarray, labels: list[str], params: dict) -> None:
+        """Fold one batch ((n, 3) arrays) into the statistics."""
+        ok_ref = np.isfinite(ref)
+        self.ref_nonfinite += int(np.count_nonzero(~ok_ref))
+        self.nan += int(np.count_nonzero(np.isnan(got) & ok_ref))
+        self.inf += int(np.count_nonzero(np.isinf(got) & ok_ref))
+        m = ok_ref & np.isfinite(got)
+        if not m.any():
+            return
+        with np.errstate(invalid="ignore", over="ignore"):
+            a = np.abs(got - ref)
+            rel = a / np.maximum(np.abs(ref), REL_FLOOR)
+        n_new = int(np.count_nonzero(m))
+        total = self.samples + n_new
+        self.mean_abs = (self.mean_abs * self.samples + float(a[m].sum())) / total
+        self.mean_rel = (self.mean_rel * self.samples + float(rel[m].sum())) / total
+        self.samples = total
+        self.max_abs = max(self.max_abs, float(a[m].max()))
+        r = np.where(m, rel, -1.0)
+        i, j = np.unravel_index(int(np.argmax(r)), r.shape)
+        for k, v in _plain(params).items():
+            key = f"{k}={v:g}" if not isinstance(v, list) else f"{k}={v}"
+            self.by_param[key] = max(self.by_param.get(key, 0.0), float(r[i, j]))
+        if r[i, j] > self.max_rel or not self.worst:
+            self.max_rel = float(r[i, j])
+            self.worst = {"case": labels[i], "params": _plain(params),
+                          "value": float(got[i, j]), "reference": float(ref[i, j])}
+
+
+def _plain(params: dict) -> dict:
+    return {k: (v if not isinstance(v, (list, tuple)) else (v[0] if len(set(v)) == 1 else list(v)))
+            for k, v in params.items()}
+
+
+# ------------------------------------------------------------------ running
+
+def default_specs(lib) -> list[str]:
+    """Every BRDF brick: each diffuse term alone, each specular term with every combination of slot fillers."""
+    from itertools import product
+    specs = [b.id for b in lib.of_kind("diffuse")]
+    for b in lib.of_kind("specular"):
+        choices = [[f"{s}={f.id}" for f in lib.of_kind(slot["kind"])] for s, slot in b.slots.items()]
+        for combo in product(*choices):
+            specs.append(f"{b.id}({','.join(combo)})" if combo else b.id)
+    return specs
+
+
+def default_targets() -> list[str]:
+    """numpy, plus the GPU languages when a lavapipe device is present."""
+    from .runtime.probe import lavapipe_present
+    return ["numpy"] + (list(GPU) if lavapipe_present() else [])
+
+
+def runs(targets, dtypes) -> list[tuple[str, str]]:
+    """(target, dtype) pairs to measure: numpy in each dtype asked, GPU languages in float32."""
+    out = []
+    for t in targets:
+        for d in dtypes:
+            if t == "numpy" or (t in GPU and d == "float32"):
+                out.append((t, d))
+    return out
+
+
+def declared_params(spec: str, lib) -> dict:
+    """{name: (type, default, range)} of a BRDF spec's parameters, from the bricks' metadata."""
+    from .permutation import parse_brdf
+    out = {}
+    for top in parse_brdf(spec, lib):
+        for node in top.walk():
+            for name, p in node.brick.params.items():
+                out.setdefault(name, (p.ty, p.default, p.range))
+    return out
+
+
+def rounded_inputs(s: SampleSet, dtype: str) -> tuple[list, list]:
+    """(L, V, N, T) rounded to `dtype` as the target gets them, and the nearest unit vectors for the reference.
+
+    The reference sees the directions the target sees, so the error measures the
+    target's arithmetic, not the rounding of its inputs.
+    """
+    given = [x.astype(dtype).astype(np.float64) for x in (s.L, s.V, s.N, s.T)]
+    return given, [x / np.linalg.norm(x, axis=-1, keepdims=True) for x in given]
+
+
+def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
+    """Errors of every (target, dtype) against the reference for one spec: {set: {"target/dtype": Errors}}."""
+    from .evaluate import evaluate
+    from .reference import reference_brdf
+
+    declared = declared_params(spec, lib)
+    sets = {"hemisphere": [hemisphere(hemisphere_k)], "stress": stress_sets(declared)}
+    out: dict = {}
+    for set_name, batches in sets.items():
+        stats = {f"{t}/{d}": Errors() for t, d in runs(targets, dtypes)}
+        for s in batches:
+            refs: dict = {}
+            for t, d in runs(targets, dtypes):
+                given, exact = rounded_inputs(s, d)
+                if d not in refs:
+                    refs[d] = reference_brdf(spec, *exact, s.params, lib=lib)
+                got = evaluate(spec, *given, s.params, target=t, dtype=d, lib=lib)
+                stats[f"{t}/{d}"].add(got, refs[d], s.labels, s.params)
+        out[set_name] = stats
+    return out
+
+
+def run(specs, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
+    """The accuracy report of several specs as a JSON-ready dict."""
+    results = []
+    for spec in specs:
+        for set_name, stats in measure(spec, targets, dtypes, lib, hemisphere_k).items():
+            for key, e in stats.items():
+                t, d = key.split("/")
+                results.append({"spec": spec, "set": set_name, "target": t, "dtype": d, **asdict(e)})
+    bad = [r for r in results if r["dtype"] == "float32" and (r["nan"] or r["inf"])]
+    return {"rel_floor": REL_FLOOR, "specs": list(specs), "runs": [f"{t}/{d}" for t, d in runs(targets, dtypes)],
+            "results": results, "float32_finite": not bad}
+
+
+def _fmt(x: float) -> str:
+    return "0" if x == 0 else f"{x:.2e}"
+
+
+def markdown(report: dict) -> str:
+    """The report as Markdown: one table per sample set."""
+    lines = ["# Accuracy against the float64 references", "",
+             f"Relative error: |f - f_ref| / max(|f_ref|, {report['rel_floor']:g} sr⁻¹), per RGB component. "
+             "NaN/Inf: outputs where the reference is finite. ref∞: samples where the reference is "
+             "a Dirac lobe (left out).", ""]
+    for set_name in ("hemisphere", "stress"):
+        rows = [r for r in report["results"] if r["set"] == set_name]
+        lines += [f"## {set_name}", "",
+                  "| spec | target | dtype | max abs | mean abs | max rel | mean rel | NaN | Inf | ref∞ | worst case |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in rows:
+            w = r["worst"]
+            where = f"{w['case']} {w['params']}" if w else ""
+            lines.append(f"| `{r['spec']}` | {r['target']} | {r['dtype']} | {_fmt(r['max_abs'])} | "
+                         f"{_fmt(r['mean_abs'])} | {_fmt(r['max_rel'])} | {_fmt(r['mean_rel'])} | "
+                         f"{r['nan']} | {r['inf']} | {r['ref_nonfinite']} | {where} |")
+        lines.append("")
+    verdict = "no NaN or Inf in float32" if report["float32_finite"] else "**NaN or Inf in float32**"
+    lines.append(f"Result: {verdict}.")
+    return "\n".join(lines) + "\n"
