@@ -36,7 +36,7 @@ class Kind:
 KINDS: dict[str, Kind] = {
     "diffuse": Kind(("diffuse",), VEC3),
     "specular": Kind(("specular",), VEC3),
-    "ndf": Kind(("ndf",), FLOAT, (("NdotH", FLOAT), ("alpha", FLOAT))),
+    "ndf": Kind(("ndf",), FLOAT, (("NdotH", FLOAT), ("NxH2", FLOAT), ("alpha", FLOAT))),
     "fresnel": Kind(("fresnel",), VEC3, (("f0", VEC3), ("VdotH", FLOAT))),
     "visibility": Kind(("vis",), FLOAT, (("NdotL", FLOAT), ("NdotV", FLOAT), ("NdotH", FLOAT),
                                           ("VdotH", FLOAT), ("alpha", FLOAT))),
@@ -50,7 +50,7 @@ BRDF_KINDS = ("diffuse", "specular")
 
 # Geometric inputs a BRDF entry may name as parameters (DESIGN.md conventions).
 GEOMETRY = {"L": VEC3, "V": VEC3, "N": VEC3, "H": VEC3, "T": VEC3, "B": VEC3,
-            "NdotL": FLOAT, "NdotV": FLOAT, "NdotH": FLOAT, "LdotH": FLOAT, "VdotH": FLOAT,
+            "NdotL": FLOAT, "NdotV": FLOAT, "NdotH": FLOAT, "NxH2": FLOAT, "LdotH": FLOAT, "VdotH": FLOAT,
             "LdotV": FLOAT, "RdotV": FLOAT}
 # Shading-context inputs of light, shadow, packing and normal bricks.
 SURFACE = {"P": VEC3, "N": VEC3, "T": VEC3, "B": VEC3, "uv": BUILTIN_TYPES["vec2"]}

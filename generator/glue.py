@@ -26,9 +26,15 @@ NEEDS = [
     ("NdotL", "min(dot(N, L), 1.0)", ()),
     ("NdotV", "clamp(dot(N, V), 0.0001, 1.0)", ()),
     ("Hsum", "L + V", ()),
-    # |l + v| is floored so that l = -v (possible only for v below the horizon) gives H = 0, not NaN.
-    ("H", "Hsum * rsqrt(max(dot(Hsum, Hsum), 0.000000000001))", ("Hsum",)),
+    # |l + v|² is floored so that l = -v (possible only for v below the horizon) gives H = 0, not
+    # NaN. The floor is a normal float32 far below the mirror configuration at grazing, where
+    # |l + v|² = 4 cos²θ (a floor of 1e-12 left H unnormalized, n·h wrong, for cos θ < 5e-7).
+    ("H", "Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30))", ("Hsum",)),
     ("NdotH", "clamp(dot(N, H), 0.0, 1.0)", ("H",)),
+    # sin²θ_h = |n × h|² (Filament): keeps its digits as h → n, where 1 - (n·h)² is all rounding
+    # in float32 (ACCURACY-FACTS pitfall 4); 1 where n·h is clamped to 0, as 1 - 0².
+    ("NxH", "cross(N, H)", ("H",)),
+    ("NxH2", "dot(NxH, NxH) if NdotH > 0.0 else 1.0", ("NxH", "NdotH")),
     ("LdotH", "clamp(dot(L, H), 0.0, 1.0)", ("H",)),
     ("VdotH", "clamp(dot(V, H), 0.0, 1.0)", ("H",)),
     ("LdotV", "dot(L, V)", ()),

@@ -4,7 +4,7 @@ Cook & Torrance 1982; the factored form of RTR3 §7.6.1 eq. 7.51
 (f = F D G / (4 cos theta_i cos theta_o)), with the visibility term
 V = G / (4 (n.l)(n.v)) supplied by the `vis` slot, so that a filler can fold
 the cosines into its own expression (RTR3 §7.6.1, "visibility term").
-Slots: ndf (D, normalized so that the integral of D cos theta_h is 1),
+Slots: ndf (D(n.h, |n x h|^2, alpha), normalized so that the integral of D cos theta_h is 1),
 fresnel (F(f0, v.h)), vis (V).
 """
 BRICK = {
@@ -22,7 +22,8 @@ BRICK = {
 }
 
 
-def specular(NdotL: float, NdotV: float, NdotH: float, VdotH: float, alpha: float, f0: vec3) -> vec3:
-    D = ndf(NdotH, alpha)
+def specular(NdotL: float, NdotV: float, NdotH: float, NxH2: float, VdotH: float, alpha: float,
+             f0: vec3) -> vec3:
+    D = ndf(NdotH, NxH2, alpha)
     Vis = vis(NdotL, NdotV, NdotH, VdotH, alpha)
     return fresnel(f0, VdotH) * (D * Vis)

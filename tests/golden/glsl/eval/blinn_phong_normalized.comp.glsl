@@ -26,7 +26,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float n, vec3 f0) {
     }
 #line 7 "<glue>"
     vec3 Hsum = (L + V);
-    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-12)));
+    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
     return blinn_phong_normalized_specular(NdotH, n, f0);
 }

@@ -4,9 +4,9 @@
 // eval: microfacet(ndf=beckmann,fresnel=none,vis=torrance_sparrow)
 // hash: 5e84b038a5f7
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:a19bd1ffdea3
-// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:4182047e2a9c
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template glsl/eval.glsl.j2 sha256:184a01d74c8a
 // template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
@@ -17,13 +17,11 @@ layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } sa
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
 layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[2]; } params;
 
-#line 12 "bricks/brdf/microfacet/ndf/beckmann.py"
-float beckmann_ndf(float NdotH, float alpha) {
-#line 16 "bricks/brdf/microfacet/ndf/beckmann.py"
-    float a2 = max((alpha * alpha), 1e-06);
+#line 24 "bricks/brdf/microfacet/ndf/beckmann.py"
+float beckmann_ndf(float NdotH, float NxH2, float alpha) {
+    float a2 = max((alpha * alpha), 1e-08);
     float c2 = max((NdotH * NdotH), 1e-08);
-    float tan2 = ((1.0 - c2) / c2);
-    return (exp(((-tan2) / a2)) / (((3.141592653589793 * a2) * c2) * c2));
+    return (exp(((-NxH2) / (a2 * c2))) / (((3.141592653589793 * a2) * c2) * c2));
 }
 
 #line 12 "bricks/brdf/microfacet/fresnel/none.py"
@@ -33,7 +31,7 @@ vec3 none_fresnel(vec3 f0, float VdotH) {
 
 #line 12 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
 float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
+#line 19 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
     float vh = max(VdotH, 0.0001);
     float nl = max(NdotL, 0.0001);
     float G = min(1.0, min((((2.0 * NdotH) * NdotV) / vh), (((2.0 * NdotH) * nl) / vh)));
@@ -41,8 +39,9 @@ float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, f
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, vec3 f0) {
-    float D = beckmann_ndf(NdotH, alpha);
+vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = beckmann_ndf(NdotH, NxH2, alpha);
     float Vis = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (none_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -56,14 +55,16 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     vec3 Hsum = (L + V);
-    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-12)));
+    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    vec3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 
-#line 67 "5e84b038a5f7.comp.glsl"
+#line 68 "5e84b038a5f7.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

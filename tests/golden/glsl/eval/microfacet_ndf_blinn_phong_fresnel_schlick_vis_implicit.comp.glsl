@@ -4,9 +4,9 @@
 // eval: microfacet(ndf=blinn_phong,fresnel=schlick,vis=implicit)
 // hash: 990b9a56f7cb
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:9a76bc833beb
+// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:2f94379e0524
 // brick bricks/brdf/microfacet/visibility/implicit.py sha256:7042a3d619ce
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template glsl/eval.glsl.j2 sha256:184a01d74c8a
 // template glsl/macros.glsl.j2 sha256:96d4a6c59c48
 
@@ -17,12 +17,13 @@ layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } sa
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
 layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[2]; } params;
 
-#line 13 "bricks/brdf/microfacet/ndf/blinn_phong.py"
-float blinn_phong_ndf(float NdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/ndf/blinn_phong.py"
-    float a = max(alpha, 0.001);
+#line 30 "bricks/brdf/microfacet/ndf/blinn_phong.py"
+float blinn_phong_ndf(float NdotH, float NxH2, float alpha) {
+    float a = max(alpha, 0.0001);
     float n = ((2.0 / (a * a)) - 2.0);
-    return (((n + 2.0) * 0.15915494309189535) * pow(NdotH, n));
+    float x = NxH2;
+    float ln_c2 = ((x < 0.01) ? ((-x) * (1.0 + (x * (0.5 + (x * ((1.0 / 3.0) + (x * 0.25))))))) : (2.0 * log(max(NdotH, 1e-30))));
+    return (((n + 2.0) * 0.15915494309189535) * exp(((0.5 * n) * ln_c2)));
 }
 
 #line 12 "bricks/brdf/microfacet/fresnel/schlick.py"
@@ -39,8 +40,9 @@ float implicit_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alp
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, vec3 f0) {
-    float D = blinn_phong_ndf(NdotH, alpha);
+vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = blinn_phong_ndf(NdotH, NxH2, alpha);
     float Vis = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -54,14 +56,16 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     vec3 Hsum = (L + V);
-    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-12)));
+    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    vec3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 
-#line 65 "990b9a56f7cb.comp.glsl"
+#line 69 "990b9a56f7cb.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -5,9 +5,9 @@
 // hash: 3492f48173ec
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:9a76bc833beb
+// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:2f94379e0524
 // brick bricks/brdf/microfacet/visibility/implicit.py sha256:7042a3d619ce
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
@@ -29,12 +29,13 @@ vec3 lambert_diffuse(vec3 rho_d) {
     return (rho_d * 0.3183098861837907);
 }
 
-#line 13 "bricks/brdf/microfacet/ndf/blinn_phong.py"
-float blinn_phong_ndf(float NdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/ndf/blinn_phong.py"
-    float a = max(alpha, 0.001);
+#line 30 "bricks/brdf/microfacet/ndf/blinn_phong.py"
+float blinn_phong_ndf(float NdotH, float NxH2, float alpha) {
+    float a = max(alpha, 0.0001);
     float n = ((2.0 / (a * a)) - 2.0);
-    return (((n + 2.0) * 0.15915494309189535) * pow(NdotH, n));
+    float x = NxH2;
+    float ln_c2 = ((x < 0.01) ? ((-x) * (1.0 + (x * (0.5 + (x * ((1.0 / 3.0) + (x * 0.25))))))) : (2.0 * log(max(NdotH, 1e-30))));
+    return (((n + 2.0) * 0.15915494309189535) * exp(((0.5 * n) * ln_c2)));
 }
 
 #line 12 "bricks/brdf/microfacet/fresnel/none.py"
@@ -48,8 +49,9 @@ float implicit_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alp
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, vec3 f0) {
-    float D = blinn_phong_ndf(NdotH, alpha);
+vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = blinn_phong_ndf(NdotH, NxH2, alpha);
     float Vis = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (none_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -89,10 +91,12 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     vec3 Hsum = (L + V);
-    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-12)));
+    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    vec3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0));
+    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3 l0_position, vec3 l0_color, vec3 l1_position, vec3 l1_color) {
@@ -105,7 +109,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3
         float s0 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf(L0, V, N, m_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 25 "<glue>"
+#line 27 "<glue>"
     vec3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -113,12 +117,12 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf(L1, V, N, m_rho_d, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 31 "<glue>"
+#line 33 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 122 "3492f48173ec.frag.glsl"
+#line 126 "3492f48173ec.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

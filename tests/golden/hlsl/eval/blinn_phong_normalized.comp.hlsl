@@ -23,7 +23,7 @@ float3 brdf(float3 L, float3 V, float3 N, float n, float3 f0) {
     }
 #line 7 "<glue>"
     float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-12)));
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
     return blinn_phong_normalized_specular(NdotH, n, f0);
 }

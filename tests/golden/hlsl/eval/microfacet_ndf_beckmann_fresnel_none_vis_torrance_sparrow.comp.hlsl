@@ -2,9 +2,9 @@
 // eval: microfacet(ndf=beckmann,fresnel=none,vis=torrance_sparrow)
 // hash: 5e84b038a5f7
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:a19bd1ffdea3
-// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:4182047e2a9c
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template hlsl/eval.hlsl.j2 sha256:2c2924df8739
 // template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
@@ -14,13 +14,11 @@ StructuredBuffer<float4> samples : register(t0, space0);
 RWStructuredBuffer<float4> result : register(u1, space0);
 cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[2]; };
 
-#line 12 "bricks/brdf/microfacet/ndf/beckmann.py"
-float beckmann_ndf(float NdotH, float alpha) {
-#line 16 "bricks/brdf/microfacet/ndf/beckmann.py"
-    float a2 = max((alpha * alpha), 1e-06);
+#line 24 "bricks/brdf/microfacet/ndf/beckmann.py"
+float beckmann_ndf(float NdotH, float NxH2, float alpha) {
+    float a2 = max((alpha * alpha), 1e-08);
     float c2 = max((NdotH * NdotH), 1e-08);
-    float tan2 = ((1.0 - c2) / c2);
-    return (exp(((-tan2) / a2)) / (((3.141592653589793 * a2) * c2) * c2));
+    return (exp(((-NxH2) / (a2 * c2))) / (((3.141592653589793 * a2) * c2) * c2));
 }
 
 #line 12 "bricks/brdf/microfacet/fresnel/none.py"
@@ -30,7 +28,7 @@ float3 none_fresnel(float3 f0, float VdotH) {
 
 #line 12 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
 float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
+#line 19 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
     float vh = max(VdotH, 0.0001);
     float nl = max(NdotL, 0.0001);
     float G = min(1.0, min((((2.0 * NdotH) * NdotV) / vh), (((2.0 * NdotH) * nl) / vh)));
@@ -38,8 +36,9 @@ float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, f
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, float3 f0) {
-    float D = beckmann_ndf(NdotH, alpha);
+float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = beckmann_ndf(NdotH, NxH2, alpha);
     float Vis = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (none_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -53,14 +52,16 @@ float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-12)));
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    float3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 
-#line 64 "5e84b038a5f7.comp.hlsl"
+#line 65 "5e84b038a5f7.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

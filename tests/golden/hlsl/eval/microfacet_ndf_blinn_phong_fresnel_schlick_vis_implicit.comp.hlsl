@@ -2,9 +2,9 @@
 // eval: microfacet(ndf=blinn_phong,fresnel=schlick,vis=implicit)
 // hash: 990b9a56f7cb
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:9a76bc833beb
+// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:2f94379e0524
 // brick bricks/brdf/microfacet/visibility/implicit.py sha256:7042a3d619ce
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template hlsl/eval.hlsl.j2 sha256:2c2924df8739
 // template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
@@ -14,12 +14,13 @@ StructuredBuffer<float4> samples : register(t0, space0);
 RWStructuredBuffer<float4> result : register(u1, space0);
 cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[2]; };
 
-#line 13 "bricks/brdf/microfacet/ndf/blinn_phong.py"
-float blinn_phong_ndf(float NdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/ndf/blinn_phong.py"
-    float a = max(alpha, 0.001);
+#line 30 "bricks/brdf/microfacet/ndf/blinn_phong.py"
+float blinn_phong_ndf(float NdotH, float NxH2, float alpha) {
+    float a = max(alpha, 0.0001);
     float n = ((2.0 / (a * a)) - 2.0);
-    return (((n + 2.0) * 0.15915494309189535) * pow(NdotH, n));
+    float x = NxH2;
+    float ln_c2 = ((x < 0.01) ? ((-x) * (1.0 + (x * (0.5 + (x * ((1.0 / 3.0) + (x * 0.25))))))) : (2.0 * log(max(NdotH, 1e-30))));
+    return (((n + 2.0) * 0.15915494309189535) * exp(((0.5 * n) * ln_c2)));
 }
 
 #line 12 "bricks/brdf/microfacet/fresnel/schlick.py"
@@ -36,8 +37,9 @@ float implicit_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alp
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, float3 f0) {
-    float D = blinn_phong_ndf(NdotH, alpha);
+float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = blinn_phong_ndf(NdotH, NxH2, alpha);
     float Vis = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -51,14 +53,16 @@ float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-12)));
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    float3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 
-#line 62 "990b9a56f7cb.comp.hlsl"
+#line 66 "990b9a56f7cb.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

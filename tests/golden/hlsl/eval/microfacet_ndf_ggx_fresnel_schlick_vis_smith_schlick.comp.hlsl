@@ -2,9 +2,9 @@
 // eval: microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick)
 // hash: f637b5a924b5
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/ggx.py sha256:e52a1f7cdaf9
-// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:0da016ec3aec
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/ggx.py sha256:8bab662c825b
+// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:706385e0b16a
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template hlsl/eval.hlsl.j2 sha256:2c2924df8739
 // template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
@@ -14,12 +14,11 @@ StructuredBuffer<float4> samples : register(t0, space0);
 RWStructuredBuffer<float4> result : register(u1, space0);
 cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[2]; };
 
-#line 12 "bricks/brdf/microfacet/ndf/ggx.py"
-float ggx_ndf(float NdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/ndf/ggx.py"
-    float a = max(alpha, 0.001);
+#line 23 "bricks/brdf/microfacet/ndf/ggx.py"
+float ggx_ndf(float NdotH, float NxH2, float alpha) {
+    float a = max(alpha, 0.0001);
     float a2 = (a * a);
-    float d = (((NdotH * NdotH) * (a2 - 1.0)) + 1.0);
+    float d = (((a2 * NdotH) * NdotH) + NxH2);
     return (a2 / ((3.141592653589793 * d) * d));
 }
 
@@ -36,13 +35,14 @@ float smith_schlick_vis(float NdotL, float NdotV, float NdotH, float VdotH, floa
     float k = (alpha * 0.7978845608028654);
     float gl = ((NdotL * (1.0 - k)) + k);
     float gv = ((NdotV * (1.0 - k)) + k);
-#line 20 "bricks/brdf/microfacet/visibility/smith_schlick.py"
+#line 22 "bricks/brdf/microfacet/visibility/smith_schlick.py"
     return (1.0 / max(((4.0 * gl) * gv), 1e-08));
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, float3 f0) {
-    float D = ggx_ndf(NdotH, alpha);
+float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = ggx_ndf(NdotH, NxH2, alpha);
     float Vis = smith_schlick_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -56,14 +56,16 @@ float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-12)));
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    float3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 
-#line 67 "f637b5a924b5.comp.hlsl"
+#line 69 "f637b5a924b5.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

@@ -2,9 +2,9 @@
 // permutation: brdf=microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick);lights=directional/shadow_map,point/none;packing=constants(normal=vertex);output=linear;precision=fp32
 // hash: 3595e5d140dc
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/ggx.py sha256:e52a1f7cdaf9
-// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:0da016ec3aec
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/ggx.py sha256:8bab662c825b
+// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:706385e0b16a
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/directional.py sha256:374c6a0edde8
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
@@ -27,12 +27,11 @@ struct PSIn {
     [[vk::location(1)]] float3 v_normal : TEXCOORD1;
 };
 
-#line 12 "bricks/brdf/microfacet/ndf/ggx.py"
-float ggx_ndf(float NdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/ndf/ggx.py"
-    float a = max(alpha, 0.001);
+#line 23 "bricks/brdf/microfacet/ndf/ggx.py"
+float ggx_ndf(float NdotH, float NxH2, float alpha) {
+    float a = max(alpha, 0.0001);
     float a2 = (a * a);
-    float d = (((NdotH * NdotH) * (a2 - 1.0)) + 1.0);
+    float d = (((a2 * NdotH) * NdotH) + NxH2);
     return (a2 / ((3.141592653589793 * d) * d));
 }
 
@@ -49,13 +48,14 @@ float smith_schlick_vis(float NdotL, float NdotV, float NdotH, float VdotH, floa
     float k = (alpha * 0.7978845608028654);
     float gl = ((NdotL * (1.0 - k)) + k);
     float gv = ((NdotV * (1.0 - k)) + k);
-#line 20 "bricks/brdf/microfacet/visibility/smith_schlick.py"
+#line 22 "bricks/brdf/microfacet/visibility/smith_schlick.py"
     return (1.0 / max(((4.0 * gl) * gv), 1e-08));
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, float3 f0) {
-    float D = ggx_ndf(NdotH, alpha);
+float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = ggx_ndf(NdotH, NxH2, alpha);
     float Vis = smith_schlick_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -114,10 +114,12 @@ float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-12)));
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    float3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 float4 shade(float3 P, float3 Ng, float3 V, float m_alpha, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D l0_shadow_map, SamplerState l0_shadow_map_smp) {
@@ -130,7 +132,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float m_alpha, float3 m_f0, float3 l
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
         Lo += (((3.141592653589793 * brdf(L0, V, N, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 25 "<glue>"
+#line 27 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -138,12 +140,12 @@ float4 shade(float3 P, float3 Ng, float3 V, float m_alpha, float3 m_f0, float3 l
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf(L1, V, N, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 31 "<glue>"
+#line 33 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 147 "3595e5d140dc.frag.hlsl"
+#line 149 "3595e5d140dc.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

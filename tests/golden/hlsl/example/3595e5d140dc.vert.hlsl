@@ -2,9 +2,9 @@
 // permutation: brdf=microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick);lights=directional/shadow_map,point/none;packing=constants(normal=vertex);output=linear;precision=fp32
 // hash: 3595e5d140dc
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/ggx.py sha256:e52a1f7cdaf9
-// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:0da016ec3aec
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/ggx.py sha256:8bab662c825b
+// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:706385e0b16a
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/directional.py sha256:374c6a0edde8
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c

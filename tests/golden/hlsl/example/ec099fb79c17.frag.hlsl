@@ -3,9 +3,9 @@
 // hash: ec099fb79c17
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:a19bd1ffdea3
-// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:4182047e2a9c
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/directional.py sha256:374c6a0edde8
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
@@ -39,13 +39,11 @@ float3 lambert_diffuse(float3 rho_d) {
     return (rho_d * 0.3183098861837907);
 }
 
-#line 12 "bricks/brdf/microfacet/ndf/beckmann.py"
-float beckmann_ndf(float NdotH, float alpha) {
-#line 16 "bricks/brdf/microfacet/ndf/beckmann.py"
-    float a2 = max((alpha * alpha), 1e-06);
+#line 24 "bricks/brdf/microfacet/ndf/beckmann.py"
+float beckmann_ndf(float NdotH, float NxH2, float alpha) {
+    float a2 = max((alpha * alpha), 1e-08);
     float c2 = max((NdotH * NdotH), 1e-08);
-    float tan2 = ((1.0 - c2) / c2);
-    return (exp(((-tan2) / a2)) / (((3.141592653589793 * a2) * c2) * c2));
+    return (exp(((-NxH2) / (a2 * c2))) / (((3.141592653589793 * a2) * c2) * c2));
 }
 
 #line 12 "bricks/brdf/microfacet/fresnel/schlick.py"
@@ -58,7 +56,7 @@ float3 schlick_fresnel(float3 f0, float VdotH) {
 
 #line 12 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
 float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alpha) {
-#line 15 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
+#line 19 "bricks/brdf/microfacet/visibility/torrance_sparrow.py"
     float vh = max(VdotH, 0.0001);
     float nl = max(NdotL, 0.0001);
     float G = min(1.0, min((((2.0 * NdotH) * NdotV) / vh), (((2.0 * NdotH) * nl) / vh)));
@@ -66,8 +64,9 @@ float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, f
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float VdotH, float alpha, float3 f0) {
-    float D = beckmann_ndf(NdotH, alpha);
+float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+#line 27 "bricks/brdf/specular/microfacet.py"
+    float D = beckmann_ndf(NdotH, NxH2, alpha);
     float Vis = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -132,10 +131,12 @@ float3 brdf(float3 L, float3 V, float3 N, float3 rho_d, float alpha, float3 f0) 
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-12)));
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    float3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0));
+    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float3 m_rho_d, float m_alpha, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D t_albedo_map, SamplerState t_albedo_map_smp, Texture2D t_normal_map, SamplerState t_normal_map_smp, Texture2D l0_shadow_map, SamplerState l0_shadow_map_smp) {
@@ -149,7 +150,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
         Lo += (((3.141592653589793 * brdf(L0, V, N, p_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 26 "<glue>"
+#line 28 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -157,12 +158,12 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf(L1, V, N, p_rho_d, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 32 "<glue>"
+#line 34 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 166 "ec099fb79c17.frag.hlsl"
+#line 167 "ec099fb79c17.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

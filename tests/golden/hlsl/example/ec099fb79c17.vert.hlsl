@@ -3,9 +3,9 @@
 // hash: ec099fb79c17
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:a19bd1ffdea3
-// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:4182047e2a9c
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/directional.py sha256:374c6a0edde8
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c

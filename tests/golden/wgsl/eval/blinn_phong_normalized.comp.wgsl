@@ -21,7 +21,7 @@ fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3
         return vec3<f32>(0.0f);
     }
     var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-12f)));
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
     var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
     return blinn_phong_normalized_specular(NdotH, n, f0);
 }

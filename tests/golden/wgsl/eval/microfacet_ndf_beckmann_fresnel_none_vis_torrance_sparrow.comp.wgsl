@@ -2,9 +2,9 @@
 // eval: microfacet(ndf=beckmann,fresnel=none,vis=torrance_sparrow)
 // hash: 5e84b038a5f7
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:a19bd1ffdea3
-// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:4182047e2a9c
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template wgsl/eval.wgsl.j2 sha256:076e0c552233
 // template wgsl/macros.wgsl.j2 sha256:80e35411c40a
 
@@ -15,11 +15,10 @@ struct Params { info: vec4<u32>, data: array<vec4<f32>, 2> }
 @group(0) @binding(1) var<storage, read_write> result: array<vec4<f32>>;
 @group(0) @binding(2) var<uniform> params: Params;
 
-fn beckmann_ndf(NdotH: f32, alpha: f32) -> f32 {
-    var a2: f32 = max((alpha * alpha), 1e-06f);
+fn beckmann_ndf(NdotH: f32, NxH2: f32, alpha: f32) -> f32 {
+    var a2: f32 = max((alpha * alpha), 1e-08f);
     var c2: f32 = max((NdotH * NdotH), 1e-08f);
-    var tan2: f32 = ((1.0f - c2) / c2);
-    return (exp(((-tan2) / a2)) / (((3.141592653589793f * a2) * c2) * c2));
+    return (exp(((-NxH2) / (a2 * c2))) / (((3.141592653589793f * a2) * c2) * c2));
 }
 
 fn none_fresnel(f0: vec3<f32>, VdotH: f32) -> vec3<f32> {
@@ -33,8 +32,8 @@ fn torrance_sparrow_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f
     return (G / ((4.0f * nl) * NdotV));
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    var D: f32 = beckmann_ndf(NdotH, alpha);
+fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    var D: f32 = beckmann_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (none_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -46,10 +45,12 @@ fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> 
     var NdotL: f32 = min(dot(N, L), 1.0f);
     var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
     var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-12f)));
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
     var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    var NxH: vec3<f32> = cross(N, H);
+    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
     var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 

@@ -2,9 +2,9 @@
 // eval: microfacet(ndf=blinn_phong,fresnel=schlick,vis=implicit)
 // hash: 990b9a56f7cb
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:9a76bc833beb
+// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:2f94379e0524
 // brick bricks/brdf/microfacet/visibility/implicit.py sha256:7042a3d619ce
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template wgsl/eval.wgsl.j2 sha256:076e0c552233
 // template wgsl/macros.wgsl.j2 sha256:80e35411c40a
 
@@ -15,10 +15,12 @@ struct Params { info: vec4<u32>, data: array<vec4<f32>, 2> }
 @group(0) @binding(1) var<storage, read_write> result: array<vec4<f32>>;
 @group(0) @binding(2) var<uniform> params: Params;
 
-fn blinn_phong_ndf(NdotH: f32, alpha: f32) -> f32 {
-    var a: f32 = max(alpha, 0.001f);
+fn blinn_phong_ndf(NdotH: f32, NxH2: f32, alpha: f32) -> f32 {
+    var a: f32 = max(alpha, 0.0001f);
     var n: f32 = ((2.0f / (a * a)) - 2.0f);
-    return (((n + 2.0f) * 0.15915494309189535f) * pow(NdotH, n));
+    var x: f32 = NxH2;
+    var ln_c2: f32 = select((2.0f * log(max(NdotH, 1e-30f))), ((-x) * (1.0f + (x * (0.5f + (x * ((1.0f / 3.0f) + (x * 0.25f))))))), (x < 0.01f));
+    return (((n + 2.0f) * 0.15915494309189535f) * exp(((0.5f * n) * ln_c2)));
 }
 
 fn schlick_fresnel(f0: vec3<f32>, VdotH: f32) -> vec3<f32> {
@@ -31,8 +33,8 @@ fn implicit_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32) -> f
     return 0.25f;
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    var D: f32 = blinn_phong_ndf(NdotH, alpha);
+fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    var D: f32 = blinn_phong_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -44,10 +46,12 @@ fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> 
     var NdotL: f32 = min(dot(N, L), 1.0f);
     var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
     var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-12f)));
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
     var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    var NxH: vec3<f32> = cross(N, H);
+    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
     var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 

@@ -3,9 +3,9 @@
 // hash: 3492f48173ec
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:9a76bc833beb
+// brick bricks/brdf/microfacet/ndf/blinn_phong.py sha256:2f94379e0524
 // brick bricks/brdf/microfacet/visibility/implicit.py sha256:7042a3d619ce
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/constants.py sha256:df1740cdcbbf

@@ -2,9 +2,9 @@
 // permutation: brdf=microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick);lights=directional/shadow_map,point/none;packing=constants(normal=vertex);output=linear;precision=fp32
 // hash: 3595e5d140dc
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/ggx.py sha256:e52a1f7cdaf9
-// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:0da016ec3aec
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/ggx.py sha256:8bab662c825b
+// brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:706385e0b16a
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/directional.py sha256:374c6a0edde8
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
@@ -25,10 +25,10 @@ struct Material { data: array<vec4<f32>, 2> }
 @group(0) @binding(2) var l0_shadow_map: texture_2d<f32>;
 @group(0) @binding(3) var l0_shadow_map_smp: sampler;
 
-fn ggx_ndf(NdotH: f32, alpha: f32) -> f32 {
-    var a: f32 = max(alpha, 0.001f);
+fn ggx_ndf(NdotH: f32, NxH2: f32, alpha: f32) -> f32 {
+    var a: f32 = max(alpha, 0.0001f);
     var a2: f32 = (a * a);
-    var d: f32 = (((NdotH * NdotH) * (a2 - 1.0f)) + 1.0f);
+    var d: f32 = (((a2 * NdotH) * NdotH) + NxH2);
     return (a2 / ((3.141592653589793f * d) * d));
 }
 
@@ -45,8 +45,8 @@ fn smith_schlick_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32)
     return (1.0f / max(((4.0f * gl) * gv), 1e-08f));
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    var D: f32 = ggx_ndf(NdotH, alpha);
+fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    var D: f32 = ggx_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = smith_schlick_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -95,10 +95,12 @@ fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> 
     var NdotL: f32 = min(dot(N, L), 1.0f);
     var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
     var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-12f)));
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
     var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    var NxH: vec3<f32> = cross(N, H);
+    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
     var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0);
+    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, m_alpha: f32, m_f0: vec3<f32>, l0_direction: vec3<f32>, l0_color: vec3<f32>, l0_shadow_matrix: mat4x4<f32>, l0_shadow_bias: f32, l1_position: vec3<f32>, l1_color: vec3<f32>, l0_shadow_map: texture_2d<f32>, l0_shadow_map_smp: sampler) -> vec4<f32> {

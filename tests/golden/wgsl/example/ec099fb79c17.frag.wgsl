@@ -3,9 +3,9 @@
 // hash: ec099fb79c17
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:ef42b86f54bd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:a19bd1ffdea3
-// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:4182047e2a9c
-// brick bricks/brdf/specular/microfacet.py sha256:dc57cdb2b93b
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
+// brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick bricks/light/directional.py sha256:374c6a0edde8
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
@@ -34,11 +34,10 @@ fn lambert_diffuse(rho_d: vec3<f32>) -> vec3<f32> {
     return (rho_d * 0.3183098861837907f);
 }
 
-fn beckmann_ndf(NdotH: f32, alpha: f32) -> f32 {
-    var a2: f32 = max((alpha * alpha), 1e-06f);
+fn beckmann_ndf(NdotH: f32, NxH2: f32, alpha: f32) -> f32 {
+    var a2: f32 = max((alpha * alpha), 1e-08f);
     var c2: f32 = max((NdotH * NdotH), 1e-08f);
-    var tan2: f32 = ((1.0f - c2) / c2);
-    return (exp(((-tan2) / a2)) / (((3.141592653589793f * a2) * c2) * c2));
+    return (exp(((-NxH2) / (a2 * c2))) / (((3.141592653589793f * a2) * c2) * c2));
 }
 
 fn schlick_fresnel(f0: vec3<f32>, VdotH: f32) -> vec3<f32> {
@@ -54,8 +53,8 @@ fn torrance_sparrow_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f
     return (G / ((4.0f * nl) * NdotV));
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    var D: f32 = beckmann_ndf(NdotH, alpha);
+fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    var D: f32 = beckmann_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
@@ -109,10 +108,12 @@ fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, alpha: f32, 
     var NdotL: f32 = min(dot(N, L), 1.0f);
     var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
     var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-12f)));
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
     var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    var NxH: vec3<f32> = cross(N, H);
+    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
     var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, VdotH, alpha, f0));
+    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, T: vec3<f32>, B: vec3<f32>, uv: vec2<f32>, m_rho_d: vec3<f32>, m_alpha: f32, m_f0: vec3<f32>, l0_direction: vec3<f32>, l0_color: vec3<f32>, l0_shadow_matrix: mat4x4<f32>, l0_shadow_bias: f32, l1_position: vec3<f32>, l1_color: vec3<f32>, t_albedo_map: texture_2d<f32>, t_albedo_map_smp: sampler, t_normal_map: texture_2d<f32>, t_normal_map_smp: sampler, l0_shadow_map: texture_2d<f32>, l0_shadow_map_smp: sampler) -> vec4<f32> {
