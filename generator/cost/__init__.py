@@ -1,0 +1,133 @@
+"""Static cost of SPIR-V entry points: instruction classes, scalarized counts, register pressure.
+
+Read from the module's binary words after ``spirv-opt -O`` (which inlines
+every function, so an entry point is one function). Counts are static: each
+instruction once, wherever it sits in the control flow (both sides of a
+branch count; a loop body counts once). Classes and the scalar rules are in
+:mod:`generator.cost.classify`, the register estimate in
+:mod:`generator.cost.liveness`.
+"""
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field, fields
+
+from .classify import NOT_EXECUTED, classify, storage_class
+from .liveness import analyze_function
+from .spirv import Module, SpirvError, read
+
+__all__ = ["Cost", "analyze", "entry_cost", "SpirvError", "read"]
+
+# Cost fields in report order; "alu" etc. are instruction counts, "*_scalar" scalarized counts.
+COUNT_FIELDS = ("instructions", "alu", "transcendental", "texture", "branches", "loads", "stores", "other",
+                "alu_scalar", "transcendental_scalar", "loads_scalar", "stores_scalar", "registers", "calls")
+_CLASS_FIELD = {"alu": "alu", "transcendental": "transcendental", "texture": "texture", "branch": "branches",
+                "load": "loads", "store": "stores", "other": "other"}
+
+
+@dataclass
+class Cost:
+    """Static cost of one entry point (or a difference of two: fields may then be negative)."""
+
+    instructions: int = 0     # every instruction executed as code (merge declarations excluded)
+    alu: int = 0
+    transcendental: int = 0
+    texture: int = 0
+    branches: int = 0         # conditional branches
+    loads: int = 0
+    stores: int = 0
+    other: int = 0            # moves, shuffles, phis, access chains, jumps, returns
+    alu_scalar: int = 0
+    transcendental_scalar: int = 0
+    loads_scalar: int = 0     # 32-bit components loaded
+    stores_scalar: int = 0
+    registers: int = 0        # peak live 32-bit scalars (an estimate: see generator.cost.liveness)
+    calls: int = 0            # OpFunctionCall left after optimization (0 when fully inlined)
+    opcodes: dict = field(default_factory=dict)           # histogram: "OpFMul" / "Exp" -> count
+    loads_by_storage: dict = field(default_factory=dict)  # "Uniform" / "Input" / ... -> load count
+
+    def __add__(self, other: "Cost") -> "Cost":
+        return _combine(self, other, 1)
+
+    def __sub__(self, other: "Cost") -> "Cost":
+        return _combine(self, other, -1)
+
+    def as_dict(self, histograms: bool = True) -> dict:
+        """Plain JSON-ready dict (histograms sorted, zero entries dropped; left out unless `histograms`)."""
+        d = {f: getattr(self, f) for f in COUNT_FIELDS}
+        if not histograms:
+            return d
+        d["opcodes"] = {k: v for k, v in sorted(self.opcodes.items()) if v}
+        d["loads_by_storage"] = {k: v for k, v in sorted(self.loads_by_storage.items()) if v}
+        return d
+
+
+def _combine(a: Cost, b: Cost, sign: int) -> Cost:
+    out = Cost(**{f.name: getattr(a, f.name) + sign * getattr(b, f.name)
+                  for f in fields(Cost) if f.name in COUNT_FIELDS})
+    for name in ("opcodes", "loads_by_storage"):
+        c = Counter(getattr(a, name))
+        for k, v in getattr(b, name).items():
+            c[k] += sign * v
+        setattr(out, name, {k: v for k, v in sorted(c.items()) if v})
+    return out
+
+
+def _function_cost(mod: Module, fn_id: int, memo: dict[int, Cost]) -> Cost:
+    """Own instructions plus, per call site, the callee's cost (as if inlined); peak registers."""
+    if fn_id in memo:
+        return memo[fn_id]
+    fn = mod.functions[fn_id]
+    cost = Cost()
+    ops: Counter = Counter()
+    storage: Counter = Counter()
+    callees: list[int] = []
+    for block in fn.blocks:
+        for ins in block.body:
+            if ins.name in NOT_EXECUTED:
+                continue
+            cls, key, scalars = classify(mod, ins)
+            cost.instructions += 1
+            ops[key] += 1
+            name = _CLASS_FIELD[cls]
+            setattr(cost, name, getattr(cost, name) + 1)
+            cost.alu_scalar += scalars.get("alu", 0)
+            cost.transcendental_scalar += scalars.get("transcendental", 0)
+            cost.loads_scalar += scalars.get("load", 0)
+            cost.stores_scalar += scalars.get("store", 0)
+            if cls == "load" and ins.name == "Load":
+                storage[storage_class(mod, ins.words[2])] += 1
+            if ins.name == "FunctionCall":
+                cost.calls += 1
+                callees.append(ins.operands[0])
+    cost.opcodes, cost.loads_by_storage = dict(ops), dict(storage)
+    memo[fn_id] = cost  # placeholder against (invalid) recursion
+    peaks = {}
+    for callee in callees:
+        sub = _function_cost(mod, callee, memo)
+        peaks[callee] = sub.registers
+        registers = cost.registers
+        cost = cost + sub
+        cost.registers = registers
+    cost.registers = analyze_function(mod, fn, peaks).peak
+    memo[fn_id] = cost
+    return cost
+
+
+def analyze(spirv: bytes) -> dict[str, Cost]:
+    """Cost of every entry point of a SPIR-V module, by entry-point name."""
+    mod = read(spirv)
+    memo: dict[int, Cost] = {}
+    return {name: _function_cost(mod, fid, memo) for name, (_, fid) in sorted(mod.entry_points.items())}
+
+
+def entry_cost(spirv: bytes, entry: str | None = None) -> Cost:
+    """Cost of one entry point (the only one when `entry` is None)."""
+    costs = analyze(spirv)
+    if entry is None:
+        if len(costs) != 1:
+            raise SpirvError(f"module has {len(costs)} entry points ({', '.join(costs)}); name one")
+        return next(iter(costs.values()))
+    if entry not in costs:
+        raise SpirvError(f"no entry point '{entry}' (found: {', '.join(costs) or 'none'})")
+    return costs[entry]
