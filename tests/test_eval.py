@@ -37,6 +37,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import require, require_tool
+from tests.lavapipe import device, no_validation_messages  # noqa: F401 (fixtures)
 
 pytestmark = pytest.mark.lavapipe
 
@@ -81,31 +82,6 @@ def samples():
     T, B, N = frames(rng, SAMPLES)
     L, V = hemisphere(rng, T, B, N), hemisphere(rng, T, B, N)
     return tuple(f32(x) for x in (L, V, N, T))
-
-
-@pytest.fixture(scope="module")
-def device():
-    for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
-        require_tool(t)
-    from generator.runtime.device import VulkanUnavailable
-    from generator.runtime.eval_kernel import close_shared, shared_device
-
-    try:
-        dev = shared_device(validation=True)
-    except VulkanUnavailable as exc:
-        require(False, str(exc))
-    yield dev
-    close_shared()
-    assert dev.messages == [], "validation messages while closing:\n" + "\n".join(map(str, dev.messages))
-
-
-@pytest.fixture(autouse=True)
-def no_validation_messages(request):
-    yield
-    if "device" in request.fixturenames:
-        dev = request.getfixturevalue("device")
-        found, dev.messages[:] = list(dev.messages), []
-        assert found == [], "validation messages:\n" + "\n".join(map(str, found))
 
 
 def sharpness(ep, values) -> float:

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.conftest import require, require_tool
+from tests.conftest import require_tool
+from tests.lavapipe import device, no_validation_messages, open_device  # noqa: F401 (fixtures)
 
 pytestmark = pytest.mark.lavapipe
 
@@ -21,32 +22,6 @@ void main() {
     if (i < params.info.x) { dst.y[i] = 2.0 * src.x[i] + 1.0; }
 }
 """
-
-
-def open_device():
-    from generator.runtime.device import Device, VulkanUnavailable
-
-    try:
-        return Device(validation=True)
-    except VulkanUnavailable as exc:
-        require(False, str(exc))
-
-
-@pytest.fixture(scope="module")
-def device():
-    dev = open_device()
-    yield dev
-    dev.close()
-    assert dev.messages == [], "validation messages while closing:\n" + "\n".join(map(str, dev.messages))
-
-
-@pytest.fixture(autouse=True)
-def no_validation_messages(request):
-    yield
-    if "device" in request.fixturenames:
-        dev = request.getfixturevalue("device")
-        found, dev.messages[:] = list(dev.messages), []
-        assert found == [], "validation messages:\n" + "\n".join(map(str, found))
 
 
 @pytest.fixture(scope="module")
@@ -113,8 +88,6 @@ def test_validation_layer_reports_misuse(double_spirv):
 
 def test_eval_kernel_chunks_large_inputs(device):
     """Inputs beyond one dispatch's workgroup limit run in chunks with the same results."""
-    for t in ("glslc", "spirv-val", "spirv-opt"):
-        require_tool(t)
     from generator.evaluate import _param_block, gpu_kernel, program, resolve_params
 
     spec = "lambert+blinn_phong_normalized"
@@ -134,8 +107,6 @@ def test_eval_kernel_chunks_large_inputs(device):
 
 
 def test_eval_kernel_times_loaded_samples_and_releases_buffers(device):
-    for t in ("glslc", "spirv-val", "spirv-opt"):
-        require_tool(t)
     from generator.evaluate import _param_block, gpu_kernel, program, resolve_params
 
     spec = "lambert"
