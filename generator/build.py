@@ -1,8 +1,9 @@
 """`shadermatrix build`: a scene's permutations → sources, SPIR-V and manifest.json.
 
 Compose every permutation in every language, compile them all in batches,
-write what changed atomically, then the manifest. A permutation that fails
-(brick error, compiler error) is reported and the others still build.
+write what changed atomically, then the manifest (with each shader's static
+cost, read from the optimized SPIR-V already in hand). A permutation that
+fails (brick error, compiler error) is reported and the others still build.
 """
 from __future__ import annotations
 
@@ -16,9 +17,10 @@ from . import __version__
 from .bricks import Library
 from .cache import atomic_write, sha256
 from .compose import LANGUAGES, Composed, compose_permutation
+from .cost import entry_cost
 from .lang import SourceError
 from .scene import Scene
-from .toolchain import CompileJob, compile_many, tool_versions
+from .toolchain import CompileJob, CompileResult, compile_many, tool_versions
 
 
 @dataclass
@@ -42,9 +44,9 @@ def job_key(h: str, stage: str, lang: str) -> str:
     return f"{h}.{stage}.{lang}"
 
 
-def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> BuildResult:
-    """Build every permutation of `scene` into `out`; see the module docstring."""
-    out = Path(out)
+def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES
+                  ) -> tuple[dict[str, Composed], dict[str, list[str]], dict[str, CompileResult]]:
+    """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key)."""
     composed: dict[str, Composed] = {}
     errors: dict[str, list[str]] = {}
     jobs: list[CompileJob] = []
@@ -59,6 +61,13 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> B
             jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
                                    line_map=tuple(src.line_map)))
     results = compile_many(jobs, optimize=True, validate=True, progress=show_progress())
+    return composed, errors, results
+
+
+def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> BuildResult:
+    """Build every permutation of `scene` into `out`; see the module docstring."""
+    out = Path(out)
+    composed, errors, results = compile_scene(scene, lib, languages)
 
     res = BuildResult(manifest={})
     entries = []
@@ -77,7 +86,8 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> B
                 item = {"source": rel_src, "source_sha256": sha256(data)}
                 if r.ok and r.spirv:
                     _count(res, atomic_write(out / rel_spv, r.spirv))
-                    item.update({"spirv": rel_spv, "spirv_sha256": sha256(r.spirv)})
+                    item.update({"spirv": rel_spv, "spirv_sha256": sha256(r.spirv),
+                                 "cost": entry_cost(r.spirv).as_dict(histograms=False)})
                 else:
                     errs += [str(d) for d in r.diagnostics if d.severity == "error"] or [f"{rel_src}: compile failed"]
                 entry["languages"].setdefault(src.language, {})[src.stage] = item

@@ -1,13 +1,17 @@
-"""Cost analysis: hand-assembled SPIR-V with known answers.
+"""Cost analysis: hand-assembled SPIR-V with known answers, bricks of known cost, the costs CLI.
 
 Fixtures in tests/fixtures/spirv/*.spvasm are assembled with the real
 `spirv-as` (and validated with `spirv-val`); their comments state the
-answers asserted here.
+answers asserted here. Bricks in tests/fixtures/cost_bricks cost what their
+docstrings say by construction.
 """
 from __future__ import annotations
 
+import json
+import re
 import struct
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -16,6 +20,8 @@ from tests.conftest import require_tool
 
 REPO = Path(__file__).resolve().parent.parent
 FIXTURES = REPO / "tests" / "fixtures" / "spirv"
+COST_BRICKS = REPO / "tests" / "fixtures" / "cost_bricks"
+EXAMPLE = REPO / "scenes" / "example.toml"
 COMPILERS = ("glslc", "naga", "spirv-val", "spirv-opt")
 
 
@@ -149,3 +155,170 @@ def test_opcode_table_agrees_with_spirv_dis(tmp_path):
         mine = [("Op" + OPCODES.get(op, f"?{op}"), GLSL_STD_450.get(w[3]) if op == 12 else None)
                 for op, w in instructions(data)]
         assert mine == _dis_ops(spirv_dis, data, tmp_path)
+
+
+# ------------------------------------------------------------------ bricks
+
+@pytest.fixture(scope="module")
+def fixture_brick_rows():
+    for t in COMPILERS:
+        require_tool(t)
+    from generator.costs import brick_rows, load_cost_library
+    return brick_rows(load_cost_library([COST_BRICKS]))
+
+
+def _rows(rows, subject, table="brick"):
+    found = {r.language: r for r in rows if r.subject == subject and r.table == table}
+    assert set(found) == {"hlsl", "glsl", "wgsl"}, f"no {table} rows for {subject}"
+    assert not any(r.error for r in found.values()), [r.error for r in found.values()]
+    return found
+
+
+@pytest.mark.toolchain
+def test_brick_of_known_cost_five_multiplications(fixture_brick_rows):
+    for lang, r in _rows(fixture_brick_rows, "five_muls").items():
+        c = r.cost
+        assert (c.alu_scalar, c.transcendental, c.texture, c.branches, c.loads) == (15, 0, 0, 0, 1), lang
+        # spirv-opt -O contracts the last multiply and the BRDF's sum (diffuse + specular) into one
+        # Fma (2 scalar operations), which replaces the baseline's add: 4 instructions, 15 operations.
+        assert (c.alu, c.opcodes.get("Fma"), c.opcodes.get("OpFMul"), c.opcodes.get("OpFAdd")) == (4, 1, 4, -1), lang
+        assert (r.measured, r.baseline) == ("five_muls+standin_specular", "standin_diffuse+standin_specular")
+
+
+@pytest.mark.toolchain
+def test_brick_of_known_cost_two_exponentials(fixture_brick_rows):
+    for lang, r in _rows(fixture_brick_rows, "two_exps").items():
+        c = r.cost
+        assert (c.transcendental, c.transcendental_scalar, c.alu, c.alu_scalar) == (2, 2, 3, 5), lang
+        assert (c.texture, c.branches, c.loads) == (0, 0, 2), lang  # its parameters f0 and k
+
+
+@pytest.mark.toolchain
+def test_every_brick_and_slot_filler_has_a_row_and_no_stand_in_does(fixture_brick_rows):
+    from generator.bricks import load_library
+    subjects = {r.subject for r in fixture_brick_rows if r.table == "brick"}
+    assert not any("standin" in s.split("=")[-1].split("(")[0] for s in subjects)
+    for (kind, bid), b in load_library().bricks.items():
+        if kind in ("ndf", "fresnel", "visibility"):
+            assert any(s.endswith(f"={bid}") for s in subjects), bid
+        elif b.slots and kind in ("diffuse", "specular"):
+            assert any(s.startswith(f"{bid}(") for s in subjects), bid  # named with its default fillers
+        else:
+            assert bid in subjects, bid
+    shadow = _rows(fixture_brick_rows, "shadow_map")
+    assert all(r.cost.texture == 1 and r.stage == "frag" for r in shadow.values())
+
+
+@pytest.mark.toolchain
+def test_course_models_are_data_and_a_new_brick_adds_its_row(fixture_brick_rows):
+    for model, tables in {"Blinn-Phong": {("shift-invariant", 0, "7"), ("shift-variant", 1, "15")},
+                          "Cook-Torrance": {("shift-invariant", 0, "35"), ("shift-variant", 1, "40")},
+                          "Banks": {("shift-invariant", 0, "12"), ("shift-variant", 1, "25")}}.items():
+        rows = [r for r in fixture_brick_rows if r.table == "model" and r.subject == model]
+        assert {(r.course.table, r.course.texture, r.course.alu) for r in rows} == tables
+        variant = [r for r in rows if r.course.table == "shift-variant"]
+        assert all(r.cost.texture == 1 for r in variant)  # the albedo texture
+    from generator.costs import brick_rows, course_models, load_cost_library
+    assert "Ashikhmin-Shirley" in {m.name for m in course_models()[0]}
+    assert not any(r.subject == "Ashikhmin-Shirley" for r in fixture_brick_rows)
+
+
+# ------------------------------------------------------------------ CLI, scene, manifest
+
+def cli(*args):
+    return subprocess.run([sys.executable, "-m", "generator.cli", "costs", *map(str, args)],
+                          cwd=REPO, capture_output=True, text=True, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def scene_json():
+    for t in COMPILERS:
+        require_tool(t)
+    r = cli(EXAMPLE, "--format", "json")
+    assert r.returncode == 0, r.stderr
+    return r.stdout
+
+
+@pytest.mark.toolchain
+def test_scene_costs_json_rows_and_stability(scene_json):
+    doc = json.loads(scene_json)
+    rows = doc["rows"]
+    assert len(rows) == 5 * 2 * 3  # permutations x stages x languages
+    for r in rows:
+        for key in ("subject", "language", "alu", "transcendental", "texture", "branches", "registers",
+                    "instructions", "loads", "stores", "alu_scalar"):
+            assert r[key] is not None, key
+    course = {(r["subject"], r["course_model"], r["course_table"]) for r in rows if r["course_model"]}
+    ids = {r["subject"]: r["measured"] for r in rows}
+    for subject, model, table in course:
+        assert model in ("Blinn-Phong", "Cook-Torrance")
+        assert (table == "shift-variant") == ("albedo_texture" in ids[subject])
+    assert len(course) == 2
+    assert doc["differences"] and all(d["why"] for d in doc["differences"])
+    again = cli(EXAMPLE, "--format", "json")
+    assert again.stdout == scene_json  # costs of the example scene are identical across runs
+
+
+@pytest.mark.toolchain
+def test_scene_costs_markdown_and_csv(scene_json):
+    md = cli(EXAMPLE)
+    assert md.returncode == 0, md.stderr
+    assert "| permutation | objects | stage | tex | ALU |" in md.stdout
+    assert "## Where the languages differ" in md.stdout
+    csv_out = cli(EXAMPLE, "--format", "csv")
+    assert csv_out.returncode == 0
+    lines = csv_out.stdout.splitlines()
+    assert lines[0].startswith("table,subject,kind,stage,language,instructions,alu,transcendental,texture")
+    assert len(lines) == 1 + 30
+
+
+@pytest.mark.toolchain
+def test_manifest_carries_the_same_costs(scene_json, tmp_path):
+    from generator.bricks import load_library
+    from generator.build import build_scene
+    from generator.cost import entry_cost
+    from generator.scene import load_scene
+    lib = load_library()
+    res = build_scene(load_scene(EXAMPLE, lib), lib, tmp_path)
+    assert res.ok
+    by_key = {(r["subject"], r["stage"], r["language"]): r for r in json.loads(scene_json)["rows"]}
+    for p in res.manifest["permutations"]:
+        for lang, stages in p["languages"].items():
+            for stage, item in stages.items():
+                cost = item["cost"]
+                assert cost == entry_cost((tmp_path / item["spirv"]).read_bytes()).as_dict(histograms=False)
+                row = by_key[(p["hash"], stage, lang)]
+                assert {k: row[k] for k in cost} == cost
+
+
+@pytest.mark.toolchain
+def test_bricks_table_markdown_shows_course_figures():
+    for t in COMPILERS:
+        require_tool(t)
+    r = cli("--bricks")
+    assert r.returncode == 0, r.stderr
+    assert re.search(r"\| Blinn-Phong \| direct \| shift-invariant \| `lambert\+blinn_phong_normalized` \| 0 \| 7 \|",
+                     r.stdout)
+    assert "| Lafortune | direct | shift-invariant |  | 0 | 10 + 5n | no brick yet |" in r.stdout
+    assert "standin" not in r.stdout.split("## The course's models")[0].split("## Per brick")[1]
+
+
+def test_cli_usage_errors(tmp_path):
+    assert cli().returncode == 2
+    assert cli(EXAMPLE, "--bricks").returncode == 2
+    assert cli(EXAMPLE, "--format", "xml").returncode == 2
+    missing = cli(tmp_path / "nope.toml")
+    assert missing.returncode == 1 and "nope.toml" in missing.stderr
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / "broken.py").write_text('"""Broken."""\nBRICK = {"kind": "nonsense", "cite": "x"}\n')
+    r = cli("--bricks", "--brick-dir", bad)
+    assert r.returncode == 1 and "broken.py" in r.stderr
+
+
+def test_stand_ins_stay_out_of_the_brick_list_and_scenes():
+    from generator.bricks import load_library
+    assert not any(bid.startswith("standin") for _, bid in load_library().bricks)
+    out = subprocess.run([sys.executable, "-m", "generator.cli", "bricks", "--json"], cwd=REPO,
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0 and "standin" not in out.stdout

@@ -1,0 +1,46 @@
+"""`shadermatrix costs`: measured cost tables per permutation of a scene, or per brick."""
+from __future__ import annotations
+
+import sys
+
+HELP = "cost tables (texture, ALU, transcendental, branches, registers) per permutation of a scene, or per brick"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("scene", nargs="?", help="scene file (TOML): one row per permutation and stage")
+    p.add_argument("--bricks", action="store_true",
+                   help="per-brick table instead: each brick's cost against a trivial stand-in, and the course's models")
+    p.add_argument("--brick-dir", action="append", metavar="DIR", default=[],
+                   help="an extra brick directory (repeatable)")
+    p.add_argument("--format", choices=("md", "csv", "json"), default="md", help="output format (default md)")
+
+
+def run(args) -> int:
+    if bool(args.scene) == bool(args.bricks):
+        print("error: give a SCENE or --bricks (one of them) — e.g. `shadermatrix costs scenes/example.toml` "
+              "or `shadermatrix costs --bricks`", file=sys.stderr)
+        return 2
+    from ..costs import brick_rows, course_models, load_cost_library, scene_rows
+    from ..costs_report import markdown, to_csv, to_json
+
+    models = None
+    if args.bricks:
+        rows = brick_rows(load_cost_library(args.brick_dir))
+        subject, title, models = "bricks", "Costs per brick", course_models()[0]
+    else:
+        from ..bricks import load_library
+        from ..scene import load_scene
+        lib = load_library(args.brick_dir)
+        scene = load_scene(args.scene, lib)
+        rows = scene_rows(scene, lib)
+        subject, title = scene.name, f"Costs of scene {scene.name}"
+    if args.format == "md":
+        sys.stdout.write(markdown(rows, title, models))
+    elif args.format == "csv":
+        sys.stdout.write(to_csv(rows))
+    else:
+        sys.stdout.write(to_json(rows, subject, models))
+    failed = sorted({f"{r.subject} ({r.language}): {r.error}" for r in rows if r.error})
+    for f in failed:
+        print(f"error: {f}", file=sys.stderr)
+    return 1 if failed else 0

@@ -1,0 +1,357 @@
+"""Measured costs: per permutation of a scene, and per brick as "with it" minus "with a stand-in".
+
+Every figure comes from the optimized SPIR-V of real shaders, in each
+language (:mod:`generator.cost` reads it). A brick's cost is the difference
+between two shaders that differ only in that brick. The stand-ins do no
+arithmetic and read no parameter; the BRDF stand-ins return the view vector
+V, so that fetching V (an input, as in the course's accounting) is in every
+shader measured and never in a difference.
+
+- diffuse and specular bricks: the eval kernel of the brick beside the other
+  kind's stand-in (``lambert+standin_specular``) minus the kernel of both
+  stand-ins; a brick with slots is measured with its default fillers;
+- slot fillers (ndf, fresnel, visibility): inside each BRDF brick that has
+  such a slot (the microfacet host), with the host's default fillers in the
+  other slots, minus the same host with the stand-in in that slot;
+- lights, shadows, packings, normals, outputs: the fragment shader of a small
+  synthetic permutation (BRDF ``standin_diffuse+standin_specular``, one
+  ``standin_light`` with ``standin_shadow``, ``standin_packing``,
+  ``standin_output``) with the brick put in its place, minus the permutation
+  with stand-ins only. Slots of the brick get stand-ins too. A packing that
+  provides material inputs is measured under a BRDF brick that reads them
+  (the same BRDF in both shaders).
+
+Models of the course's table (``course_costs.toml``) are measured the same
+way, whole: shift-invariant as the eval kernel of the model's spec minus the
+stand-in BRDF; shift-variant as the synthetic fragment shader with the
+model's BRDF and the textured packing minus the all-stand-in one. The
+stand-ins live in ``generator/cost_bricks/`` (slot fillers are generated
+from the slot signature) and are loaded only here.
+"""
+from __future__ import annotations
+
+import tempfile
+import tomllib
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from .bricks import BRDF_KINDS, KINDS, Brick, Library, load_brick, load_library
+from .build import compile_scene, job_key, show_progress
+from .compose import Composed, compose_eval, compose_permutation
+from .cost import Cost, entry_cost
+from .lang import SourceError
+from .permutation import LightKey, Permutation, SpecError, parse_brdf, parse_spec
+from .scene import Scene
+from .toolchain import CompileJob, compile_many
+
+__all__ = ["Row", "CourseFigure", "CourseModel", "course_models", "course_figure", "brick_rows",
+           "scene_rows", "load_cost_library", "standin", "is_standin", "COST_BRICKS", "REPORT_LANGUAGES"]
+
+COST_BRICKS = Path(__file__).resolve().parent / "cost_bricks"
+COURSE_FILE = Path(__file__).resolve().parent / "course_costs.toml"
+REPORT_LANGUAGES = ("hlsl", "glsl", "wgsl")  # column order of the reports
+STANDIN_CITE = "shadermatrix cost baseline (no model)"  # what marks a stand-in brick
+
+
+@dataclass(frozen=True)
+class CourseFigure:
+    """One figure of the course's tables: texture and ALU cost of a model for one point light."""
+
+    model: str
+    form: str       # "direct" | "factored"
+    table: str      # "shift-invariant" | "shift-variant"
+    texture: int
+    alu: str        # text: the course writes formulas for Lafortune
+
+
+@dataclass(frozen=True)
+class CourseModel:
+    name: str
+    form: str
+    spec: str
+    requires: tuple
+    invariant: CourseFigure
+    variant: CourseFigure
+
+
+def course_models() -> tuple[list[CourseModel], str]:
+    """The course's table as data, and the packing that makes a model shift-variant."""
+    data = tomllib.loads(COURSE_FILE.read_text(encoding="utf-8"))
+    models = []
+    for m in data["model"]:
+        fig = {t: CourseFigure(m["name"], m["form"], f"shift-{t}", int(m[t]["texture"]), str(m[t]["alu"]))
+               for t in ("invariant", "variant")}
+        models.append(CourseModel(m["name"], m["form"], m["spec"], tuple(m["requires"]),
+                                  fig["invariant"], fig["variant"]))
+    return models, data["variant"]["packing"]
+
+
+def course_figure(perm: Permutation, lib: Library) -> CourseFigure | None:
+    """The course's figure for a permutation's BRDF (direct form), shift-variant when its packing reads textures."""
+    try:
+        ids = {n.brick.id for top in parse_brdf(perm.brdf, lib) for n in top.walk()}
+        packing = parse_spec(perm.packing, lib, ("packing",))[0].brick
+    except (SpecError, SourceError):
+        return None
+    for m in course_models()[0]:
+        if m.form == "direct" and m.requires and set(m.requires) <= ids:
+            return m.variant if packing.entries else m.invariant
+    return None
+
+
+@dataclass
+class Row:
+    """One measured subject in one language."""
+
+    table: str           # "brick" | "model" | "permutation"
+    subject: str         # brick id, "ndf=beckmann", model name, permutation hash
+    kind: str            # brick kind; "brdf" for models; the stage name for permutations
+    language: str
+    stage: str           # "comp" | "frag" | "vert"
+    measured: str        # what was compiled (spec or permutation key)
+    baseline: str = ""   # what was subtracted (per-brick and model rows)
+    cost: Cost | None = None
+    course: CourseFigure | None = None
+    error: str = ""
+    objects: tuple = ()  # permutation rows: the scene objects using it
+    lights: int = 0      # permutation rows: light count (the course's figures are per light)
+
+
+# ------------------------------------------------------------------ compiling
+
+class _Batch:
+    """Shaders to compile once each (eval kernels and permutation fragment shaders), then their costs."""
+
+    def __init__(self, lib: Library, languages):
+        self.lib, self.languages = lib, tuple(languages)
+        self.units: dict[str, Composed | str] = {}  # unit key -> composed, or an error message
+        self.results: dict = {}
+
+    def eval(self, spec: str) -> str:
+        key = "eval:" + spec
+        if key not in self.units:
+            self.units[key] = _compose(lambda: compose_eval(spec, self.lib, self.languages))
+        return key
+
+    def perm(self, perm: Permutation) -> str:
+        key = "perm:" + perm.canonical()
+        if key not in self.units:
+            self.units[key] = _compose(lambda: compose_permutation(perm, self.lib, self.languages))
+        return key
+
+    def run(self) -> None:
+        jobs, seen = [], set()
+        for c in self.units.values():
+            if isinstance(c, str):
+                continue
+            for src in c.sources:
+                k = job_key(c.hash, src.stage, src.language)
+                if src.stage in ("comp", "frag") and k not in seen:
+                    seen.add(k)
+                    jobs.append(CompileJob(k, src.language, src.stage, src.text, line_map=tuple(src.line_map)))
+        self.results = compile_many(jobs, progress=show_progress())
+
+    def fail(self, name: str, message: str) -> str:
+        """A unit that cannot be built: its rows carry `message`."""
+        key = "fail:" + name
+        self.units[key] = message
+        return key
+
+    def canonical(self, unit: str) -> str:
+        """The canonical spec or permutation key of a unit (as given when it did not compose)."""
+        c = self.units[unit]
+        return unit.split(":", 1)[1] if isinstance(c, str) else c.key
+
+    def cost(self, unit: str, language: str) -> Cost | str:
+        c = self.units[unit]
+        if isinstance(c, str):
+            return c
+        stage = "comp" if unit.startswith("eval:") else "frag"
+        r = self.results[job_key(c.hash, stage, language)]
+        if not r.ok:
+            return "; ".join(str(d) for d in r.diagnostics if d.severity == "error") or "compile failed"
+        return entry_cost(r.spirv)
+
+
+def _compose(fn) -> Composed | str:
+    try:
+        return fn()
+    except (SourceError, SpecError) as e:
+        return str(e)
+
+
+# ------------------------------------------------------------------ per brick
+
+def standin(lib: Library, kind: str) -> Brick | None:
+    """The stand-in brick of a kind (generator/cost_bricks, or generated for slot kinds)."""
+    return next((b for b in lib.of_kind(kind) if is_standin(b)), None)
+
+
+def is_standin(b: Brick) -> bool:
+    return b.id.startswith("standin_") and b.cite == STANDIN_CITE
+
+
+def _consumer(lib: Library, packing: Brick, pair) -> str | None:
+    """A BRDF reading every material input a packing provides (the same in both measured shaders)."""
+    wanted = {f.name[len("get_"):] for f in packing.entries}
+    if not wanted:
+        return pair("diffuse", standin(lib, "diffuse").id)
+    for kind in BRDF_KINDS:
+        for b in lib.of_kind(kind):
+            if not is_standin(b) and wanted <= set(b.params):
+                return pair(kind, b.id)
+    return None
+
+
+def _with_standin_slots(b: Brick, lib: Library) -> str:
+    """A brick's spec with every slot filled by its kind's stand-in."""
+    if not b.slots:
+        return b.id
+    fillers = [f"{slot}={standin(lib, v['kind']).id}" for slot, v in b.slots.items()]
+    return f"{b.id}({','.join(fillers)})"
+
+
+@dataclass
+class _Plan:
+    table: str
+    subject: str
+    kind: str
+    with_unit: str
+    without_unit: str
+    course: CourseFigure | None = None
+
+
+def brick_rows(lib: Library, languages=REPORT_LANGUAGES) -> list[Row]:
+    """Per-brick and per-model rows; `lib` must include the stand-ins (see load_cost_library)."""
+    batch = _Batch(lib, languages)
+    sd, ss = standin(lib, "diffuse").id, standin(lib, "specular").id
+
+    def pair(kind: str, spec: str) -> str:
+        """A BRDF term with the other kind's stand-in beside it (which reads V, so V is always fetched)."""
+        return f"{spec}+{ss}" if kind == "diffuse" else f"{sd}+{spec}"
+
+    base = Permutation(f"{sd}+{ss}", (LightKey(standin(lib, "light").id, standin(lib, "shadow").id),),
+                       _with_standin_slots(standin(lib, "packing"), lib), standin(lib, "output").id)
+    plans: list[_Plan] = []
+
+    def eval_plan(table, subject, kind, spec, baseline, course=None):
+        plans.append(_Plan(table, subject, kind, batch.eval(spec), batch.eval(baseline), course))
+
+    def perm_plan(table, subject, kind, perm, course=None, baseline=base):
+        plans.append(_Plan(table, subject, kind, batch.perm(perm), batch.perm(baseline), course))
+
+    hosts = [b for k in BRDF_KINDS for b in lib.of_kind(k) if b.slots and not is_standin(b)]
+    for kind in KINDS:
+        sub = standin(lib, kind)
+        for b in (x for x in lib.of_kind(kind) if not is_standin(x)):
+            if kind in BRDF_KINDS:  # a brick with slots is measured with its default fillers, named in full
+                subject = parse_brdf(b.id, lib)[0].canonical()
+                eval_plan("brick", subject, kind, pair(kind, b.id), pair(kind, sub.id))
+            elif any(v["kind"] == kind for h in hosts for v in h.slots.values()):
+                for h in hosts:
+                    for slot in (s for s, v in h.slots.items() if v["kind"] == kind):
+                        eval_plan("brick", f"{slot}={b.id}", kind, pair(h.kind, f"{h.id}({slot}={b.id})"),
+                                  pair(h.kind, f"{h.id}({slot}={sub.id})"))
+            elif kind == "light":
+                perm_plan("brick", b.id, kind, replace(base, lights=(LightKey(b.id, base.lights[0].shadow),)))
+            elif kind == "shadow":
+                perm_plan("brick", b.id, kind, replace(base, lights=(LightKey(base.lights[0].light, b.id),)))
+            elif kind == "packing":
+                brdf = _consumer(lib, b, pair)
+                if brdf is None:
+                    wanted = ", ".join(f.name[len("get_"):] for f in b.entries)
+                    plans.append(_Plan("brick", b.id, kind, batch.fail(b.id, f"no BRDF brick reads {wanted}"),
+                                       batch.perm(base)))
+                    continue
+                perm_plan("brick", b.id, kind, replace(base, brdf=brdf, packing=_with_standin_slots(b, lib)),
+                          baseline=replace(base, brdf=brdf))
+            elif kind == "normal":
+                perm_plan("brick", b.id, kind, replace(base, packing=f"{standin(lib, 'packing').id}(normal={b.id})"))
+            elif kind == "output":
+                perm_plan("brick", b.id, kind, replace(base, output=b.id))
+
+    models, variant_packing = course_models()
+    for m in models:
+        if not m.spec or not all(lib.find(r, KINDS) for r in m.requires):
+            continue  # no brick for this model yet: the report shows the course's figures alone
+        try:
+            kinds = [n.brick.kind for n in parse_brdf(m.spec, lib)]
+        except (SpecError, SourceError):
+            continue
+        stand = "+".join(standin(lib, k).id for k in kinds)
+        eval_plan("model", m.name, "brdf", m.spec, stand, m.invariant)
+        packing = lib.find(variant_packing, ("packing",))
+        if packing:
+            perm_plan("model", m.name, "brdf",
+                      replace(base, brdf=m.spec, packing=_with_standin_slots(packing[0], lib)), m.variant,
+                      baseline=replace(base, brdf=stand))
+
+    batch.run()
+    rows = []
+    for p in plans:
+        for lang in languages:
+            with_, without = batch.cost(p.with_unit, lang), batch.cost(p.without_unit, lang)
+            stage = "comp" if p.with_unit.startswith("eval:") else "frag"
+            row = Row(p.table, p.subject, p.kind, lang, stage, batch.canonical(p.with_unit),
+                      batch.canonical(p.without_unit), course=p.course)
+            if isinstance(with_, str) or isinstance(without, str):
+                row.error = with_ if isinstance(with_, str) else f"baseline: {without}"
+            else:
+                row.cost = with_ - without
+            rows.append(row)
+    return rows
+
+
+# ------------------------------------------------------------------ per permutation
+
+def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES) -> list[Row]:
+    """Fragment and vertex shader cost of every permutation of a scene, per language."""
+    composed, errors, results = compile_scene(scene, lib, languages)
+    rows = []
+    for h, perm in sorted(scene.permutations.items()):
+        course = course_figure(perm, lib)
+        for stage in ("frag", "vert"):
+            for lang in languages:
+                row = Row("permutation", h, stage, lang, stage, perm.canonical(), course=course,
+                          objects=tuple(scene.users.get(h, [])), lights=len(perm.lights))
+                if h in errors:
+                    row.error = "; ".join(errors[h])
+                else:
+                    r = results[job_key(h, stage, lang)]
+                    if r.ok:
+                        row.cost = entry_cost(r.spirv)
+                    else:
+                        row.error = "; ".join(str(d) for d in r.diagnostics if d.severity == "error")
+                rows.append(row)
+    return rows
+
+
+def load_cost_library(extra_dirs=()) -> Library:
+    """The bricks, an engine's extra brick directories, and the cost stand-ins.
+
+    Stand-ins of slot kinds (ndf, fresnel, visibility) are generated from the
+    kind's slot signature, so they follow it when it changes; the others are
+    files in generator/cost_bricks.
+    """
+    lib = load_library([*extra_dirs, COST_BRICKS])
+    with tempfile.TemporaryDirectory(prefix="shadermatrix-standins-") as tmp:
+        for kind, k in KINDS.items():
+            if k.interface is None or standin(lib, kind) is not None:
+                continue
+            path = Path(tmp) / f"standin_{kind}.py"
+            path.write_text(_slot_standin(kind), encoding="utf-8")
+            b = load_brick(path)
+            b.display_path = f"<stand-in {kind}>"  # the temporary file is gone after loading
+            lib.bricks[(kind, b.id)] = b
+    return lib
+
+
+def _slot_standin(kind: str) -> str:
+    """Brick text of a slot kind's stand-in: it returns one of its inputs unchanged, so nothing folds."""
+    k = KINDS[kind]
+    params = ", ".join(f"{n}: {t}" for n, t in k.interface)
+    same = [n for n, t in k.interface if t == k.ret]
+    value = same[-1] if same else f"{k.ret}({k.interface[-1][0]})"
+    return (f'"""Cost stand-in {kind}: returns {value} (not a model; the baseline of `costs --bricks`)."""\n'
+            f'BRICK = {{"kind": "{kind}", "cite": "{STANDIN_CITE}"}}\n\n\n'
+            f"def {k.entries[0]}({params}) -> {k.ret}:\n    return {value}\n")

@@ -1,0 +1,280 @@
+"""Cost tables as Markdown, CSV or JSON, and why the three languages differ.
+
+Markdown is for people: one row per subject, a cell holds one number when
+HLSL, GLSL and WGSL agree and ``HLSL / GLSL / WGSL`` when they do not, laid
+out like Hoffman & Baker 2006's "BRDF Costs" tables (texture, ALU) with
+transcendental, branch and register columns, and the course's figure beside
+ours where the model is in its table. CSV and JSON are for machines: one row
+per subject and language. Output is deterministic (no timestamps, no paths).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections import Counter
+
+from . import __version__
+from .cost import COUNT_FIELDS
+from .costs import REPORT_LANGUAGES, CourseModel, Row
+from .toolchain import tool_versions
+
+# Markdown columns: (header, Cost field or derived name).
+MD_COLUMNS = [("tex", "texture"), ("ALU", "alu"), ("transc.", "transcendental"), ("ALU+T", "alu_t"),
+              ("branches", "branches"), ("regs", "registers"), ("instr.", "instructions"),
+              ("loads", "loads"), ("ALU ops", "alu_scalar")]
+DIFF_FIELDS = ("texture", "alu", "transcendental", "branches", "registers", "instructions", "loads", "stores",
+               "alu_scalar", "transcendental_scalar")
+CSV_FIELDS = ["table", "subject", "kind", "stage", "language", *COUNT_FIELDS, "course_model", "course_table",
+              "course_texture", "course_alu", "lights", "objects", "measured", "baseline", "error"]
+
+# Why the languages differ: (key, applies(language, stage, opcode delta vs the reference language,
+# {count: {language: value}} of the counts that differ), explanation).
+# Found by reading the disassembly (spirv-dis) of the example scene and the eval kernels.
+EXPLANATIONS = [
+    ("separate-samplers",
+     lambda lang, stage, d, m: bool(d.get("OpSampledImage")),
+     "GLSL samples a combined `sampler2D`; HLSL (`Texture2D` + `SamplerState`) and WGSL (`texture_2d` + "
+     "`sampler`) load the image and the sampler handles separately and join them with OpSampledImage before "
+     "each sample. Descriptor handling, not arithmetic: it shows in instr., never in ALU or tex."),
+    ("hlsl-row-major-mul",
+     lambda lang, stage, d, m: lang == "hlsl" and bool(d.get("OpVectorTimesMatrix")),
+     "glslang's HLSL front end keeps HLSL's row-major view of matrices: `mul(M, v)` becomes "
+     "OpVectorTimesMatrix(v, M) (with an OpTranspose where the emitter built the matrix from columns as "
+     "`transpose(float4x4(...))`). The scalar multiplies and adds are the same; the transpose is a register "
+     "renaming, counted with the moves."),
+    ("naga-y-flip",
+     lambda lang, stage, d, m: lang == "wgsl" and stage == "vert" and bool(d.get("OpFNegate")),
+     "naga's SPIR-V back end negates `gl_Position.y` at the end of every vertex shader (its "
+     "`ADJUST_COORDINATE_SPACE` writer flag, on by default in naga-cli), mapping WebGPU's y-up clip space to "
+     "Vulkan's y-down one: one more ALU, load and store."),
+    ("naga-column-loads",
+     lambda lang, stage, d, m: lang == "wgsl" and stage == "vert" and d.get("OpLoad", 0) > 0,
+     "The WGSL vertex template builds the normal matrix from `frame.model[0].xyz`, `[1].xyz`, `[2].xyz`; naga "
+     "reads each column with its own access chain and load, where glslang loads the mat4 once and extracts "
+     "the columns. More loads, the same arithmetic."),
+    ("glsl-input-component-load",
+     lambda lang, stage, d, m: lang != "glsl" and d.get("OpLoad", 0) < 0 and d.get("OpAccessChain", 0) < 0,
+     "glslang reads a component of a GLSL input (`v_tangent.w`) with its own access chain and load next to "
+     "the load of the whole vector (`v_tangent.xyz`), and `spirv-opt -O` does not merge the two; HLSL and "
+     "WGSL entry points receive the input as a value, load it once and extract the component. One load "
+     "more in GLSL, the same arithmetic."),
+    ("late-output-stores",
+     lambda lang, stage, d, m: lang != "glsl" and stage == "vert" and "registers" in m,
+     "HLSL and WGSL vertex entry points return an output struct; glslang's HLSL wrapper and naga store its "
+     "members only at the end, so every output stays live until the last instruction, where GLSL stores "
+     "each output as soon as it is computed. The register estimate differs, the arithmetic does not."),
+    ("glsl-ternary-branch",
+     lambda lang, stage, d, m: lang != "glsl" and d.get("OpSelect", 0) > 0 and d.get("OpBranchConditional", 0) < 0,
+     "GLSL's `c ? a : b` evaluates only the chosen operand, so glslang compiles a ternary whose operand is a "
+     "computation (e.g. `dot(NxH, NxH)` in the glue's NxH2) to a conditional branch and an OpPhi, which "
+     "`spirv-opt -O` keeps (its if-conversion does not hoist the operand). HLSL's ternary (through glslang's "
+     "HLSL front end) and WGSL's `select()` evaluate both operands and pick one with OpSelect: one ALU "
+     "instead of a branch, and the operand computed always."),
+    ("naga-vector-construct",
+     lambda lang, stage, d, m: lang == "wgsl" and d.get("OpCompositeExtract", 0) < 0,
+     "naga builds a vector from a smaller vector and scalars in one OpCompositeConstruct (`vec4(v, 1.0)`); "
+     "glslang first extracts every component. Moves only: instr. and other differ, ALU does not."),
+]
+SAME_INSTRUCTIONS = (
+    "same-instructions",
+    "The instruction counts agree in every language; only their order differs (each front end schedules its "
+    "own way), which moves the peak of the register estimate. In a per-brick row, the with/without shaders "
+    "may also differ alike in every language, which cancels in the counts but not in the peak.")
+NO_EXPLANATION = ("unexplained", "No explanation recorded yet: compare `spirv-dis` of the shaders.")
+
+
+def _value(row: Row, name: str):
+    if row.cost is None:
+        return None
+    if name == "alu_t":
+        return row.cost.alu + row.cost.transcendental
+    return getattr(row.cost, name)
+
+
+def group(rows: list[Row]) -> dict[tuple, dict[str, Row]]:
+    """Rows by (table, subject, stage, measured) -> {language: row}, in first-seen order."""
+    out: dict[tuple, dict[str, Row]] = {}
+    for r in rows:
+        out.setdefault((r.table, r.subject, r.stage, r.measured), {})[r.language] = r
+    return out
+
+
+def _cell(by_lang: dict[str, Row], name: str) -> str:
+    vals = [_value(by_lang[lang], name) if lang in by_lang else None for lang in REPORT_LANGUAGES
+            if lang in by_lang]
+    shown = ["–" if v is None else str(v) for v in vals]
+    return shown[0] if len(set(shown)) == 1 else " / ".join(shown)
+
+
+def differences(rows: list[Row]) -> list[dict]:
+    """Subjects whose counts differ between languages: which counts, which opcodes, and why."""
+    out = []
+    for (table, subject, stage, _), by_lang in group(rows).items():
+        have = {lang: r for lang, r in by_lang.items() if r.cost is not None}
+        if len(have) < 2:
+            continue
+        metrics = {f: {lang: getattr(r.cost, f) for lang, r in have.items()} for f in DIFF_FIELDS}
+        metrics = {f: v for f, v in metrics.items() if len(set(v.values())) > 1}
+        if not metrics:
+            continue
+        ref = "glsl" if "glsl" in have else sorted(have)[0]
+        opcodes, why = {}, []
+        for lang in (x for x in REPORT_LANGUAGES if x in have and x != ref):
+            delta = Counter(have[lang].cost.opcodes)
+            delta.subtract(have[ref].cost.opcodes)
+            d = {k: v for k, v in sorted(delta.items()) if v}
+            if d:
+                opcodes[lang] = d
+            why += [key for key, applies, _ in EXPLANATIONS if applies(lang, stage, d, metrics) and key not in why]
+        if not why and not opcodes:
+            why = [SAME_INSTRUCTIONS[0]]
+        out.append({"table": table, "subject": subject, "stage": stage, "reference": ref, "metrics": metrics,
+                    "opcodes": opcodes, "why": why or [NO_EXPLANATION[0]]})
+    return out
+
+
+def _explanation_texts() -> dict[str, str]:
+    return {key: text for key, _, text in EXPLANATIONS} | dict([SAME_INSTRUCTIONS, NO_EXPLANATION])
+
+
+def _course_cell(r: Row, per_light: bool) -> str:
+    if r.course is None:
+        return ""
+    text = f"{r.course.texture} / {r.course.alu}"
+    if per_light:
+        return f"{text} per light ×{r.lights} ({r.course.model}, {r.course.table})"
+    return text
+
+
+def _md_table(header: list[str], lines: list[list[str]]) -> list[str]:
+    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    out += ["| " + " | ".join(cells) + " |" for cells in lines]
+    return out
+
+
+def _metric_cells(by_lang: dict[str, Row]) -> list[str]:
+    first = next(iter(by_lang.values()))
+    if first.error:
+        return ["error"] + [""] * (len(MD_COLUMNS) - 1)
+    return [_cell(by_lang, name) for _, name in MD_COLUMNS]
+
+
+LEGEND = [
+    "Static counts from the optimized SPIR-V (`spirv-opt -O`) of each entry point. A cell holds one number "
+    "when HLSL, GLSL and WGSL agree, otherwise HLSL / GLSL / WGSL. tex, ALU, transc. (transcendental) and "
+    "instr. count instructions (a vec3 operation is one); ALU ops is the scalarized ALU count (a vec3 add is "
+    "3, a dot of vec3 5); regs is an estimate of the peak number of live 32-bit scalars. Rules: "
+    "`generator/cost/classify.py`, `generator/cost/liveness.py`.",
+    "",
+    "Course: Hoffman & Baker 2006, \"BRDF Costs\" tables, texture / ALU for one point light in hand-counted "
+    "pixel-shader instructions, where every arithmetic instruction (transcendentals too) is ALU: compare it "
+    "with our ALU+T.",
+]
+
+
+def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = None) -> str:
+    """The report as Markdown (per-permutation rows, or per-brick and model rows)."""
+    out = [f"# {title}", "", *LEGEND, ""]
+    groups = group(rows)
+    head = [h for h, _ in MD_COLUMNS]
+    perm = [(k, v) for k, v in groups.items() if k[0] == "permutation"]
+    if perm:
+        out += ["## Per permutation", ""]
+        lines = []
+        for (_, subject, stage, _), by_lang in perm:
+            r = next(iter(by_lang.values()))
+            lines.append([f"`{subject}`", ", ".join(r.objects), stage, *_metric_cells(by_lang),
+                          _course_cell(r, per_light=True) if stage == "frag" else ""])
+        out += _md_table(["permutation", "objects", "stage", *head, "course tex / ALU"], lines)
+        out += ["", "Permutation keys:", ""]
+        seen = []
+        for (_, subject, _, measured), _ in perm:
+            if subject not in seen:
+                seen.append(subject)
+                out.append(f"- `{subject}` `{measured}`")
+        out.append("")
+    bricks = [(k, v) for k, v in groups.items() if k[0] == "brick"]
+    if bricks:
+        out += ["## Per brick", "",
+                "What a brick adds: the shader with the brick minus the same shader with a trivial stand-in "
+                "of its kind (`generator/costs.py` says which shader for each kind: eval kernels for BRDF "
+                "terms and slot fillers, a one-light fragment shader for the others). Negative values: the "
+                "brick lets the optimizer remove more than it adds.", ""]
+        lines = [[next(iter(v.values())).kind, f"`{k[1]}`", *_metric_cells(v)] for k, v in bricks]
+        out += _md_table(["kind", "brick", *head], lines) + [""]
+    model_rows = [(k, v) for k, v in groups.items() if k[0] == "model"]
+    if models is not None:
+        out += ["## The course's models", "",
+                "Whole BRDFs (`course_costs.toml`): shift-invariant = eval kernel of the spec minus the stand-in "
+                "BRDF; shift-variant = one-light fragment shader with the textured packing minus stand-ins.", ""]
+        lines = []
+        for m in models:
+            for fig in (m.invariant, m.variant):
+                match = [v for k, v in model_rows if k[1] == m.name and
+                         next(iter(v.values())).course == fig]
+                ours = _metric_cells(match[0]) if match else ["no brick yet"] + [""] * (len(MD_COLUMNS) - 1)
+                lines.append([m.name, m.form, fig.table, f"`{m.spec}`" if m.spec and match else "",
+                              str(fig.texture), fig.alu, *ours])
+        out += _md_table(["model", "form", "table", "measured", "course tex", "course ALU", *head], lines) + [""]
+    diffs = differences(rows)
+    if diffs:
+        out += ["## Where the languages differ", ""]
+        texts = _explanation_texts()
+        used: list[str] = []
+        for d in diffs:
+            metrics = "; ".join(f"{f} {' / '.join(str(v.get(lang, '–')) for lang in REPORT_LANGUAGES)}"
+                                for f, v in d["metrics"].items())
+            ops = "; ".join(f"{lang} vs {d['reference']}: " + ", ".join(f"{k} {v:+d}" for k, v in o.items())
+                            for lang, o in d["opcodes"].items())
+            ops = f" {ops}." if ops else ""
+            out.append(f"- `{d['subject']}` {d['stage']} — {metrics} (HLSL / GLSL / WGSL).{ops} "
+                       f"Why: {', '.join(d['why'])}.")
+            used += [w for w in d["why"] if w not in used]
+        out += [""] + [f"- **{key}**: {texts[key]}" for key in used] + [""]
+    errors = [r for r in rows if r.error]
+    if errors:
+        out += ["## Errors", ""] + [f"- `{r.subject}` {r.language}: {r.error}" for r in errors] + [""]
+    return "\n".join(out)
+
+
+def _flat(r: Row) -> dict:
+    d = {"table": r.table, "subject": r.subject, "kind": r.kind, "stage": r.stage, "language": r.language}
+    d.update({f: getattr(r.cost, f) if r.cost else None for f in COUNT_FIELDS})
+    c = r.course
+    d.update({"course_model": c.model if c else None, "course_table": c.table if c else None,
+              "course_texture": c.texture if c else None, "course_alu": c.alu if c else None,
+              "lights": r.lights or None, "objects": list(r.objects) or None,
+              "measured": r.measured, "baseline": r.baseline or None, "error": r.error or None})
+    return d
+
+
+def to_csv(rows: list[Row]) -> str:
+    """One line per subject and language."""
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=CSV_FIELDS, lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        d = _flat(r)
+        d["objects"] = " ".join(d["objects"] or [])
+        w.writerow({k: ("" if v is None else v) for k, v in d.items()})
+    return buf.getvalue()
+
+
+def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = None) -> str:
+    """Rows (with opcode histograms), the language differences and their explanations."""
+    out_rows = []
+    for r in rows:
+        d = _flat(r)
+        if r.cost is not None:
+            d["opcodes"] = r.cost.as_dict()["opcodes"]
+            d["loads_by_storage"] = r.cost.as_dict()["loads_by_storage"]
+        out_rows.append(d)
+    doc = {"generator": f"shadermatrix {__version__}", "tools": tool_versions(), "subject": subject,
+           "languages": list(REPORT_LANGUAGES), "rows": out_rows, "differences": differences(rows),
+           "explanations": _explanation_texts()}
+    if models is not None:
+        doc["course"] = [{"model": m.name, "form": m.form, "spec": m.spec or None, "requires": list(m.requires),
+                          "tables": {f.table: {"texture": f.texture, "alu": f.alu} for f in (m.invariant, m.variant)}}
+                         for m in models]
+    return json.dumps(doc, indent=2) + "\n"
