@@ -330,23 +330,39 @@ def _fmt(x: float) -> str:
 
 
 def markdown(report: dict) -> str:
-    """The report as Markdown: one table per sample set."""
+    """The report as Markdown: NaN/Inf per run, then one table per sample set, then the stress set by parameter."""
+    res = report["results"]
     lines = ["# Accuracy against the float64 references", "",
-             f"Relative error: |f - f_ref| / max(|f_ref|, {report['rel_floor']:g} sr⁻¹), per RGB component. "
-             "NaN/Inf: non-finite outputs (all samples). Left out of the errors: Dirac (RGB values in "
-             "batches whose reference is a Dirac peak, alpha = 0) and ill-cond. (values whose reference "
-             f"moves by more than {ILL_CONDITIONED:g} when the inputs are rounded to the dtype).", ""]
+             f"Relative error: |f - f_ref| / max(|f_ref|, {report['rel_floor']:g} sr⁻¹), per RGB component; "
+             "the reference is evaluated at the inputs as rounded to the dtype. NaN/Inf: non-finite "
+             "outputs (every sample). Left out of the errors: Dirac (RGB values in batches whose reference "
+             "is a Dirac peak, alpha = 0) and ill-cond. (values whose reference moves by more than "
+             f"{ILL_CONDITIONED:g} when the inputs are rounded to the dtype).", ""]
+    lines += [f"Note: {n}" for n in report.get("notes", [])]
+    lines += ["## NaN / Inf per run (every spec, both sample sets)", "", "| run | NaN | Inf |", "|---|---|---|"]
+    for run_ in report["runs"]:
+        rows = [r for r in res if f"{r['target']}/{r['dtype']}" == run_]
+        lines.append(f"| {run_} | {sum(r['nan'] for r in rows)} | {sum(r['inf'] for r in rows)} |")
+    lines.append("")
     for set_name in ("hemisphere", "stress"):
-        rows = [r for r in report["results"] if r["set"] == set_name]
         lines += [f"## {set_name}", "",
                   "| spec | target | dtype | max abs | mean abs | max rel | mean rel | NaN | Inf | Dirac | ill-cond. | worst case |",
                   "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-        for r in rows:
+        for r in (r for r in res if r["set"] == set_name):
             w = r["worst"]
-            where = f"{w['case']} {w['params']}" if w else ""
+            where = f"{w['case']} {w['params'] or ''}".strip() if w and set_name == "stress" else ""
             lines.append(f"| `{r['spec']}` | {r['target']} | {r['dtype']} | {_fmt(r['max_abs'])} | "
                          f"{_fmt(r['mean_abs'])} | {_fmt(r['max_rel'])} | {_fmt(r['mean_rel'])} | "
                          f"{r['nan']} | {r['inf']} | {r['dirac']} | {r['ill_conditioned']} | {where} |")
+        lines.append("")
+    stress32 = [r for r in res if r["set"] == "stress" and r["dtype"] == "float32"]
+    if stress32:
+        first = stress32[0]["target"]
+        lines += [f"## stress, {first}/float32: max relative error by parameter value", "",
+                  "| spec | max rel per parameter value |", "|---|---|"]
+        for r in (r for r in stress32 if r["target"] == first):
+            cells = ", ".join(f"{k}: {_fmt(v)}" for k, v in r["by_param"].items())
+            lines.append(f"| `{r['spec']}` | {cells} |")
         lines.append("")
     verdict = "no NaN or Inf in float32" if report["float32_finite"] else "**NaN or Inf in float32**"
     lines.append(f"Result: {verdict}.")

@@ -1,0 +1,101 @@
+"""`shadermatrix accuracy`: error of every target and dtype against the float64 references.
+
+    shadermatrix accuracy [SPEC ...] [--targets numpy,glsl,hlsl,wgsl] [--dtypes float64,float32,float16]
+                          [--format md|json] [--out FILE] [--samples K] [--fail-above TOL]
+
+Without SPECs: every BRDF brick (each diffuse term, each specular term with
+every combination of slot fillers). Without --targets: numpy, plus GLSL, HLSL
+and WGSL when a lavapipe device is present. Two sample sets per spec: a
+stratified hemisphere (K⁴ samples) and the stress set (see generator/accuracy.py).
+Exit status 1 when any float32 evaluation gives NaN or Inf (or, with
+--fail-above, a float32 hemisphere error exceeds TOL), or on bad input.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+HELP = "error of every target × dtype against the float64 references: hemisphere and stress set (Markdown/JSON)"
+TARGETS = ("numpy", "glsl", "hlsl", "wgsl")
+DTYPES = ("float64", "float32", "float16")
+
+
+def add_arguments(p) -> None:
+    p.add_argument("specs", nargs="*", metavar="SPEC", help="BRDF specs (default: every BRDF brick)")
+    p.add_argument("--targets", metavar="LIST",
+                   help=f"comma-separated, from {', '.join(TARGETS)} (default: numpy, plus the GPU "
+                        "languages when lavapipe is present)")
+    p.add_argument("--dtypes", default=",".join(DTYPES), metavar="LIST",
+                   help="comma-separated, from float64, float32, float16 (GPU targets run float32 only)")
+    p.add_argument("--format", choices=("md", "json"), default="md", help="report format (default md)")
+    p.add_argument("--out", metavar="FILE", help="write the report to FILE (atomically) instead of stdout")
+    p.add_argument("--samples", type=int, default=12, metavar="K",
+                   help="hemisphere strata per dimension: K⁴ (l, v) pairs (default 12)")
+    p.add_argument("--fail-above", type=float, metavar="TOL",
+                   help="also exit 1 when a float32 hemisphere max relative error exceeds TOL")
+    p.add_argument("--bricks", action="append", metavar="DIR", help="an extra brick directory (repeatable)")
+
+
+def _list(value: str, allowed: tuple, what: str) -> list[str]:
+    items = [v.strip() for v in value.split(",") if v.strip()]
+    bad = [v for v in items if v not in allowed]
+    if bad or not items:
+        raise ValueError(f"unknown {what} {', '.join(map(repr, bad)) or '(none given)'} — "
+                         f"use a comma-separated list from {', '.join(allowed)}")
+    return items
+
+
+def run(args) -> int:
+    from .. import accuracy
+    from ..bricks import load_library
+    from ..cache import atomic_write
+    from ..evaluate import EvalError
+    from ..permutation import SpecError
+    from ..reference import ReferenceMissing
+    from ..runtime.device import VulkanUnavailable
+
+    try:
+        if args.samples < 1:
+            raise ValueError(f"--samples {args.samples} — give a positive number of strata (e.g. 12)")
+        dtypes = _list(args.dtypes, DTYPES, "dtype")
+        notes = []
+        if args.targets:
+            targets = _list(args.targets, TARGETS, "target")
+        else:
+            targets = accuracy.default_targets()
+            if targets == ["numpy"]:
+                notes.append("GPU targets skipped: no lavapipe Vulkan device (see `shadermatrix doctor`)")
+        lib = load_library(args.bricks or ())
+        specs = args.specs or accuracy.default_specs(lib)
+        if not accuracy.runs(targets, dtypes):
+            raise ValueError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
+                             "GPU targets run float32 only; add float32 or the numpy target")
+        report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples)
+    except (ValueError, EvalError, SpecError, ReferenceMissing, VulkanUnavailable) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    report["notes"] = notes
+    text = accuracy.markdown(report) if args.format == "md" else json.dumps(report, indent=1) + "\n"
+    if args.out:
+        atomic_write(Path(args.out), text.encode())
+    else:
+        sys.stdout.write(text)
+
+    f32 = [r for r in report["results"] if r["dtype"] == "float32"]
+    bad = [r for r in f32 if r["nan"] or r["inf"]]
+    worst = max((r for r in f32 if r["set"] == "hemisphere"), key=lambda r: r["max_rel"], default=None)
+    for r in bad:
+        print(f"error: {r['spec']} {r['target']}/float32 ({r['set']}): {r['nan']} NaN, {r['inf']} Inf",
+              file=sys.stderr)
+    too_big = args.fail_above is not None and worst is not None and worst["max_rel"] > args.fail_above
+    if too_big:
+        print(f"error: {worst['spec']} {worst['target']}/float32: hemisphere max relative error "
+              f"{worst['max_rel']:.3g} exceeds --fail-above {args.fail_above:g}", file=sys.stderr)
+    for n in notes:
+        print(f"note: {n}", file=sys.stderr)
+    print(f"{len(specs)} specs × {', '.join(report['runs'])}: "
+          f"{'no' if not bad else len(bad)} float32 NaN/Inf"
+          + (f"; worst float32 hemisphere error {worst['max_rel']:.2e} ({worst['spec']}, {worst['target']})"
+             if worst else "") + (f" → {args.out}" if args.out else ""), file=sys.stderr)
+    return 1 if bad or too_big else 0
