@@ -12,7 +12,7 @@ Geometry (geometry.py)
   shading_geometry(L, V, N, T=None) -> Geometry (NdotL, NdotV, NdotH, sin2_h, VdotH, ...), NV_MIN.
 Exact quantities (exact.py); cosines in [0, 1], alpha = GGX α or Beckmann m
   NDFs:     d_ggx(cos_h, sin2_h, alpha), d_beckmann(...), d_blinn_phong(...),
-            blinn_phong_exponent(alpha), cos_power(sin2, n)
+            blinn_phong_exponent(alpha), cos_power(cos, sin2, n)
   Fresnel:  fresnel_schlick(f0, cos_d), fresnel_dielectric(cos_d, eta), f0_to_eta(f0),
             fresnel_dielectric_f0(f0, cos_d), fresnel_conductor(cos_d, eta, k)
   Smith:    lambda_ggx(cos, alpha), lambda_beckmann(cos, alpha) (erfc form),
