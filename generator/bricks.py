@@ -138,6 +138,17 @@ def load_library(extra_dirs=(), strict: bool = True) -> Library:
     return lib
 
 
+_BUILTIN: Library | None = None
+
+
+def builtin_library() -> Library:
+    """The built-in bricks, parsed once per process (for callers that were given no library)."""
+    global _BUILTIN
+    if _BUILTIN is None:
+        _BUILTIN = load_library()
+    return _BUILTIN
+
+
 def _meta_error(shown: str, loc: ir.Loc, message: str, hint: str) -> SourceError:
     return SourceError(shown, loc.line, loc.col, message, hint)
 

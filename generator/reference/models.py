@@ -144,17 +144,9 @@ def vis_smith_schlick(g: Geometry, alpha):
 
 # ------------------------------------------------------------------ whole BRDFs
 
-_LIB = None
-
-
 def _library(lib):
-    global _LIB
-    if lib is not None:
-        return lib
-    if _LIB is None:
-        from ..bricks import load_library
-        _LIB = load_library()
-    return _LIB
+    from ..bricks import builtin_library
+    return lib if lib is not None else builtin_library()
 
 
 def brdf_parameters(nodes) -> dict:
