@@ -10,10 +10,12 @@ Two sample sets per BRDF spec:
   0 … 1, exponents 1 … 1e5, f0 = 0 and 1, sigma 0 … 1.2 rad), in the canonical
   frame (exact zeros) and in the rotated frame.
 
-Errors are per RGB component against the reference: absolute, and relative
-|f - f_ref| / max(|f_ref|, REL_FLOOR). NaN and Inf outputs are counted, not
-averaged; samples where the reference itself is not finite (a Dirac lobe at
-alpha = 0, exactly at h = n) are counted and left out.
+Errors are per RGB component against the reference evaluated at the inputs as
+rounded to the target's dtype (the target's arithmetic, not its input rounding):
+absolute, and relative |f - f_ref| / max(|f_ref|, REL_FLOOR). NaN and Inf outputs
+are counted on every sample, never averaged. Left out of the errors and counted
+apart (see Errors): batches whose reference is a Dirac peak (alpha = 0), and
+samples that the dtype's input rounding alone moves by more than ILL_CONDITIONED.
 """
 from __future__ import annotations
 
