@@ -43,11 +43,6 @@ EXPLANATIONS = [
      "OpVectorTimesMatrix(v, M) (with an OpTranspose where the emitter built the matrix from columns as "
      "`transpose(float4x4(...))`). The scalar multiplies and adds are the same; the transpose is a register "
      "renaming, counted with the moves."),
-    ("naga-y-flip",
-     lambda lang, stage, d, m: lang == "wgsl" and stage == "vert" and bool(d.get("OpFNegate")),
-     "naga's SPIR-V back end negates `gl_Position.y` at the end of every vertex shader (its "
-     "`ADJUST_COORDINATE_SPACE` writer flag, on by default in naga-cli), mapping WebGPU's y-up clip space to "
-     "Vulkan's y-down one: one more ALU, load and store."),
     ("naga-column-loads",
      lambda lang, stage, d, m: lang == "wgsl" and stage == "vert" and d.get("OpLoad", 0) > 0,
      "The WGSL vertex template builds the normal matrix from `frame.model[0].xyz`, `[1].xyz`, `[2].xyz`; naga "
@@ -64,13 +59,6 @@ EXPLANATIONS = [
      "HLSL and WGSL vertex entry points return an output struct; glslang's HLSL wrapper and naga store its "
      "members only at the end, so every output stays live until the last instruction, where GLSL stores "
      "each output as soon as it is computed. The register estimate differs, the arithmetic does not."),
-    ("glsl-ternary-branch",
-     lambda lang, stage, d, m: lang != "glsl" and d.get("OpSelect", 0) > 0 and d.get("OpBranchConditional", 0) < 0,
-     "GLSL's `c ? a : b` evaluates only the chosen operand, so glslang compiles a ternary whose operand is a "
-     "computation (e.g. `dot(NxH, NxH)` in the glue's NxH2) to a conditional branch and an OpPhi, which "
-     "`spirv-opt -O` keeps (its if-conversion does not hoist the operand). HLSL's ternary (through glslang's "
-     "HLSL front end) and WGSL's `select()` evaluate both operands and pick one with OpSelect: one ALU "
-     "instead of a branch, and the operand computed always."),
     ("naga-vector-construct",
      lambda lang, stage, d, m: lang == "wgsl" and d.get("OpCompositeExtract", 0) < 0,
      "naga builds a vector from a smaller vector and scalars in one OpCompositeConstruct (`vec4(v, 1.0)`); "

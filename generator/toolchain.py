@@ -17,7 +17,8 @@ Pipeline per job (all SPIR-V is version 1.3, validated for ``vulkan1.1``):
      sentinel's message closes the previous job's diagnostics. A job that has
      no output and no parsed error (a crash, an unknown message format) is
      recompiled alone.
-   - WGSL: ``naga --spirv-version 1.3 in.wgsl out.spv``, one process per file
+   - WGSL: ``naga --spirv-version 1.3 --keep-coordinate-space in.wgsl out.spv`` (no y flip:
+    the same matrices place vertices alike in every language), one process per file
      (naga converts one input per run); about 2 ms each.
 2. ``spirv-val --target-env vulkan1.1`` on the front end's output;
 3. with ``optimize``: ``spirv-opt --target-env=vulkan1.1 -O`` and
@@ -320,7 +321,7 @@ def _naga_one(naga: str, tmp: str, idx: int, job: CompileJob) -> _Front:
     src, out = f"j{idx:06d}.wgsl", f"j{idx:06d}.spv"
     Path(tmp, src).write_text(job.source, encoding="utf-8")
     env = dict(os.environ, NO_COLOR="1", RUST_LOG="off")
-    rc, text = _run([naga, "--spirv-version", SPIRV_VERSION, "--entry-point", job.entry, src, out],
+    rc, text = _run([naga, "--spirv-version", SPIRV_VERSION, "--keep-coordinate-space", "--entry-point", job.entry, src, out],
                     cwd=tmp, env=env)
     out_path = Path(tmp, out)
     spv = out_path.read_bytes() if rc == 0 and out_path.is_file() else None

@@ -307,8 +307,8 @@ def test_spellings_per_target():
         (intr("fract", x), ("fract(x)", "frac(x)", "fract(x)")),
         (intr("saturate", v, ty=VEC3), ("clamp(v, 0.0, 1.0)", "saturate(v)", "saturate(v)")),
         (intr("atan2", y, x), ("atan(y, x)", "atan2(y, x)", "atan2(y, x)")),
-        (intr("select", c, x, y), ("(c ? x : y)", "(c ? x : y)", "select(y, x, c)")),
-        (ir.Select(FLOAT, L, c, x, y), ("(c ? x : y)", "(c ? x : y)", "select(y, x, c)")),
+        (intr("select", c, x, y), ("mix(y, x, c)", "(c ? x : y)", "select(y, x, c)")),
+        (ir.Select(FLOAT, L, c, x, y), ("mix(y, x, c)", "(c ? x : y)", "select(y, x, c)")),
         (ir.Var(FLOAT, L, "PI", "const"), ("3.141592653589793",) * 2 + ("3.141592653589793f",)),
         (ir.Construct(VEC3, L, [x]), ("vec3(x)", "((float3)(x))", "vec3<f32>(x)")),
         (ir.Construct(FLOAT, L, [ir.Var(INT, L, "i", "local")]), ("float(i)", "float(i)", "f32(i)")),
@@ -376,3 +376,40 @@ def test_registry():
     assert {get_target(name).type_name(VEC3) for name in LANGS} == {"vec3", "float3", "vec3<f32>"}
     with pytest.raises(ValueError, match="unknown target 'msl'"):
         get_target("msl")
+
+
+@pytest.mark.toolchain
+def test_conditional_expressions_are_selects_not_branches_in_every_language(require_tool):
+    """`a if c else b` must cost the same everywhere: OpSelect, no branch (GLSL's ?: would branch)."""
+    from generator.bricks import load_library
+    from generator.compose import compose_eval
+    from generator.cost import entry_cost
+    from generator.toolchain import CompileJob, compile_many
+
+    for t in ("glslc", "naga", "spirv-opt", "spirv-val"):
+        require_tool(t)
+    composed = compose_eval("microfacet(ndf=ggx)", load_library())  # the glue's NxH2 is a conditional expression
+    jobs = [CompileJob(f"k.{s.language}", s.language, "comp", s.text) for s in composed.sources]
+    results = compile_many(jobs)
+    branches = {j.language: entry_cost(results[j.key].spirv).branches for j in jobs}
+    selects = {j.language: entry_cost(results[j.key].spirv).opcodes.get("OpSelect", 0) for j in jobs}
+    assert len(set(branches.values())) == 1, branches
+    assert all(n >= 1 for n in selects.values()), selects
+
+
+@pytest.mark.toolchain
+def test_wgsl_vertex_keeps_the_vulkan_coordinate_space(require_tool):
+    """naga flips gl_Position.y unless told not to; all languages must place vertices alike."""
+    from generator.bricks import load_library
+    from generator.compose import compose_permutation
+    from generator.cost import entry_cost
+    from generator.permutation import LightKey, Permutation
+    from generator.toolchain import CompileJob, compile_many
+
+    for t in ("glslc", "naga", "spirv-opt", "spirv-val"):
+        require_tool(t)
+    perm = Permutation("lambert", (LightKey("point", "none"),), "constants(normal=vertex)")
+    sources = [s for s in compose_permutation(perm, load_library()).sources if s.stage == "vert"]
+    results = compile_many([CompileJob(f"v.{s.language}", s.language, "vert", s.text) for s in sources])
+    negates = {s.language: entry_cost(results[f"v.{s.language}"].spirv).opcodes.get("OpFNegate", 0) for s in sources}
+    assert negates == {"glsl": 0, "hlsl": 0, "wgsl": 0}

@@ -1,6 +1,8 @@
 """GLSL 4.50 for Vulkan (glslang): column-major matrices and combined image samplers, as in the IR."""
 from __future__ import annotations
 
+from ..lang import ir
+from ..lang.types import Type
 from .clike import CLikeTarget
 
 
@@ -17,7 +19,6 @@ class GlslTarget(CLikeTarget):
         "rsqrt": "inversesqrt({0})",
         "saturate": "clamp({0}, 0.0, 1.0)",  # GLSL clamp takes float bounds for any genFType
         "atan2": "atan({0}, {1})",
-        "select": "({0} ? {1} : {2})",
         "sample": "texture({0}, {1})",
         "sample_level": "textureLod({0}, {1}, {2})",
     }
@@ -29,3 +30,18 @@ class GlslTarget(CLikeTarget):
     def declare_texture(self, name: str, set: int, binding: int) -> str:
         """One combined sampler2D at binding B; B+1 stays free so all targets number alike."""
         return f"layout(set = {int(set)}, binding = {int(binding)}) uniform sampler2D {self.ident(name)};"
+
+    def expr_select(self, e: ir.Select) -> str:
+        return self.typed_select(e.ty, self.expr(e.cond), self.expr(e.if_true), self.expr(e.if_false))
+
+    def expr_intrinsic(self, e: ir.Intrinsic) -> str:
+        if e.name == "select":
+            return self.typed_select(e.ty, *(self.expr(a) for a in e.args))
+        return super().expr_intrinsic(e)
+
+    def typed_select(self, ty: Type, cond: str, if_true: str, if_false: str) -> str:
+        """mix() with a bool selector: glslang emits OpSelect, as HLSL's ?: and WGSL's select()
+        do; a GLSL ?: with a non-trivial operand becomes a branch. Both operands are evaluated,
+        which is harmless: brick expressions are pure."""
+        sel = cond if ty.kind == "scalar" else f"bvec{ty.size}({cond})"
+        return f"mix({if_false}, {if_true}, {sel})"

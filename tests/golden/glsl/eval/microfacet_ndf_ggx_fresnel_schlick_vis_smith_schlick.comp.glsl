@@ -62,7 +62,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
     vec3 NxH = cross(N, H);
-    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
+    float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
     return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }

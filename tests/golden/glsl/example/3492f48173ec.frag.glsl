@@ -34,7 +34,7 @@ float blinn_phong_ndf(float NdotH, float NxH2, float alpha) {
     float a = max(alpha, 0.0001);
     float n = ((2.0 / (a * a)) - 2.0);
     float x = NxH2;
-    float ln_c2 = ((x < 0.01) ? ((-x) * (1.0 + (x * (0.5 + (x * ((1.0 / 3.0) + (x * 0.25))))))) : (2.0 * log(max(NdotH, 1e-30))));
+    float ln_c2 = mix((2.0 * log(max(NdotH, 1e-30))), ((-x) * (1.0 + (x * (0.5 + (x * ((1.0 / 3.0) + (x * 0.25))))))), (x < 0.01));
     return (((n + 2.0) * 0.15915494309189535) * exp(((0.5 * n) * ln_c2)));
 }
 
@@ -94,7 +94,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
     vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
     vec3 NxH = cross(N, H);
-    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
+    float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
     return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }

@@ -80,7 +80,7 @@ float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, sampler2D
     vec3 p = (c.xyz / max(c.w, 1e-06));
     vec2 uv = ((p.xy * 0.5) + vec2(0.5));
     float stored = textureLod(shadow_map, uv, 0.0).x;
-    return (((p.z - shadow_bias) <= stored) ? 1.0 : 0.0);
+    return mix(0.0, 1.0, ((p.z - shadow_bias) <= stored));
 }
 
 #line 17 "bricks/light/point.py"
@@ -116,7 +116,7 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
     vec3 NxH = cross(N, H);
-    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
+    float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
     return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }

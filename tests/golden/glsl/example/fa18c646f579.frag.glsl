@@ -63,7 +63,7 @@ float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, sampler2D
     vec3 p = (c.xyz / max(c.w, 1e-06));
     vec2 uv = ((p.xy * 0.5) + vec2(0.5));
     float stored = textureLod(shadow_map, uv, 0.0).x;
-    return (((p.z - shadow_bias) <= stored) ? 1.0 : 0.0);
+    return mix(0.0, 1.0, ((p.z - shadow_bias) <= stored));
 }
 
 #line 17 "bricks/light/point.py"
