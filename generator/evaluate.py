@@ -39,19 +39,13 @@ class EvalError(ValueError):
 
 # ------------------------------------------------------------------ caches
 
-_LIB = None
 _PROGRAMS: dict = {}  # (id(lib), spec) -> (lib, EvalProgram)
 _NUMPY: dict = {}     # (id(lib), spec, dtype) -> (lib, brdf function)
 
 
 def _library(lib):
-    global _LIB
-    if lib is not None:
-        return lib
-    if _LIB is None:
-        from .bricks import load_library
-        _LIB = load_library()
-    return _LIB
+    from .bricks import builtin_library
+    return lib if lib is not None else builtin_library()
 
 
 def program(spec: str, lib=None) -> EvalProgram:
