@@ -32,11 +32,6 @@ CSV_FIELDS = ["table", "subject", "kind", "stage", "language", *COUNT_FIELDS, "c
 # {count: {language: value}} of the counts that differ), explanation).
 # Found by reading the disassembly (spirv-dis) of the example scene and the eval kernels.
 EXPLANATIONS = [
-    ("separate-samplers",
-     lambda lang, stage, d, m: bool(d.get("OpSampledImage")),
-     "GLSL samples a combined `sampler2D`; HLSL (`Texture2D` + `SamplerState`) and WGSL (`texture_2d` + "
-     "`sampler`) load the image and the sampler handles separately and join them with OpSampledImage before "
-     "each sample. Descriptor handling, not arithmetic: it shows in instr., never in ALU or tex."),
     ("hlsl-row-major-mul",
      lambda lang, stage, d, m: lang == "hlsl" and bool(d.get("OpVectorTimesMatrix")),
      "glslang's HLSL front end keeps HLSL's row-major view of matrices: `mul(M, v)` becomes "

@@ -322,9 +322,9 @@ def test_spellings_per_target():
 def test_texture_parameters_and_samples(module):
     f = module.functions["sample_albedo"]
     texts = {lang: emit(module, lang).text for lang in LANGS}
-    assert "vec4 sample_albedo(sampler2D albedo_map, vec2 uv)" in texts["glsl"]
-    assert "texture(albedo_map, uv)" in texts["glsl"]
-    assert "textureLod(albedo_map, uv, lod)" in texts["glsl"]
+    assert "vec4 sample_albedo(texture2D albedo_map, sampler albedo_map_smp, vec2 uv)" in texts["glsl"]
+    assert "texture(sampler2D(albedo_map, albedo_map_smp), uv)" in texts["glsl"]
+    assert "textureLod(sampler2D(albedo_map, albedo_map_smp), uv, lod)" in texts["glsl"]
     assert "float4 sample_albedo(Texture2D albedo_map, SamplerState albedo_map_smp, float2 uv)" in texts["hlsl"]
     assert "albedo_map.Sample(albedo_map_smp, uv)" in texts["hlsl"]
     assert "albedo_map.SampleLevel(albedo_map_smp, uv, lod)" in texts["hlsl"]
@@ -333,8 +333,9 @@ def test_texture_parameters_and_samples(module):
     assert "textureSampleLevel(albedo_map, albedo_map_smp, uv, lod)" in texts["wgsl"]
     assert "sample_lod(albedo_map, albedo_map_smp, uv, 1.0f)" in texts["wgsl"]
     assert f.params[0].ty == TEXTURE2D
-    assert TARGETS["glsl"].declare_texture("sampler", 1, 4) == \
-        "layout(set = 1, binding = 4) uniform sampler2D sampler_r;"
+    assert TARGETS["glsl"].declare_texture("sampler", 1, 4).splitlines() == [
+        "layout(set = 1, binding = 4) uniform texture2D sampler_r;",
+        "layout(set = 1, binding = 5) uniform sampler sampler_r_smp;"]
     assert TARGETS["hlsl"].declare_texture("t", 1, 4).splitlines() == [
         "[[vk::binding(4, 1)]] Texture2D t : register(t4, space1);",
         "[[vk::binding(5, 1)]] SamplerState t_smp : register(s5, space1);"]

@@ -1,4 +1,9 @@
-"""GLSL 4.50 for Vulkan (glslang): column-major matrices and combined image samplers, as in the IR."""
+"""GLSL 4.50 for Vulkan (glslang): column-major matrices as in the IR; separate images and samplers.
+
+Textures are a `texture2D` and a `sampler` (Vulkan GLSL), joined at the call as
+`sampler2D(t, s)`, so the descriptor layout is the same as HLSL's and WGSL's:
+image at binding B, sampler at B+1.
+"""
 from __future__ import annotations
 
 from ..lang import ir
@@ -13,14 +18,14 @@ class GlslTarget(CLikeTarget):
     SCALARS = {"float": "float", "int": "int", "uint": "uint", "bool": "bool"}
     VECTORS = {"float": "vec{n}", "int": "ivec{n}", "uint": "uvec{n}", "bool": "bvec{n}"}
     MATRIX = "mat{n}"
-    TEXTURE = "sampler2D"
-    SAMPLER = ""  # combined image sampler: one parameter, one binding
+    TEXTURE = "texture2D"
+    SAMPLER = "sampler"
     INTRINSICS = {
         "rsqrt": "inversesqrt({0})",
         "saturate": "clamp({0}, 0.0, 1.0)",  # GLSL clamp takes float bounds for any genFType
         "atan2": "atan({0}, {1})",
-        "sample": "texture({0}, {1})",
-        "sample_level": "textureLod({0}, {1}, {2})",
+        "sample": "texture(sampler2D({0}, {smp}), {1})",
+        "sample_level": "textureLod(sampler2D({0}, {smp}), {1}, {2})",
     }
 
     def header(self) -> str:
@@ -28,8 +33,10 @@ class GlslTarget(CLikeTarget):
         return "#extension GL_GOOGLE_cpp_style_line_directive : require"
 
     def declare_texture(self, name: str, set: int, binding: int) -> str:
-        """One combined sampler2D at binding B; B+1 stays free so all targets number alike."""
-        return f"layout(set = {int(set)}, binding = {int(binding)}) uniform sampler2D {self.ident(name)};"
+        """texture2D NAME at binding B and sampler NAME_smp at B+1 of set S (as HLSL and WGSL)."""
+        s, b = int(set), int(binding)
+        return (f"layout(set = {s}, binding = {b}) uniform texture2D {self.ident(name)};\n"
+                f"layout(set = {s}, binding = {b + 1}) uniform sampler {self.sampler_name(name)};")
 
     def expr_select(self, e: ir.Select) -> str:
         return self.typed_select(e.ty, self.expr(e.cond), self.expr(e.if_true), self.expr(e.if_false))
