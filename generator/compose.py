@@ -15,11 +15,11 @@ from pathlib import Path
 import jinja2
 
 from . import __version__
-from .bricks import GEOMETRY, SURFACE, Brick, Library
-from .glue import Program, brdf_glue, entry_args, glue_header, mangle, surface_inputs
+from .bricks import Library
+from .glue import Program, brdf_glue, brdf_params, check_packing, glue_header, shade_glue
 from .lang import SourceError
 from .lang.types import Type
-from .permutation import Node, Permutation, parse_brdf, parse_spec
+from .permutation import Node, Permutation, parse_brdf, resolve
 from .targets import get_target
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
@@ -103,20 +103,6 @@ def _templates_used(lang: str, main: str) -> dict[str, str]:
     """The template and the macros it imports, with their hashes (for provenance and cache keys)."""
     names = [main, f"{lang}/macros.{lang}.j2"]
     return {n: _template_hash(n) for n in names}
-
-
-def brdf_params(nodes: list[Node]) -> dict[str, Type]:
-    """Material parameters of a BRDF (union over its bricks; a shared name must agree on type)."""
-    out: dict[str, Type] = {}
-    for top in nodes:
-        for n in top.walk():
-            for name, p in n.brick.params.items():
-                if name in out and out[name] != p.ty:
-                    raise SourceError(n.brick.display_path, 1, 1,
-                                      f"parameter '{name}' is {p.ty} here but {out[name]} in another brick of the BRDF",
-                                      "canonical parameter names have one type (DESIGN.md)")
-                out.setdefault(name, p.ty)
-    return out
 
 
 LINE_RESET = "//@line-reset"
@@ -223,138 +209,16 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
 
 # ------------------------------------------------------------------ permutation
 
-@dataclass
-class Resolved:
-    """A permutation's bricks, resolved from its key."""
-
-    brdf: list[Node]
-    packing: Node
-    lights: list[tuple[Brick, Node]]
-    output: Brick
-
-
-def resolve(perm: Permutation, lib: Library) -> Resolved:
-    brdf = parse_brdf(perm.brdf, lib)
-    packing = parse_spec(perm.packing, lib, ("packing",))
-    if len(packing) != 1:
-        raise SourceError("<key>", 1, 1, f"packing '{perm.packing}' names more than one brick", "name one packing")
-    lights = []
-    for lk in perm.lights:
-        lb = lib.get("light", lk.light)
-        if lb is None:
-            raise SourceError("<key>", 1, 1, f"unknown light brick '{lk.light}'",
-                              f"known: {', '.join(b.id for b in lib.of_kind('light'))}")
-        shadow = parse_spec(lk.shadow, lib, ("shadow",))
-        lights.append((lb, shadow[0]))
-    out = lib.get("output", perm.output)
-    if out is None:
-        raise SourceError("<key>", 1, 1, f"unknown output brick '{perm.output}'",
-                          f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
-    return Resolved(brdf, packing[0], lights, out)
-
-
-def check_packing(perm: Permutation, lib: Library) -> str:
-    """'' when the packing fits the BRDF, else why not (a provided input the BRDF does not read)."""
-    r = resolve(perm, lib)
-    params = brdf_params(r.brdf)
-    for f in r.packing.brick.entries:
-        name = f.name[len("get_"):]
-        if name not in params:
-            return f"packing '{r.packing.brick.id}' provides {name}, which BRDF '{perm.brdf}' does not read"
-    return ""
-
-
 def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) -> Composed:
     """Vertex and fragment shaders of one permutation in each language."""
     r = resolve(perm, lib)
-    problem = check_packing(perm, lib)
+    problem = check_packing(r)
     if problem:
         raise SourceError("<key>", 1, 1, problem, "use the constants packing for this BRDF")
     prog = Program()
-    for n in r.brdf:
-        prog.link(n)
-    params = brdf_params(r.brdf)
-    brdf_text, brdf_sig = brdf_glue(prog, r.brdf, params)
-
-    pack = r.packing
-    normal_node = dict(pack.fillers)["normal"]
-    prog.link(pack)
-    for lb, sh in r.lights:
-        prog.link(Node(lb, ()))
-        prog.link(sh)
-    prog.link(Node(r.output, ()))
-
-    material: list[tuple[str, Type]] = [(f"m_{k}", t) for k, t in params.items()]
-    for n in pack.walk():
-        material += [(f"m_{k}", p.ty) for k, p in n.brick.params.items()]
-    textures: list[dict] = []
-    shade_params: list[tuple[str, Type]] = []
-    body: list[str] = []
-
-    def add_texture(glob: str, local: str, brick: Brick, name: str, group: str):
-        textures.append({"name": glob, "srgb": bool(brick.textures[name].get("srgb")), "group": group})
-        shade_params.append((local, Type("texture", "float", 1, "texture2d")))
-
-    def bind_surface(brick: Brick, prefix: str, group: str):
-        def bind(p):
-            if p.ty.kind == "texture":
-                glob = f"{prefix}{p.name}"
-                if glob not in {t["name"] for t in textures}:
-                    add_texture(glob, glob, brick, p.name, group)
-                return glob
-            if p.name in ("P", "T", "B", "uv"):
-                return p.name
-            if p.name == "N":
-                return "Ng"
-            return f"{prefix if prefix.startswith('l') else 'm_'}{p.name}"
-        return bind
-
-    # Packing: material inputs from textures, then the shading normal.
-    provided = {}
-    for f in pack.brick.entries:
-        name = f.name[len("get_"):]
-        body.append(f"    p_{name} = {mangle(pack.brick, f.name)}({entry_args(f, bind_surface(pack.brick, 't_', 'material'))})")
-        provided[name] = f"p_{name}"
-    nf = normal_node.brick.entries[0]
-    body.append(f"    N = {mangle(normal_node.brick, nf.name)}({entry_args(nf, bind_surface(normal_node.brick, 't_', 'material'))})")
-    body.append("    Lo = vec3(0.0)")
-    brdf_args = ["L{i}", "V", "N"] + (["T", "B"] if any(n == "T" for n, _ in brdf_sig) else [])
-    brdf_args += [provided.get(k, f"m_{k}") for k in params]
-    lights_layout = []
-    for i, (lb, sh) in enumerate(r.lights):
-        values = [(f"l{i}_{k}", p.ty) for k, p in lb.params.items()]
-        for n in sh.walk():
-            values += [(f"l{i}_{k}", p.ty) for k, p in n.brick.params.items()]
-        lights_layout.append(values)
-        bind = bind_surface(lb, f"l{i}_", "light")
-        ld, lr = lb.module.functions["light_dir"], lb.module.functions["light_radiance"]
-        sf = sh.brick.entries[0]
-        body += [f"    L{i} = {mangle(lb, 'light_dir')}({entry_args(ld, bind)})",
-                 f"    NdotL{i} = dot(N, L{i})",
-                 f"    if NdotL{i} > 0.0:",
-                 f"        c{i} = {mangle(lb, 'light_radiance')}({entry_args(lr, bind)})",
-                 f"        s{i} = {mangle(sh.brick, sf.name)}({entry_args(sf, bind_surface(sh.brick, f'l{i}_', 'light'))})",
-                 f"        Lo += PI * brdf({', '.join(a.format(i=i) for a in brdf_args)}) * c{i} * (NdotL{i} * s{i})"]
-    body.append(f"    return {mangle(r.output, 'output')}(Lo)")
-
-    used_fns = list(pack.brick.entries) + [nf] + [f for lb, sh in r.lights
-                                                  for f in (lb.module.functions["light_dir"],
-                                                            lb.module.functions["light_radiance"], sh.brick.entries[0])]
-    surf = surface_inputs(used_fns)
-    if any(n == "T" for n, _ in brdf_sig):
-        surf |= {"T", "B"}
-    inputs = ["P", "N"] + [x for x in ("T", "B", "uv") if x in surf]
-    if "B" in inputs and "T" not in inputs:
-        inputs.insert(2, "T")
-    if "T" in inputs and "B" not in inputs:
-        inputs.insert(3, "B")
-
-    light_values = [v for vals in lights_layout for v in vals]
-    sig = [("P", GEOMETRY["L"]), ("Ng", GEOMETRY["N"]), ("V", GEOMETRY["V"])]
-    sig += [(x, SURFACE[x]) for x in inputs if x in ("T", "B", "uv")]
-    sig += material + light_values + shade_params
-    shade = (f"def shade({', '.join(f'{n}: {t}' for n, t in sig)}) -> vec4:\n" + "\n".join(body) + "\n")
-    prog.add_glue(glue_header("BRDF and shading glue") + brdf_text + "\n\n" + shade)
+    g = shade_glue(prog, r)
+    textures, inputs, sig = g.textures, g.inputs, g.signature
+    material, light_values = g.material, [v for vals in g.lights for v in vals]
 
     # Descriptor bindings: two per texture (image, then sampler) in every language,
     # so one descriptor layout serves all three. Set 0: frame, lights, light textures;
@@ -370,16 +234,15 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
     sources = []
-    call_args = []
+    slots = {s.name: ("material", s) for s in mat_slots} | {s.name: ("lights", s) for s in light_slots}
+    call_args = []  # how the template passes each shade() parameter
     for name, ty in sig:
         if ty.kind == "texture":
             call_args.append({"kind": "texture", "name": name})
-        elif name in ("P", "Ng", "V", "T", "B", "uv"):
-            call_args.append({"kind": "local", "name": name})
+        elif name in slots:
+            call_args.append({"kind": slots[name][0], "name": name, "slot": slots[name][1]})
         else:
-            src = "material" if name.startswith("m_") else "lights"
-            slot = next(s for s in (mat_slots if src == "material" else light_slots) if s.name == name)
-            call_args.append({"kind": src, "name": name, "slot": slot})
+            call_args.append({"kind": "local", "name": name})
     for lang in languages:
         target = get_target(lang)
         emitted = target.emit(prog.structs, prog.functions)

@@ -14,6 +14,7 @@ import re
 from dataclasses import dataclass
 
 from .bricks import BRDF_KINDS, Brick, Library
+from .lang import SourceError
 
 _TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[()+=,])")
 PRECISIONS = ("fp32",)  # fp16 is on the roadmap (issue: accuracy); the key keeps the axis
@@ -178,3 +179,33 @@ class Permutation:
 
 def spec_hash(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+@dataclass
+class Resolved:
+    """A permutation's bricks, resolved from its key."""
+
+    brdf: list[Node]
+    packing: Node
+    lights: list[tuple[Brick, Node]]  # (light brick, shadow spec) per light, in order
+    output: Brick
+
+
+def resolve(perm: Permutation, lib: Library) -> Resolved:
+    """The bricks a permutation key names (errors name the key's part that is wrong)."""
+    brdf = parse_brdf(perm.brdf, lib)
+    packing = parse_spec(perm.packing, lib, ("packing",))
+    if len(packing) != 1:
+        raise SourceError("<key>", 1, 1, f"packing '{perm.packing}' names more than one brick", "name one packing")
+    lights = []
+    for lk in perm.lights:
+        lb = lib.get("light", lk.light)
+        if lb is None:
+            raise SourceError("<key>", 1, 1, f"unknown light brick '{lk.light}'",
+                              f"known: {', '.join(b.id for b in lib.of_kind('light'))}")
+        lights.append((lb, parse_spec(lk.shadow, lib, ("shadow",))[0]))
+    out = lib.get("output", perm.output)
+    if out is None:
+        raise SourceError("<key>", 1, 1, f"unknown output brick '{perm.output}'",
+                          f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
+    return Resolved(brdf, packing[0], lights, out)

@@ -16,9 +16,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .bricks import Library, check_value
-from .compose import brdf_params, check_packing
+from .glue import brdf_params, check_packing
 from .lang import SourceError
-from .permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
+from .permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec, resolve
 
 
 class Locator:
@@ -132,7 +132,7 @@ def load_scene(path, lib: Library) -> Scene:
         ranges = {k: p.range for n in nodes for x in n.walk() for k, p in x.brick.params.items()}
         params = m.get("params", {})
         _check_params(loc, f"materials.{name}", params, types, ranges, f"BRDF '{brdf}'")
-        problem = check_packing(Permutation(brdf, (), packing, output), lib)
+        problem = check_packing(resolve(Permutation(brdf, (), packing, output), lib))
         if problem:
             raise loc.error(loc.find(f"materials.{name}", "packing"), problem, "use the constants packing for this BRDF")
         scene.materials[name] = Material(name, brdf, packing, params)

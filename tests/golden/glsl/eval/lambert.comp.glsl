@@ -20,16 +20,20 @@ vec3 lambert_diffuse(vec3 rho_d) {
 }
 
 #line 4 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d) {
+    return lambert_diffuse(rho_d);
+}
+
 vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d) {
     if (dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
-#line 7 "<glue>"
-    return lambert_diffuse(rho_d);
+#line 11 "<glue>"
+    return brdf_lit(L, V, N, rho_d);
 }
 
 
-#line 33 "55679a70c070.comp.glsl"
+#line 37 "55679a70c070.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -26,19 +26,23 @@ vec3 blinn_phong_normalized_specular(float NdotH, float n, vec3 f0) {
 }
 
 #line 4 "<glue>"
-vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
-    if (dot(N, L) <= 0.0) {
-        return vec3(0.0);
-    }
-#line 7 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
     vec3 Hsum = (L + V);
     vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
     return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
 }
 
+vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
+    if (dot(N, L) <= 0.0) {
+        return vec3(0.0);
+    }
+#line 14 "<glue>"
+    return brdf_lit(L, V, N, rho_d, n, f0);
+}
 
-#line 42 "4db92c6b384d.comp.glsl"
+
+#line 46 "4db92c6b384d.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

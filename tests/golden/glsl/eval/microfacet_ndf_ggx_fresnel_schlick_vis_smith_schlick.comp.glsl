@@ -51,11 +51,7 @@ vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, floa
 }
 
 #line 4 "<glue>"
-vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
-    if (dot(N, L) <= 0.0) {
-        return vec3(0.0);
-    }
-#line 7 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     vec3 Hsum = (L + V);
@@ -67,8 +63,16 @@ vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
+vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
+    if (dot(N, L) <= 0.0) {
+        return vec3(0.0);
+    }
+#line 19 "<glue>"
+    return brdf_lit(L, V, N, alpha, f0);
+}
 
-#line 72 "f637b5a924b5.comp.glsl"
+
+#line 76 "f637b5a924b5.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -83,11 +83,7 @@ vec4 linear_output(vec3 color) {
 }
 
 #line 4 "<glue>"
-vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
-    if (dot(N, L) <= 0.0) {
-        return vec3(0.0);
-    }
-#line 7 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     vec3 Hsum = (L + V);
@@ -107,22 +103,22 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3
     if (NdotL0 > 0.0) {
         vec3 c0 = point_light_radiance(P, l0_position, l0_color);
         float s0 = none_shadow(P);
-        Lo += (((3.141592653589793 * brdf(L0, V, N, m_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
+        Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 27 "<glue>"
+#line 25 "<glue>"
     vec3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
         vec3 c1 = point_light_radiance(P, l1_position, l1_color);
         float s1 = none_shadow(P);
-        Lo += (((3.141592653589793 * brdf(L1, V, N, m_rho_d, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
+        Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 33 "<glue>"
+#line 31 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 126 "3492f48173ec.frag.glsl"
+#line 122 "3492f48173ec.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

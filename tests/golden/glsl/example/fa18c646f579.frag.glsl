@@ -90,11 +90,7 @@ vec4 linear_output(vec3 color) {
 }
 
 #line 4 "<glue>"
-vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
-    if (dot(N, L) <= 0.0) {
-        return vec3(0.0);
-    }
-#line 7 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
     float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
     return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
 }
@@ -108,22 +104,22 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec2 uv, vec3 m_rho_d, float m_n, vec3 m_f0,
     if (NdotL0 > 0.0) {
         vec3 c0 = directional_light_radiance(P, l0_color);
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
-        Lo += (((3.141592653589793 * brdf(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
+        Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 21 "<glue>"
+#line 19 "<glue>"
     vec3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
         vec3 c1 = point_light_radiance(P, l1_position, l1_color);
         float s1 = none_shadow(P);
-        Lo += (((3.141592653589793 * brdf(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
+        Lo += (((3.141592653589793 * brdf_lit(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 27 "<glue>"
+#line 25 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 127 "fa18c646f579.frag.glsl"
+#line 123 "fa18c646f579.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

@@ -48,11 +48,7 @@ float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, fl
 }
 
 #line 4 "<glue>"
-float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
-    if (dot(N, L) <= 0.0) {
-        return ((float3)(0.0));
-    }
-#line 7 "<glue>"
+float3 brdf_lit(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
     float3 Hsum = (L + V);
@@ -64,8 +60,16 @@ float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
+float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
+    if (dot(N, L) <= 0.0) {
+        return ((float3)(0.0));
+    }
+#line 19 "<glue>"
+    return brdf_lit(L, V, N, alpha, f0);
+}
 
-#line 69 "f637b5a924b5.comp.hlsl"
+
+#line 73 "f637b5a924b5.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

@@ -58,11 +58,7 @@ float4 linear_output(float3 color) {
 }
 
 #line 4 "<glue>"
-float3 brdf(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
-    if (dot(N, L) <= 0.0) {
-        return ((float3)(0.0));
-    }
-#line 7 "<glue>"
+float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
     float3 Hsum = (L + V);
     float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
     float NdotH = clamp(dot(N, H), 0.0, 1.0);
@@ -77,22 +73,22 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_n, float3 m_
     if (NdotL0 > 0.0) {
         float3 c0 = point_light_radiance(P, l0_position, l0_color);
         float s0 = none_shadow(P);
-        Lo += (((3.141592653589793 * brdf(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
+        Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 22 "<glue>"
+#line 20 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
         float3 c1 = point_light_radiance(P, l1_position, l1_color);
         float s1 = none_shadow(P);
-        Lo += (((3.141592653589793 * brdf(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
+        Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 28 "<glue>"
+#line 26 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 96 "9d9a4a1d0909.frag.hlsl"
+#line 92 "9d9a4a1d0909.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

@@ -90,11 +90,7 @@ float4 linear_output(float3 color) {
 }
 
 #line 4 "<glue>"
-float3 brdf(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
-    if (dot(N, L) <= 0.0) {
-        return ((float3)(0.0));
-    }
-#line 7 "<glue>"
+float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
     float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
     return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
 }
@@ -108,22 +104,22 @@ float4 shade(float3 P, float3 Ng, float3 V, float2 uv, float3 m_rho_d, float m_n
     if (NdotL0 > 0.0) {
         float3 c0 = directional_light_radiance(P, l0_color);
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
-        Lo += (((3.141592653589793 * brdf(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
+        Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 21 "<glue>"
+#line 19 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
         float3 c1 = point_light_radiance(P, l1_position, l1_color);
         float s1 = none_shadow(P);
-        Lo += (((3.141592653589793 * brdf(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
+        Lo += (((3.141592653589793 * brdf_lit(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 27 "<glue>"
+#line 25 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 127 "fa18c646f579.frag.hlsl"
+#line 123 "fa18c646f579.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

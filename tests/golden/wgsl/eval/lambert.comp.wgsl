@@ -16,11 +16,15 @@ fn lambert_diffuse(rho_d: vec3<f32>) -> vec3<f32> {
     return (rho_d * 0.3183098861837907f);
 }
 
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>) -> vec3<f32> {
+    return lambert_diffuse(rho_d);
+}
+
 fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>) -> vec3<f32> {
     if (dot(N, L) <= 0.0f) {
         return vec3<f32>(0.0f);
     }
-    return lambert_diffuse(rho_d);
+    return brdf_lit(L, V, N, rho_d);
 }
 
 

@@ -21,14 +21,18 @@ fn blinn_phong_normalized_specular(NdotH: f32, n: f32, f0: vec3<f32>) -> vec3<f3
     return (f0 * (((n + 4.0f) / (8.0f * 3.141592653589793f)) * pow(NdotH, n)));
 }
 
-fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
-    if (dot(N, L) <= 0.0f) {
-        return vec3<f32>(0.0f);
-    }
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
     var Hsum: vec3<f32> = (L + V);
     var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
     var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
     return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
+}
+
+fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
+    if (dot(N, L) <= 0.0f) {
+        return vec3<f32>(0.0f);
+    }
+    return brdf_lit(L, V, N, rho_d, n, f0);
 }
 
 

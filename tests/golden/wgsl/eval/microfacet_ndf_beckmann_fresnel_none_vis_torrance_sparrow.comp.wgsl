@@ -38,10 +38,7 @@ fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32
     return (none_fresnel(f0, VdotH) * (D * Vis));
 }
 
-fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    if (dot(N, L) <= 0.0f) {
-        return vec3<f32>(0.0f);
-    }
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
     var NdotL: f32 = min(dot(N, L), 1.0f);
     var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
     var Hsum: vec3<f32> = (L + V);
@@ -51,6 +48,13 @@ fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> 
     var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
     var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
     return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
+}
+
+fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    if (dot(N, L) <= 0.0f) {
+        return vec3<f32>(0.0f);
+    }
+    return brdf_lit(L, V, N, alpha, f0);
 }
 
 

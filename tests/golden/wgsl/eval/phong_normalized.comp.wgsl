@@ -16,12 +16,16 @@ fn phong_normalized_specular(RdotV: f32, n: f32, f0: vec3<f32>) -> vec3<f32> {
     return (f0 * (((n + 2.0f) * 0.15915494309189535f) * pow(RdotV, n)));
 }
 
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
+    var RdotV: f32 = clamp(dot(reflect((-L), N), V), 0.0f, 1.0f);
+    return phong_normalized_specular(RdotV, n, f0);
+}
+
 fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
     if (dot(N, L) <= 0.0f) {
         return vec3<f32>(0.0f);
     }
-    var RdotV: f32 = clamp(dot(reflect((-L), N), V), 0.0f, 1.0f);
-    return phong_normalized_specular(RdotV, n, f0);
+    return brdf_lit(L, V, N, n, f0);
 }
 
 

@@ -74,10 +74,7 @@ fn linear_output(color: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(color, 1.0f);
 }
 
-fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
-    if (dot(N, L) <= 0.0f) {
-        return vec3<f32>(0.0f);
-    }
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
     var RdotV: f32 = clamp(dot(reflect((-L), N), V), 0.0f, 1.0f);
     return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
 }
@@ -91,14 +88,14 @@ fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, uv: vec2<f32>, m_rho_d: vec3
     if (NdotL0 > 0.0f) {
         var c0: vec3<f32> = directional_light_radiance(P, l0_color);
         var s0: f32 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
-        Lo += (((3.141592653589793f * brdf(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
+        Lo += (((3.141592653589793f * brdf_lit(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     var L1: vec3<f32> = point_light_dir(P, l1_position);
     var NdotL1: f32 = dot(N, L1);
     if (NdotL1 > 0.0f) {
         var c1: vec3<f32> = point_light_radiance(P, l1_position, l1_color);
         var s1: f32 = none_shadow(P);
-        Lo += (((3.141592653589793f * brdf(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
+        Lo += (((3.141592653589793f * brdf_lit(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
     return linear_output(Lo);
 }
