@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from . import ir
 from .errors import SourceError
 from .intrinsics import CONSTANTS
+from .exprs import check_identifier, parse_type
 from .typecheck import Checker
 from .types import BUILTIN_TYPES, Type, struct
 
@@ -57,26 +58,6 @@ def read_meta(text: str, path: str) -> tuple[dict, ir.Loc, str]:
                 raise _err(path, node.value, "BRICK must be a dict", 'write BRICK = {"kind": ..., "params": {...}}')
             return meta, _loc(path, node), doc
     raise SourceError(path, 1, 1, "no BRICK metadata dict", 'add BRICK = {"kind": "...", "params": {...}} at top level')
-
-
-def parse_type(path: str, node, structs: dict[str, Type]) -> Type:
-    """A type annotation: a builtin type name or a struct declared in the same brick."""
-    if isinstance(node, ast.Name):
-        if node.id in BUILTIN_TYPES:
-            return BUILTIN_TYPES[node.id]
-        if node.id in structs:
-            return structs[node.id]
-    if isinstance(node, ast.Constant) and node.value is None:
-        raise _err(path, node, "functions must return a value", "bricks are pure: return a float, vector or struct")
-    names = ", ".join(sorted(BUILTIN_TYPES))
-    shown = ast.unparse(node) if isinstance(node, ast.AST) else str(node)
-    raise _err(path, node, f"unknown type '{shown}'", f"use one of {names} or a struct declared in this brick")
-
-
-def check_identifier(path: str, node, name: str) -> None:
-    if name.startswith("_") or "__" in name:
-        raise _err(path, node, f"identifier '{name}' starts with or contains '__' / '_'",
-                   "names beginning with '_' or containing '__' are reserved for the generator; rename it")
 
 
 def parse_module(text: str, path: str, externals: dict[str, Signature] | None = None) -> ir.Module:
