@@ -21,6 +21,7 @@ from .lang import SourceError
 from .lang.types import Type
 from .permutation import Node, Permutation, parse_brdf, resolve
 from .targets import get_target
+from .targets.base import Emitted
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
 LANGUAGES = ("glsl", "hlsl", "wgsl")
@@ -253,19 +254,9 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
             ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, used),
                    "inputs": inputs, "material_vec4s": mat_count, "light_vec4s": light_count,
                    "textures": textures, "call_args": call_args, "shade": target.ident("shade")}
-            sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else _EMPTY,
+            sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
     return Composed(perm.canonical(), h, sources, bricks, templates, material=mat_slots,
                     lights=[[s for s in light_slots if s.name.startswith(f"l{i}_")] for i in range(len(r.lights))],
                     textures=textures, inputs=inputs)
 
-
-class _Empty:
-    text = ""
-
-    @staticmethod
-    def shifted(offset):
-        return []
-
-
-_EMPTY = _Empty()
