@@ -227,16 +227,27 @@ _ANSI = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
 _NAGA_HEAD = re.compile(r"^(?P<sev>error|warning)(?:\[[^\]]*\])?: (?P<msg>.*)$")
 _NAGA_LOC = re.compile(r"^\s*┌─\s*(?P<path>.+?):(?P<line>\d+):(?P<col>\d+)")
 _NAGA_NOTE = re.compile(r"^\s*= (?P<note>.*)$")
+_NAGA_SOURCE = re.compile(r"^\s*(?P<line>\d+)\s+│")  # a numbered source line of the snippet
+_NAGA_EXPR_LABEL = re.compile(r"\^+\s+naga::ir::Expression")
 
 
 def _parse_naga(text: str, job: CompileJob) -> list[Diagnostic]:
+    """naga's diagnostics. A validation error's header points at the whole function; the
+    snippet underlines the offending expression below its source line, so that line wins."""
     diags: list[dict] = []
+    source_line = 0
     for raw in _ANSI.sub("", text).splitlines():
         if m := _NAGA_HEAD.match(raw):
             diags.append(dict(path=job.key, line=0, col=0, severity=m["sev"], message=m["msg"].strip(), tool="naga"))
+            source_line = 0
         elif diags and (m := _NAGA_LOC.match(raw)) and diags[-1]["line"] == 0:
             path, line = _map_line(job, int(m["line"]))
             diags[-1].update(path=path, line=line, col=int(m["col"]))
+        elif diags and (m := _NAGA_SOURCE.match(raw)):
+            source_line = int(m["line"])
+        elif diags and source_line and _NAGA_EXPR_LABEL.search(raw):
+            path, line = _map_line(job, source_line)
+            diags[-1].update(path=path, line=line, col=0)  # the line map has no columns
         elif diags and (m := _NAGA_NOTE.match(raw)):
             diags[-1]["message"] += ": " + m["note"].strip()
     return [Diagnostic(**d) for d in diags]

@@ -171,8 +171,8 @@ def test_compiler_failure_names_the_brick_line_and_other_permutations_still_buil
     out = tmp_path / "out"
     r = run("build", scene, "--out", out, "--bricks", d)
     assert r.returncode == 1
-    # naga's validator reports the span of the whole function, so the message names the brick's def line.
-    assert f"{d / 'branchy.py'}:6:1: error: " in r.stderr and "Division by zero [naga]" in r.stderr, r.stderr
+    # naga's header points at the function; the underlined expression's line names the statement.
+    assert f"{d / 'branchy.py'}:8:0: error: " in r.stderr and "Division by zero [naga]" in r.stderr, r.stderr
     m = json.loads((out / "manifest.json").read_text())
     status = {p["id"].split(";")[0]: p["status"] for p in m["permutations"]}
     assert status == {"brdf=lambert+blinn_phong_normalized": "ok", "brdf=lambert": "failed"}
