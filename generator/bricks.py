@@ -156,7 +156,12 @@ def _meta_error(shown: str, loc: ir.Loc, message: str, hint: str) -> SourceError
 def load_brick(path: Path) -> Brick:
     """Parse one brick file and check its metadata against its functions."""
     shown = display(path)
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise SourceError(shown, 1, 1, f"not UTF-8 text (byte {e.start})", "save the brick as UTF-8") from None
+    except OSError as e:
+        raise SourceError(shown, 1, 1, f"cannot read brick: {e.strerror}", "check the file") from None
     meta, loc, doc = read_meta(text, shown)
     unknown = set(meta) - META_KEYS
     if unknown:

@@ -41,6 +41,10 @@ def main(argv=None) -> int:
     except SourceError as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
+    except OSError as e:  # an output path that is a file, a full disk, no permission
+        where = f"{e.filename}: " if e.filename else ""
+        print(f"error: {where}{e.strerror or e} — check the path, its permissions and free space", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("interrupted; earlier outputs are intact", file=sys.stderr)
         return 130

@@ -96,6 +96,8 @@ def load_scene(path, lib: Library) -> Scene:
         text = path.read_text(encoding="utf-8")
     except OSError as e:
         raise SourceError(shown, 1, 1, f"cannot read scene: {e.strerror}", "check the path") from None
+    except UnicodeDecodeError as e:
+        raise SourceError(shown, 1, 1, f"not UTF-8 text (byte {e.start})", "save the scene as UTF-8") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

@@ -212,3 +212,21 @@ def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, to
     assert len(changed) == 6, "files renamed before the interruption are complete new files; the rest untouched"
     assert json.loads((out / "manifest.json").read_text()) == json.loads((out / "manifest.json").read_text())
     assert after["manifest.json"] == before["manifest.json"], "the manifest is written last"
+
+
+def test_output_path_that_is_a_file_is_a_clear_error(tmp_path):
+    blocker = tmp_path / "out"
+    blocker.write_text("not a directory")
+    r = run("build", _scene(tmp_path, GOOD), "--out", blocker)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert "Not a directory — check the path" in r.stderr, r.stderr
+    assert blocker.read_text() == "not a directory"
+
+
+def test_brick_that_is_not_utf8_is_a_located_error(tmp_path):
+    d = tmp_path / "b"
+    d.mkdir()
+    (d / "latin1.py").write_bytes(b'"""caf\xe9"""\n')
+    r = run("bricks", "--bricks", d)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert f"{d / 'latin1.py'}:1:1: not UTF-8 text (byte 4) — save the brick as UTF-8" in r.stderr, r.stderr
