@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .lang import Signature, SourceError, parse_module, read_meta
+from .lang.errors import read_text
 from .lang import ir
 from .lang.types import BUILTIN_TYPES, FLOAT, VEC3, Type
 
@@ -156,12 +157,7 @@ def _meta_error(shown: str, loc: ir.Loc, message: str, hint: str) -> SourceError
 def load_brick(path: Path) -> Brick:
     """Parse one brick file and check its metadata against its functions."""
     shown = display(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as e:
-        raise SourceError(shown, 1, 1, f"not UTF-8 text (byte {e.start})", "save the brick as UTF-8") from None
-    except OSError as e:
-        raise SourceError(shown, 1, 1, f"cannot read brick: {e.strerror}", "check the file") from None
+    text = read_text(path, "brick")
     meta, loc, doc = read_meta(text, shown)
     unknown = set(meta) - META_KEYS
     if unknown:

@@ -18,6 +18,7 @@ from pathlib import Path
 from .bricks import Library, check_value
 from .glue import brdf_params, check_packing
 from .lang import SourceError
+from .lang.errors import read_text
 from .permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec, resolve
 
 
@@ -92,12 +93,9 @@ def load_scene(path, lib: Library) -> Scene:
     """Read, validate and reduce a TOML scene to its permutations."""
     path = Path(path)
     shown = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as e:
-        raise SourceError(shown, 1, 1, f"cannot read scene: {e.strerror}", "check the path") from None
-    except UnicodeDecodeError as e:
-        raise SourceError(shown, 1, 1, f"not UTF-8 text (byte {e.start})", "save the scene as UTF-8") from None
+    if path.is_dir():
+        raise SourceError(shown, 1, 1, "is a directory, not a scene file", "pass a .toml scene file")
+    text = read_text(path, "scene")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

@@ -229,4 +229,4 @@ def test_brick_that_is_not_utf8_is_a_located_error(tmp_path):
     (d / "latin1.py").write_bytes(b'"""caf\xe9"""\n')
     r = run("bricks", "--bricks", d)
     assert r.returncode == 1 and "Traceback" not in r.stderr
-    assert f"{d / 'latin1.py'}:1:1: not UTF-8 text (byte 4) — save the brick as UTF-8" in r.stderr, r.stderr
+    assert f"{d / 'latin1.py'}:1:7: byte 0xe9 is not UTF-8 — save the brick as UTF-8" in r.stderr, r.stderr

@@ -18,3 +18,19 @@ class SourceError(Exception):
 def at(loc, message: str, hint: str = "") -> SourceError:
     """A SourceError at an ir.Loc (or anything with path/line/col)."""
     return SourceError(loc.path, loc.line, loc.col, message, hint)
+
+
+def read_text(path, what: str) -> str:
+    """A UTF-8 file's text; a decoding or reading problem is a SourceError at the offending byte."""
+    shown = str(path)
+    try:
+        data = open(path, "rb").read()
+    except OSError as e:
+        raise SourceError(shown, 1, 1, f"cannot read {what}: {e.strerror}", "check the path") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = data.count(b"\n", 0, e.start) + 1
+        col = e.start - (data.rfind(b"\n", 0, e.start) + 1) + 1
+        raise SourceError(shown, line, col, f"byte 0x{data[e.start]:02x} is not UTF-8",
+                          f"save the {what} as UTF-8") from None
