@@ -8,7 +8,7 @@ import signal
 import sys
 
 from . import __version__, commands
-from .lang import SourceError
+from .lang.errors import UserError
 
 
 def _command_names() -> list[str]:
@@ -38,7 +38,7 @@ def main(argv=None) -> int:
     signal.signal(signal.SIGTERM, _terminate)
     try:
         return args.func(args)
-    except SourceError as e:
+    except UserError as e:  # a bad input, a missing tool, a brick a compiler rejects
         print(f"error: {e}", file=sys.stderr)
         return 1
     except OSError as e:  # an output path that is a file, a full disk, no permission

@@ -23,13 +23,14 @@ import types
 import numpy as np
 
 from .compose import EvalProgram, compose_eval, eval_program
+from .lang.errors import UserError
 
 TARGETS = ("reference", "numpy", "glsl", "hlsl", "wgsl")
 GPU_TARGETS = ("glsl", "hlsl", "wgsl")
 DTYPES = ("float64", "float32", "float16")
 
 
-class EvalError(ValueError):
+class EvalError(UserError, ValueError):
     """A bad argument to evaluate(); the message says what is wrong and what to do."""
 
     def __init__(self, what: str, todo: str):

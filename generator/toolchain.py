@@ -64,6 +64,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable
 
+from .lang.errors import UserError
+
 __all__ = ["Diagnostic", "CompileJob", "CompileResult", "ToolMissing",
            "compile_many", "tool_versions", "find_tool",
            "TARGET_ENV", "SPIRV_VERSION", "SPIRV_MAGIC"]
@@ -116,7 +118,7 @@ class CompileResult:
     diagnostics: list[Diagnostic]
 
 
-class ToolMissing(Exception):
+class ToolMissing(UserError):
     """A required external tool is not installed."""
 
     def __init__(self, name: str):

@@ -230,3 +230,26 @@ def test_brick_that_is_not_utf8_is_a_located_error(tmp_path):
     r = run("bricks", "--bricks", d)
     assert r.returncode == 1 and "Traceback" not in r.stderr
     assert f"{d / 'latin1.py'}:1:7: byte 0xe9 is not UTF-8 — save the brick as UTF-8" in r.stderr, r.stderr
+
+
+def test_cli_start_loads_neither_vulkan_nor_numpy():
+    code = ("import sys; from generator.cli import parser; parser(); "
+            "print(sorted(m for m in ('vulkan', 'numpy', 'generator.evaluate') if m in sys.modules))")
+    r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and r.stdout.strip() == "[]", (r.stdout, r.stderr)
+
+
+@pytest.mark.parametrize("command", [["build", str(EXAMPLE), "--out", "{tmp}"],
+                                     ["eval", "lambert", "--input", "{tmp}/s.npy", "--output", "{tmp}/f.npy",
+                                      "--target", "glsl"]], ids=["build", "eval"])
+def test_missing_tool_is_one_line_error(tmp_path, monkeypatch, capsys, command):
+    import numpy as np
+
+    import generator.toolchain
+    from generator.cli import main
+
+    np.save(tmp_path / "s.npy", np.tile([0.0, 0.0, 1.0], (4, 3)))
+    monkeypatch.setattr(generator.toolchain, "find_tool", lambda name: None)
+    assert main([a.format(tmp=tmp_path) for a in command]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("error: glslc not found — run `make setup`") and err.count("\n") == 1, err

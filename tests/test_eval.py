@@ -241,6 +241,35 @@ def test_cli_round_trip_matches_the_python_function(tmp_path, samples):
         assert list(tmp_path.glob(".*.tmp")) == []
 
 
+DIVIDE_BY_ZERO = '''"""A diffuse term that naga rejects (constant division by zero); glslang folds it."""
+BRICK = {"kind": "diffuse", "cite": "test probe",
+         "params": {"rho_d": {"type": "vec3", "range": [0.0, 1.0], "default": [0.5, 0.5, 0.5]}}}
+
+
+def diffuse(rho_d: vec3) -> vec3:
+    k: int = 1 / 0
+    return rho_d * INV_PI * float(k)
+'''
+
+
+def test_cli_kernel_that_does_not_compile_is_one_line_error(tmp_path):
+    for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
+        require_tool(t)
+    from generator.runtime.probe import lavapipe_present
+    require(lavapipe_present(), "no lavapipe device — install mesa-vulkan-drivers (`make setup`)")
+
+    bricks = tmp_path / "bricks"
+    bricks.mkdir()
+    (bricks / "div_zero.py").write_text(DIVIDE_BY_ZERO)
+    good = save(tmp_path / "s.npy", np.tile([0.0, 0.0, 1.0], (4, 3)))
+    r = cli("div_zero", "--bricks", bricks, "--input", good, "--output", tmp_path / "f.npy", "--target", "wgsl")
+    assert r.returncode == 1, r.stderr
+    assert r.stderr.startswith("error: the wgsl eval kernel does not compile: ")
+    assert f"{bricks / 'div_zero.py'}:7:" in r.stderr and " — " in r.stderr, r.stderr
+    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr, r.stderr
+    assert not (tmp_path / "f.npy").exists()
+
+
 def test_cli_errors_exit_1_and_leave_the_output_alone(tmp_path):
     good = save(tmp_path / "s.npy", np.tile([0.0, 0.0, 1.0], (4, 3)))
     out = tmp_path / "f.npy"

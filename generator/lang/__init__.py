@@ -1,5 +1,5 @@
 """The brick language: Python syntax parsed with ast into a typed IR (never imported or executed)."""
-from .errors import SourceError
+from .errors import SourceError, UserError
 from .parse import Signature, parse_module, read_meta
 
-__all__ = ["SourceError", "Signature", "parse_module", "read_meta"]
+__all__ = ["SourceError", "UserError", "Signature", "parse_module", "read_meta"]

@@ -2,7 +2,11 @@
 from __future__ import annotations
 
 
-class SourceError(Exception):
+class UserError(Exception):
+    """An error the user can fix; the message says what is wrong and what to do."""
+
+
+class SourceError(UserError):
     """An error in a brick, scene or other input file, with its location."""
 
     def __init__(self, path: str, line: int, col: int, message: str, hint: str = ""):

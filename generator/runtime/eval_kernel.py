@@ -17,14 +17,15 @@ import hashlib
 
 import numpy as np
 
+from ..lang.errors import UserError
 from .compute import STORAGE, UNIFORM, ComputePipeline
 from .device import Device, validation_requested
 
 WORKGROUP = 64  # local_size_x of templates/*/eval.*.j2
 
 
-class KernelError(RuntimeError):
-    """An eval kernel failed to compile or validate (a generator bug, not a user error)."""
+class KernelError(UserError, RuntimeError):
+    """An eval kernel failed to compile or validate: a brick one compiler rejects (or a generator bug)."""
 
 
 class EvalKernel:
@@ -103,8 +104,10 @@ def compile_kernel(source, device: Device, tangent: bool, param_vec4s: int) -> E
     job = CompileJob(key, source.language, "comp", source.text, line_map=tuple(map(tuple, source.line_map)))
     res = compile_many([job])[key]
     if not res.ok:
-        raise KernelError(f"eval kernel ({source.language}) does not compile:\n"
-                          + "\n".join(str(d) for d in res.diagnostics))
+        found = [d for d in res.diagnostics if d.severity == "error"] or res.diagnostics
+        raise KernelError(f"the {source.language} eval kernel does not compile: "
+                          + "; ".join(str(d).replace("\n", " ") for d in found)
+                          + " — fix the brick at that line (or evaluate with another --target)")
     return EvalKernel(device, res.spirv, tangent, param_vec4s)
 
 
