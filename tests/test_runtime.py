@@ -4,6 +4,8 @@ Without a Vulkan device these tests skip with the reason; under CI=true they fai
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,8 @@ from tests.conftest import require_tool
 from tests.lavapipe import device, no_validation_messages, open_device  # noqa: F401 (fixtures)
 
 pytestmark = pytest.mark.lavapipe
+
+REPO = Path(__file__).resolve().parent.parent
 
 DOUBLE = """#version 450
 layout(local_size_x = 64) in;
@@ -104,6 +108,27 @@ def test_eval_kernel_chunks_large_inputs(device):
         kernel.max_samples = limit
     np.testing.assert_array_equal(chunked, whole)
 
+
+def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
+    """A chunk's samples and results each fit one storage descriptor (lavapipe: 128 MiB, 2.8 M samples)."""
+    from types import SimpleNamespace
+
+    from generator.bricks import load_library
+    from generator.evaluate import gpu_kernel
+    from generator.runtime.eval_kernel import WORKGROUP, max_dispatch_samples
+
+    limit = int(device.limits.maxStorageBufferRange)
+    groups = int(device.limits.maxComputeWorkGroupCount[0])
+    probes = load_library([REPO / "tests" / "eval_bricks"])
+    for spec, lib, vec4s in (("lambert", None, 3), ("tangent_probe", probes, 4)):  # (L, V, N), (L, V, N, T)
+        kernel = gpu_kernel(spec, "glsl", lib, device)
+        assert kernel.vec4s_per_sample == vec4s
+        assert kernel.max_samples == min(groups * WORKGROUP, limit // (16 * vec4s))
+        assert 16 * vec4s * kernel.max_samples <= limit and 16 * kernel.max_samples <= limit
+    small = SimpleNamespace(maxStorageBufferRange=1 << 20, maxComputeWorkGroupCount=(65535, 1, 1))
+    assert max_dispatch_samples(small, 4) == (1 << 20) // 64
+    wide = SimpleNamespace(maxStorageBufferRange=(1 << 32) - 1, maxComputeWorkGroupCount=(100, 1, 1))
+    assert max_dispatch_samples(wide, 3) == 100 * WORKGROUP
 
 
 def test_eval_kernel_times_loaded_samples_and_releases_buffers(device):

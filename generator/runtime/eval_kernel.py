@@ -5,7 +5,8 @@ sample (L, V, N) or 4 with T (xyz; w unused); binding 1 the result, one vec4
 per sample (f_r in xyz); binding 2 a uniform block: uvec4 info (x = sample
 count) then one vec4 per parameter (four per mat4). Buffers grow as needed and
 are reused between runs. A dispatch covers at most maxComputeWorkGroupCount[0]
-workgroups of 64, so larger inputs run in chunks.
+workgroups of 64, and each storage buffer at most maxStorageBufferRange bytes
+(lavapipe: 128 MiB, 2.8 M samples), so larger inputs run in chunks.
 
 One process-wide device (:func:`shared_device`) carries a cache of kernels per
 (language, source text), so repeated evaluations compile and create each
@@ -28,6 +29,14 @@ class KernelError(UserError, RuntimeError):
     """An eval kernel failed to compile or validate: a brick one compiler rejects (or a generator bug)."""
 
 
+def max_dispatch_samples(limits, vec4s_per_sample: int) -> int:
+    """Samples one dispatch takes: the workgroup count, and each storage buffer within maxStorageBufferRange."""
+    storage = int(limits.maxStorageBufferRange)
+    return min(int(limits.maxComputeWorkGroupCount[0]) * WORKGROUP,
+               storage // (16 * vec4s_per_sample),  # the samples buffer
+               storage // 16)  # the result buffer, one vec4 per sample
+
+
 class EvalKernel:
     """One compiled eval kernel: `run` evaluates f_r for a batch of samples."""
 
@@ -37,7 +46,7 @@ class EvalKernel:
         self.vec4s_per_sample = 4 if tangent else 3
         self.param_vec4s = max(param_vec4s, 1)
         self.pipeline = ComputePipeline(device, spirv, (STORAGE, STORAGE, UNIFORM))
-        self.max_samples = int(device.limits.maxComputeWorkGroupCount[0]) * WORKGROUP
+        self.max_samples = max_dispatch_samples(device.limits, self.vec4s_per_sample)
         self.params = device.buffer(16 * (1 + self.param_vec4s), vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT)
         self.samples = self.result = None
         self.capacity = self.count = 0
