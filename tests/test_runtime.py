@@ -72,7 +72,7 @@ def test_timestamps_give_positive_durations(device, double_spirv):
     pipe, src, _ = make_pipeline(device, double_spirv, n)
     src.write(np.ones(n, np.float32))
     times = [pipe.dispatch(n // 64, timed=True) for _ in range(3)]
-    assert all(np.isfinite(t) and 0.0 < t < 60.0 for t in times), times
+    assert all(np.isfinite(t) and t > 0.0 for t in times), times
     assert pipe.dispatch(n // 64) is None  # untimed dispatches return nothing
 
 
@@ -141,7 +141,7 @@ def test_eval_kernel_times_loaded_samples_and_releases_buffers(device):
     vecs = [np.tile(np.float32([0.0, 0.0, 1.0]), (4096, 1))] * 3
     kernel.load(vecs, block)
     times = kernel.time(3)
-    assert len(times) == 3 and all(0.0 < t < 60.0 for t in times), times
+    assert len(times) == 3 and all(np.isfinite(t) and t > 0.0 for t in times), times
     kernel.release()
     with pytest.raises(ValueError, match="load"):
         kernel.time()
