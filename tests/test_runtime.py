@@ -90,6 +90,23 @@ def test_validation_layer_reports_misuse(double_spirv):
     assert any(m.severity == "error" and "VkWriteDescriptorSet" in m.id_name for m in dev.messages), dev.messages
 
 
+@pytest.mark.parametrize("fails", ["host_memory_type", "vkMapMemory"])
+def test_buffer_whose_memory_fails_leaks_nothing(monkeypatch, fails):
+    """A failed allocation or mapping destroys the VkBuffer (and frees the memory): closing reports no leak."""
+    dev = open_device()
+    try:
+        def fail(*args):
+            raise MemoryError("out of host memory (test)")
+
+        monkeypatch.setattr(dev if fails == "host_memory_type" else dev.vk, fails, fail)
+        with pytest.raises(MemoryError):
+            dev.buffer(1 << 16, dev.vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)
+        monkeypatch.undo()
+    finally:
+        dev.close()
+    assert dev.messages == [], "\n".join(map(str, dev.messages))
+
+
 def test_eval_kernel_chunks_large_inputs(device):
     """Inputs beyond one dispatch's workgroup limit run in chunks with the same results."""
     from generator.evaluate import _param_block, gpu_kernel, program, resolve_params

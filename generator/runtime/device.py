@@ -72,11 +72,19 @@ class Buffer:
         self.device, self.size = device, int(size)
         self.handle = vk.vkCreateBuffer(device.handle, vk.VkBufferCreateInfo(
             size=self.size, usage=usage, sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE), None)
-        req = vk.vkGetBufferMemoryRequirements(device.handle, self.handle)
-        self.memory = vk.vkAllocateMemory(device.handle, vk.VkMemoryAllocateInfo(
-            allocationSize=req.size, memoryTypeIndex=device.host_memory_type(req.memoryTypeBits)), None)
-        vk.vkBindBufferMemory(device.handle, self.handle, self.memory, 0)
-        self._mapped = vk.vkMapMemory(device.handle, self.memory, 0, self.size, 0)
+        self.memory = None
+        try:
+            req = vk.vkGetBufferMemoryRequirements(device.handle, self.handle)
+            self.memory = vk.vkAllocateMemory(device.handle, vk.VkMemoryAllocateInfo(
+                allocationSize=req.size, memoryTypeIndex=device.host_memory_type(req.memoryTypeBits)), None)
+            vk.vkBindBufferMemory(device.handle, self.handle, self.memory, 0)
+            self._mapped = vk.vkMapMemory(device.handle, self.memory, 0, self.size, 0)
+        except BaseException:  # out of memory, no host-visible type: free what was created
+            vk.vkDestroyBuffer(device.handle, self.handle, None)
+            if self.memory is not None:
+                vk.vkFreeMemory(device.handle, self.memory, None)
+            self.handle = self.memory = None
+            raise
 
     def array(self, dtype=np.uint8) -> np.ndarray:
         """The mapped memory as a writable 1-D numpy array (a view: valid until destroy())."""
