@@ -289,7 +289,7 @@ def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:
 
 def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
     """Errors of every (target, dtype) against the reference for one spec: {set: {"target/dtype": Errors}}."""
-    from .evaluate import evaluate
+    from .evaluate import evaluate, gpu_kernel
     from .reference import reference_brdf
 
     declared = declared_params(spec, lib)
@@ -311,6 +311,8 @@ def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
                     got = evaluate(spec, *given, s.params, target=t, dtype=d, lib=lib)
                 stats[f"{t}/{d}"].add(got, refs[d][0], s.labels, s.params, refs[d][1])
         out[set_name] = stats
+    for t in sorted({t for t, _ in runs(targets, dtypes) if t in GPU}):
+        gpu_kernel(spec, t, lib).release()  # its buffers have the largest batch's size; the pipeline stays
     return out
 
 

@@ -135,6 +135,15 @@ def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device):
             assert r["max_rel"] <= 64 * EPS32 * 5, (r["spec"], r["target"], r["max_rel"])
 
 
+
+@pytest.mark.lavapipe
+def test_measure_releases_the_kernel_buffers_after_each_spec(device):
+    from generator.evaluate import gpu_kernel
+
+    accuracy.measure("lambert", ["numpy", "glsl"], ["float32"], LIB, hemisphere_k=3)
+    kernel = gpu_kernel("lambert", "glsl", LIB)
+    assert kernel.samples is None and kernel.result is None and kernel.capacity == 0
+
 # ------------------------------------------------------------------ the command
 
 def test_command_json_report_and_exit_code(tmp_path, capsys):
