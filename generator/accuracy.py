@@ -14,8 +14,9 @@ Errors are per RGB component against the reference evaluated at the inputs as
 rounded to the target's dtype (the target's arithmetic, not its input rounding):
 absolute, and relative |f - f_ref| / max(|f_ref|, REL_FLOOR). NaN and Inf outputs
 are counted on every sample, never averaged. Left out of the errors and counted
-apart (see Errors): batches whose reference is a Dirac peak (alpha = 0), and
-samples that the dtype's input rounding alone moves by more than ILL_CONDITIONED.
+apart (see Errors): batches whose reference is a Dirac peak (alpha = 0), samples
+that the dtype's input rounding alone moves by more than ILL_CONDITIONED, and
+infinite reference values elsewhere. A NaN reference is an error.
 """
 from __future__ import annotations
 
@@ -175,10 +176,12 @@ class Errors:
 
     nan/inf count the target's non-finite outputs over every sample. The errors
     leave out (and count) samples that cannot be compared: `dirac` — batches whose
-    reference has a Dirac peak (alpha = 0: a distribution, not point values), and
+    reference has a Dirac peak (alpha = 0: a distribution, not point values),
     `ill_conditioned` — samples where rounding the inputs to the dtype alone moves
     the reference by more than ILL_CONDITIONED (h from l + v at l ≈ -v, cosines of
-    1e-7 in a rotated float32 frame): there no dtype-rounded evaluation can agree.
+    1e-7 in a rotated float32 frame): there no dtype-rounded evaluation can agree,
+    and `ref_inf` — values where the reference is infinite in any other batch. A NaN
+    in the reference is a bug in it: add() raises ValueError.
     """
 
     samples: int = 0  # RGB components compared
@@ -186,6 +189,7 @@ class Errors:
     inf: int = 0
     dirac: int = 0
     ill_conditioned: int = 0
+    ref_inf: int = 0
     max_abs: float = 0.0
     mean_abs: float = 0.0
     max_rel: float = 0.0
@@ -199,12 +203,20 @@ class Errors:
         """Fold one batch ((n, 3) arrays) into the statistics; `comparable`: (n,) well-conditioned samples."""
         self.nan += int(np.count_nonzero(np.isnan(got)))
         self.inf += int(np.count_nonzero(np.isinf(got)))
-        if not np.all(np.isfinite(ref)):
+        if params.get("alpha") == 0:
             self.dirac += got.size
             return
+        nan_ref = np.isnan(ref)
+        if nan_ref.any():
+            i = int(np.argmax(nan_ref.any(axis=1)))
+            raise ValueError(f"the float64 reference is NaN in {int(nan_ref.sum())} values (first: "
+                             f"{labels[i]}, {_plain(params)}) — fix the BRDF's reference function "
+                             "(generator/reference/)")
         keep = np.ones(len(got), bool) if comparable is None else comparable
         self.ill_conditioned += 3 * int(np.count_nonzero(~keep))
-        m = keep[:, None] & np.isfinite(got)
+        inf_ref = keep[:, None] & np.isinf(ref)
+        self.ref_inf += int(np.count_nonzero(inf_ref))
+        m = keep[:, None] & np.isfinite(got) & ~inf_ref
         if not m.any():
             return
         with np.errstate(invalid="ignore", over="ignore"):
@@ -340,8 +352,9 @@ def markdown(report: dict) -> str:
              f"Relative error: |f - f_ref| / max(|f_ref|, {report['rel_floor']:g} sr⁻¹), per RGB component; "
              "the reference is evaluated at the inputs as rounded to the dtype. NaN/Inf: non-finite "
              "outputs (every sample). Left out of the errors: Dirac (RGB values in batches whose reference "
-             "is a Dirac peak, alpha = 0) and ill-cond. (values whose reference moves by more than "
-             f"{ILL_CONDITIONED:g} when the inputs are rounded to the dtype).", ""]
+             "is a Dirac peak, alpha = 0), ill-cond. (values whose reference moves by more than "
+             f"{ILL_CONDITIONED:g} when the inputs are rounded to the dtype) and ref. Inf (values where the "
+             "reference is infinite in other batches).", ""]
     lines += [f"Note: {n}" for n in report.get("notes", [])]
     lines += ["## NaN / Inf per run (every spec, both sample sets)", "", "| run | NaN | Inf |", "|---|---|---|"]
     for run_ in report["runs"]:
@@ -350,14 +363,15 @@ def markdown(report: dict) -> str:
     lines.append("")
     for set_name in ("hemisphere", "stress"):
         lines += [f"## {set_name}", "",
-                  "| spec | target | dtype | max abs | mean abs | max rel | mean rel | NaN | Inf | Dirac | ill-cond. | worst case |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "| spec | target | dtype | max abs | mean abs | max rel | mean rel | NaN | Inf | Dirac | ill-cond. "
+                  "| ref. Inf | worst case |",
+                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in (r for r in res if r["set"] == set_name):
             w = r["worst"]
             where = f"{w['case']} {w['params'] or ''}".strip() if w and set_name == "stress" else ""
             lines.append(f"| `{r['spec']}` | {r['target']} | {r['dtype']} | {_fmt(r['max_abs'])} | "
                          f"{_fmt(r['mean_abs'])} | {_fmt(r['max_rel'])} | {_fmt(r['mean_rel'])} | "
-                         f"{r['nan']} | {r['inf']} | {r['dirac']} | {r['ill_conditioned']} | {where} |")
+                         f"{r['nan']} | {r['inf']} | {r['dirac']} | {r['ill_conditioned']} | {r['ref_inf']} | {where} |")
         lines.append("")
     stress32 = [r for r in res if r["set"] == "stress" and r["dtype"] == "float32"]
     if stress32:

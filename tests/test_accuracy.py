@@ -84,6 +84,18 @@ def test_error_metrics():
     assert e.inf == 6 and e.ill_conditioned == 3 and e.samples == 5
 
 
+def test_infinite_reference_skips_its_values_and_nan_reference_raises():
+    e = accuracy.Errors()
+    ref = np.array([[1.0, np.inf, 1.0], [2.0, 2.0, 2.0]])
+    e.add(np.array([[1.5, 1.0, 1.0], [2.0, 2.0, 2.0]]), ref, ["a", "b"], {"alpha": 0.3})
+    assert e.dirac == 0 and e.ref_inf == 1 and e.samples == 5 and e.max_rel == 0.5
+    ref[1, 2] = np.nan
+    with pytest.raises(ValueError, match=r"reference is NaN in 1 values \(first: b, \{'alpha': 0.3\}\) — fix"):
+        e.add(np.ones((2, 3)), ref, ["a", "b"], {"alpha": 0.3})
+    e.add(np.ones((2, 3)), np.zeros((2, 3)), ["a", "b"], {"alpha": 0.0})  # a Dirac batch, whatever its values
+    assert e.dirac == 6 and e.samples == 5
+
+
 # ------------------------------------------------------------------ robust bricks (part 5)
 
 @pytest.fixture(scope="module")
