@@ -219,6 +219,7 @@ def test_command_errors(tmp_path, capsys):
         (["accuracy", "lambert", "--targets", "numpy,metal"], "unknown target 'metal'"),
         (["accuracy", "lambert", "--targets", "glsl", "--dtypes", "float16"], "GPU targets run float32 only"),
         (["accuracy", "lambert", "--targets", "numpy", "--samples", "0"], "--samples 0"),
+        (["accuracy", "lambert", "--targets", "numpy", "--samples", "100"], "--samples 100 is outside 1 … 40"),
     ]
     for argv, message in cases:
         assert main(argv) == 1, argv

@@ -19,6 +19,7 @@ from pathlib import Path
 HELP = "error of every target × dtype against the float64 references: hemisphere and stress set (Markdown/JSON)"
 TARGETS = ("numpy", "glsl", "hlsl", "wgsl")
 DTYPES = ("float64", "float32", "float16")
+MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 s (K grows memory as K⁴)
 
 
 def add_arguments(p) -> None:
@@ -31,7 +32,7 @@ def add_arguments(p) -> None:
     p.add_argument("--format", choices=("md", "json"), default="md", help="report format (default md)")
     p.add_argument("--out", metavar="FILE", help="write the report to FILE (atomically) instead of stdout")
     p.add_argument("--samples", type=int, default=12, metavar="K",
-                   help="hemisphere strata per dimension: K⁴ (l, v) pairs (default 12)")
+                   help=f"hemisphere strata per dimension: K⁴ (l, v) pairs (default 12, at most {MAX_STRATA})")
     p.add_argument("--fail-above", type=float, metavar="TOL",
                    help="also exit 1 when a float32 hemisphere max relative error exceeds TOL")
     p.add_argument("--bricks", action="append", metavar="DIR", help="an extra brick directory (repeatable)")
@@ -56,8 +57,9 @@ def run(args) -> int:
     from ..runtime.device import VulkanUnavailable
 
     try:
-        if args.samples < 1:
-            raise ValueError(f"--samples {args.samples} — give a positive number of strata (e.g. 12)")
+        if not 1 <= args.samples <= MAX_STRATA:
+            raise ValueError(f"--samples {args.samples} is outside 1 … {MAX_STRATA} (K⁴ sample pairs) — "
+                             f"give a number of strata in that range (default 12)")
         dtypes = _list(args.dtypes, DTYPES, "dtype")
         notes = []
         if args.targets:
