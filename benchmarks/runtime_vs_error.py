@@ -157,10 +157,7 @@ def errors(spec: str, params: dict, lib, k: int) -> dict:
     # The exact model sees the unit directions nearest to the float32 ones the kernel sees.
     L, V, N, T = (x.astype(np.float32).astype(np.float64) for x in (L, V, N, T))
     unit = [x / np.linalg.norm(x, axis=1, keepdims=True) for x in (L, V, N, T)]
-    try:
-        exact = exact_brdf(spec, *unit, params, lib)
-    except ImportError as exc:  # generator/reference/ not there: time only
-        return {"unavailable": f"no float64 reference ({exc})"}
+    exact = exact_brdf(spec, *unit, params, lib)
     w = np.clip(np.sum(unit[0] * unit[2], 1), 0.0, None)[:, None]
 
     def rel_rms(f, ref):
@@ -262,8 +259,7 @@ def mark_pareto(report: dict) -> None:
     lang = report["langs"][0]
     groups: dict[str, list[dict]] = {}
     for r in report["rows"]:
-        if "gpu" in r["error"]:
-            groups.setdefault(r["exact"], []).append(r)
+        groups.setdefault(r["exact"], []).append(r)
     for rows in groups.values():
         front = pareto([(r["ratio"][lang], r["error"]["gpu"]["rel_rms"]) for r in rows])
         for r, f in zip(rows, front):
@@ -295,8 +291,7 @@ def markdown(report: dict) -> str:
     ]
     for r in report["rows"]:
         e = r["error"]
-        errs = (["n/a"] * 5 if "gpu" not in e else
-                [f"{e['gpu']['rel_rms']:.2e}", f"{e['gpu']['max_rel']:.2e}", f"{e['model']['rel_rms']:.2e}"]
+        errs = ([f"{e['gpu']['rel_rms']:.2e}", f"{e['gpu']['max_rel']:.2e}", f"{e['model']['rel_rms']:.2e}"]
                 + [f"{e[k]:.2e}" if k in e else "" for k in ("fresnel_only", "geometry_only")])
         lines.append(f"| `{r['spec']}` | {r['exact']} | "
                      + " | ".join(f"{r['time_ms'][l]:.2f}" for l in langs) + " | "
@@ -306,9 +301,6 @@ def markdown(report: dict) -> str:
     lines += ["", f"Spread of the paired ratios: median interquartile range {np.median(iqr):.2f} "
               f"(max {np.max(iqr):.2f}); differences in the `× Lambert` columns smaller than that are noise. "
               "Absolute times follow the machine's load; the ratios are paired to cancel it."]
-    if any("unavailable" in r["error"] for r in report["rows"]):
-        lines += ["", "Errors marked n/a: " + next(r["error"]["unavailable"] for r in report["rows"]
-                                                  if "unavailable" in r["error"])]
     return "\n".join(lines) + "\n"
 
 
@@ -321,8 +313,7 @@ def plot(report: dict, path: Path) -> None:
     lang = report["langs"][0]
     groups: dict[str, list[dict]] = {}
     for r in report["rows"]:
-        if "gpu" in r["error"]:
-            groups.setdefault(r["exact"], []).append(r)
+        groups.setdefault(r["exact"], []).append(r)
     multi = {k: v for k, v in groups.items() if len(v) > 1}
     if not multi:
         return
@@ -344,7 +335,7 @@ def plot(report: dict, path: Path) -> None:
         ax.set_xlabel(f"time × Lambert ({lang.upper()}, lavapipe)")
     axes[0][0].set_ylabel("error vs exact model (cosine-weighted relative RMS)")
     axes[0][0].legend(loc="lower left", fontsize=8)
-    exact_only = [r for r in report["rows"] if "gpu" in r["error"] and len(groups[r["exact"]]) == 1]
+    exact_only = [r for r in report["rows"] if len(groups[r["exact"]]) == 1]
     note = "Bricks without approximation (float32 error only): " + ", ".join(
         f"{r['spec']} ×{r['ratio'][lang]:.2f} ({r['error']['gpu']['rel_rms']:.0e})" for r in exact_only)
     fig.text(0.01, 0.01, note + f". Labels: Fresnel / geometry factor. {report['samples']:,} samples per dispatch.",

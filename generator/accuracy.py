@@ -158,11 +158,10 @@ def stress_params(declared: dict) -> list[dict]:
 def stress_sets(declared: dict) -> list[SampleSet]:
     """One SampleSet per parameter set, each holding every stress geometry in both frames."""
     L, V, labels = stress_geometry()
-    L2, V2 = np.concatenate([L, L]), np.concatenate([V, V])
     out = []
     for p in stress_params(declared):
         a = _framed("stress", p, L, V, labels, rotate=False)
-        b = _framed("stress", p, L2[len(L):], V2[len(V):], [f"{s} [rotated]" for s in labels], rotate=True)
+        b = _framed("stress", p, L, V, [f"{s} [rotated]" for s in labels], rotate=True)
         out.append(SampleSet("stress", p, *(np.concatenate([getattr(a, f), getattr(b, f)])
                                             for f in ("L", "V", "N", "T")), a.labels + b.labels))
     return out

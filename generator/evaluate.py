@@ -138,11 +138,8 @@ def _numpy_arg(ty, vals: list[float], dtype) -> np.ndarray:
 # ------------------------------------------------------------------ targets
 
 def _run_reference(ep: EvalProgram, vecs, values, n: int) -> np.ndarray:
-    try:
-        from .reference import reference_brdf
-    except ImportError:
-        raise EvalError("the float64 reference is not available (generator.reference.reference_brdf "
-                        "is missing)", "use --target numpy --dtype float64 meanwhile") from None
+    from .reference import reference_brdf
+
     ref_params = {k: (v[0] if ep.params[k].kind == "scalar" else list(v)) for k, v in values.items()}
     T = vecs[3] if len(vecs) > 3 else None
     out = reference_brdf(ep.spec, vecs[0], vecs[1], vecs[2], T=T, params=ref_params)
