@@ -267,11 +267,11 @@ def test_wgsl_line_map_covers_functions_and_statements(module):
 def test_reserved_words_are_renamed_identically_in_every_target(module):
     words = ["sampler", "texture", "input", "output", "half", "line", "filter", "fn", "let", "main", "gl_x"]
     for w in words:
-        assert {TARGETS[t].ident(w) for t in LANGS} == {w + "_r"}
+        assert {TARGETS[t].ident(w) for t in LANGS} == {"_r_" + w}
     for w in ["albedo", "NdotH", "rough", "acc"]:
         assert {TARGETS[t].ident(w) for t in LANGS} == {w}
     for w in reserved.GLSL | reserved.HLSL | reserved.WGSL:
-        assert TARGETS["glsl"].ident(w) == TARGETS["hlsl"].ident(w) == TARGETS["wgsl"].ident(w) == w + "_r"
+        assert TARGETS["glsl"].ident(w) == TARGETS["hlsl"].ident(w) == TARGETS["wgsl"].ident(w) == "_r_" + w
     declared = [s.name for s in ir.walk_body(module.functions["surface_term"].body) if isinstance(s, ir.Decl)]
     for lang in LANGS:
         text = emit(module, lang).text
@@ -322,25 +322,25 @@ def test_spellings_per_target():
 def test_texture_parameters_and_samples(module):
     f = module.functions["sample_albedo"]
     texts = {lang: emit(module, lang).text for lang in LANGS}
-    assert "vec4 sample_albedo(texture2D albedo_map, sampler albedo_map_smp, vec2 uv)" in texts["glsl"]
-    assert "texture(sampler2D(albedo_map, albedo_map_smp), uv)" in texts["glsl"]
-    assert "textureLod(sampler2D(albedo_map, albedo_map_smp), uv, lod)" in texts["glsl"]
-    assert "float4 sample_albedo(Texture2D albedo_map, SamplerState albedo_map_smp, float2 uv)" in texts["hlsl"]
-    assert "albedo_map.Sample(albedo_map_smp, uv)" in texts["hlsl"]
-    assert "albedo_map.SampleLevel(albedo_map_smp, uv, lod)" in texts["hlsl"]
-    assert ("fn sample_albedo(albedo_map: texture_2d<f32>, albedo_map_smp: sampler, uv: vec2<f32>) -> vec4<f32>"
+    assert "vec4 sample_albedo(texture2D albedo_map, sampler _smp_albedo_map, vec2 uv)" in texts["glsl"]
+    assert "texture(sampler2D(albedo_map, _smp_albedo_map), uv)" in texts["glsl"]
+    assert "textureLod(sampler2D(albedo_map, _smp_albedo_map), uv, lod)" in texts["glsl"]
+    assert "float4 sample_albedo(Texture2D albedo_map, SamplerState _smp_albedo_map, float2 uv)" in texts["hlsl"]
+    assert "albedo_map.Sample(_smp_albedo_map, uv)" in texts["hlsl"]
+    assert "albedo_map.SampleLevel(_smp_albedo_map, uv, lod)" in texts["hlsl"]
+    assert ("fn sample_albedo(albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, uv: vec2<f32>) -> vec4<f32>"
             in texts["wgsl"])
-    assert "textureSampleLevel(albedo_map, albedo_map_smp, uv, lod)" in texts["wgsl"]
-    assert "sample_lod(albedo_map, albedo_map_smp, uv, 1.0f)" in texts["wgsl"]
+    assert "textureSampleLevel(albedo_map, _smp_albedo_map, uv, lod)" in texts["wgsl"]
+    assert "sample_lod(albedo_map, _smp_albedo_map, uv, 1.0f)" in texts["wgsl"]
     assert f.params[0].ty == TEXTURE2D
     assert TARGETS["glsl"].declare_texture("sampler", 1, 4).splitlines() == [
-        "layout(set = 1, binding = 4) uniform texture2D sampler_r;",
-        "layout(set = 1, binding = 5) uniform sampler sampler_r_smp;"]
+        "layout(set = 1, binding = 4) uniform texture2D _r_sampler;",
+        "layout(set = 1, binding = 5) uniform sampler _smp_sampler;"]
     assert TARGETS["hlsl"].declare_texture("t", 1, 4).splitlines() == [
         "[[vk::binding(4, 1)]] Texture2D t : register(t4, space1);",
-        "[[vk::binding(5, 1)]] SamplerState t_smp : register(s5, space1);"]
+        "[[vk::binding(5, 1)]] SamplerState _smp_t : register(s5, space1);"]
     assert TARGETS["wgsl"].declare_texture("t", 1, 4).splitlines() == [
-        "@group(1) @binding(4) var t: texture_2d<f32>;", "@group(1) @binding(5) var t_smp: sampler;"]
+        "@group(1) @binding(4) var t: texture_2d<f32>;", "@group(1) @binding(5) var _smp_t: sampler;"]
 
 
 def test_hlsl_matrices_keep_glsl_column_semantics(module):
@@ -356,12 +356,12 @@ def test_hlsl_matrices_keep_glsl_column_semantics(module):
 
 def test_wgsl_assigned_parameters_are_copied(module):
     text = emit(module, "wgsl").text
-    assert "fn shade(x_in: f32, v_in: vec3<f32>, uv: vec2<f32>," in text
-    assert "    var x: f32 = x_in;\n    var v: vec3<f32> = v_in;\n" in text
-    assert "fn surface_term(sfc_in: Surface, input_r_in: f32)" in text
+    assert "fn shade(_in_x: f32, _in_v: vec3<f32>, uv: vec2<f32>," in text
+    assert "    var x: f32 = _in_x;\n    var v: vec3<f32> = _in_v;\n" in text
+    assert "fn surface_term(_in_sfc: Surface, _in_input: f32)" in text
     clash = parse_module('BRICK = {}\ndef f(a: float) -> float:\n    a_in = 1.0\n    a = a_in\n    return a\n', "t.py")
     out = get_target("wgsl").emit([], list(clash.functions.values())).text
-    assert "fn f(a_in_: f32) -> f32 {\n    var a: f32 = a_in_;\n    var a_in: f32 = 1.0f;" in out
+    assert "fn f(_in_a: f32) -> f32 {\n    var a: f32 = _in_a;\n    var a_in: f32 = 1.0f;" in out
 
 
 def test_header_and_line_reset():

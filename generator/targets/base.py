@@ -32,8 +32,8 @@ class Target(ABC):
     reserved: frozenset[str] = frozenset()
 
     def ident(self, name: str) -> str:
-        """A brick identifier as spelled in this target (reserved words get a trailing '_r')."""
-        return name + "_r" if name in self.reserved else name
+        """A brick identifier as spelled in this target (reserved words get the prefix '_r_')."""
+        return "_r_" + name if name in self.reserved else name
 
     @abstractmethod
     def type_name(self, t: Type) -> str:

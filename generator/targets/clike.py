@@ -17,7 +17,6 @@ from . import reserved
 from .base import Emitted, Target
 
 INDENT = "    "
-SAMPLER_SUFFIX = "_smp"
 
 
 class Writer:
@@ -80,20 +79,21 @@ class CLikeTarget(Target):
     INT_SUFFIX = ""
     UINT_SUFFIX = "u"
     BINARY_OPS = {"and": "&&", "or": "||"}
+    SIGNED_MOD_BY_DIVISION = True   # write signed int % as a - b*(a/b) (see expr_binary)
     UNARY_OPS = {"-": "-", "not": "!"}
     # intrinsic -> format over {0}, {1}, ... (texture args also give {smp}); missing = same name
     INTRINSICS: dict[str, str] = {}
 
     # ------------------------------------------------------------ public interface
     def ident(self, name: str) -> str:
-        """A brick identifier as spelled in every C-like target (reserved words get '_r')."""
+        """A brick identifier as spelled in every C-like target (reserved words get the prefix '_r_')."""
         if name in self.reserved or name.startswith(reserved.RESERVED_PREFIXES):
-            return name + reserved.SUFFIX
+            return reserved.PREFIX + name
         return name
 
     def sampler_name(self, texture: str) -> str:
-        """The sampler that travels with texture `texture` (HLSL and WGSL)."""
-        return self.ident(texture) + SAMPLER_SUFFIX
+        """The sampler that travels with texture `texture` ('_smp_' + its brick name: never a brick's name)."""
+        return reserved.SAMPLER_PREFIX + texture
 
     def header(self) -> str:
         """Preamble lines the source needs before any emitted code ("" if none)."""
@@ -262,6 +262,12 @@ class CLikeTarget(Target):
         return f"({self.UNARY_OPS[e.op]}{self.expr(e.operand)})"
 
     def expr_binary(self, e: ir.Binary) -> str:
+        if e.op == "%" and e.ty.scalar == "int" and self.SIGNED_MOD_BY_DIVISION:
+            # glslang compiles a signed % to OpSMod (the sign of the divisor), which spirv-opt
+            # folds one way and drivers compute another; a - b*(a/b) is the truncated remainder
+            # (the sign of the dividend), as WGSL's % and the numpy target's fmod.
+            a, b = self.expr(e.lhs), self.expr(e.rhs)
+            return f"({a} - ({b} * ({a} / {b})))"
         op = self.BINARY_OPS.get(e.op, e.op)
         return f"({self.expr(e.lhs)} {op} {self.expr(e.rhs)})"
 

@@ -24,6 +24,12 @@ def _shapes(prefixes, sizes=(2, 3, 4), matrices=False) -> frozenset[str]:
     return frozenset(out)
 
 
+def _image_types() -> frozenset[str]:
+    """GLSL's i/u prefixed texture and image types in every dimension (itexture3D, uimageCubeArray, ...)."""
+    dims = ("1D", "2D", "3D", "Cube", "2DRect", "Buffer", "1DArray", "2DArray", "CubeArray", "2DMS", "2DMSArray")
+    return frozenset(f"{p}{kind}{d}" for p in ("i", "u") for kind in ("texture", "image") for d in dims)
+
+
 # GLSL 4.60 §3.6 keywords and reserved words, GL_KHR_vulkan_glsl types, and
 # glslang extension type keywords (float16_t, f16vec3, ...).
 _GLSL_KEYWORDS = _words("""
@@ -51,7 +57,8 @@ _GLSL_KEYWORDS = _words("""
     superp input output filter sizeof cast namespace using sampler3DRect
     float16_t float32_t float64_t int8_t int16_t int32_t int64_t
     uint8_t uint16_t uint32_t uint64_t main
-""") | _shapes(("vec", "ivec", "uvec", "bvec", "dvec", "hvec", "fvec", "f16vec", "f32vec",
+    subpassInputMS isubpassInputMS usubpassInputMS shadercallcoherent pervertexEXT pervertexNV
+""") | _image_types() | _shapes(("vec", "ivec", "uvec", "bvec", "dvec", "hvec", "fvec", "f16vec", "f32vec",
                 "f64vec", "i8vec", "i16vec", "i32vec", "i64vec", "u8vec", "u16vec", "u32vec",
                 "u64vec")) | _shapes(("mat", "dmat", "f16mat", "f32mat", "f64mat"), matrices=True)
 
@@ -83,7 +90,7 @@ _GLSL_BUILTINS = _words("""
 # HLSL keywords and reserved words (FXC and DXC), intrinsics, and the object
 # and vector/matrix type names (float3, half4x4, min16float2, ...).
 _HLSL_KEYWORDS = _words("""
-    AppendStructuredBuffer asm asm_fragment BlendState bool break Buffer ByteAddressBuffer case
+    AppendStructuredBuffer SubpassInput SubpassInputMS TextureBuffer asm asm_fragment BlendState bool break Buffer ByteAddressBuffer case
     cbuffer centroid class column_major compile compile_fragment CompileShader const continue
     ComputeShader ConsumeStructuredBuffer default DepthStencilState DepthStencilView discard do
     double DomainShader dword else export extern false float for fxgroup GeometryShader
@@ -183,4 +190,8 @@ ALL: frozenset[str] = GLSL | HLSL | WGSL
 
 # GLSL reserves every identifier that starts with this prefix.
 RESERVED_PREFIXES: tuple[str, ...] = ("gl_",)
-SUFFIX = "_r"
+# A reserved brick identifier is spelled with this prefix in every target. Brick
+# identifiers never start with '_' (generator/lang/exprs.py), so a renamed name
+# cannot meet a brick's own name; the same holds for SAMPLER_PREFIX.
+PREFIX = "_r_"
+SAMPLER_PREFIX = "_smp_"

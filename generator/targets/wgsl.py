@@ -5,7 +5,7 @@ from ..lang import ir
 from ..lang.types import Type
 from .clike import CLikeTarget, Writer
 
-PARAM_COPY_SUFFIX = "_in"
+PARAM_COPY_PREFIX = "_in_"
 
 
 class WgslTarget(CLikeTarget):
@@ -19,6 +19,7 @@ class WgslTarget(CLikeTarget):
     TEXTURE = "texture_2d<f32>"
     SAMPLER = "sampler"
     # Typed literals keep constant folding in f32/i32, as GLSL and HLSL do (abstract numbers fold in f64).
+    SIGNED_MOD_BY_DIVISION = False  # WGSL's % on i32 already truncates
     FLOAT_SUFFIX = "f"
     INT_SUFFIX = "i"
     INTRINSICS = {
@@ -47,7 +48,7 @@ class WgslTarget(CLikeTarget):
 
     # ------------------------------------------------------------ functions
     def param_list(self, f: ir.Function) -> list[str]:
-        copies = _param_copies(f, self.ident)
+        copies = _param_copies(f)
         out = []
         for p in f.params:
             out += [self.var_decl(copies[p.name], p.ty)] if p.name in copies else self.params(p)
@@ -58,7 +59,7 @@ class WgslTarget(CLikeTarget):
 
     def prologue(self, w: Writer, f: ir.Function) -> None:
         """WGSL parameters are immutable: an assigned one is copied into a var of its name."""
-        copies = _param_copies(f, self.ident)
+        copies = _param_copies(f)
         for p in f.params:
             if p.name in copies:
                 w.line(self.decl(self.ident(p.name), p.ty, copies[p.name]), f.loc)
@@ -84,17 +85,6 @@ class WgslTarget(CLikeTarget):
         return f"select({if_false}, {if_true}, {cond})"
 
 
-def _param_copies(f: ir.Function, ident) -> dict[str, str]:
-    """Signature names for assigned parameters: `<name>_in`, plus '_' while that is taken."""
-    taken = {ident(p.name) for p in f.params}
-    taken |= {ident(s.name) for s in ir.walk_body(f.body) if isinstance(s, ir.Decl)}
-    taken |= {ident(s.var) for s in ir.walk_body(f.body) if isinstance(s, ir.For)}
-    out = {}
-    for p in f.params:
-        if p.assigned:
-            name = ident(p.name) + PARAM_COPY_SUFFIX
-            while name in taken:
-                name += "_"
-            taken.add(name)
-            out[p.name] = name
-    return out
+def _param_copies(f: ir.Function) -> dict[str, str]:
+    """Signature names for assigned parameters: '_in_' + the brick name (brick names never start with '_')."""
+    return {p.name: PARAM_COPY_PREFIX + p.name for p in f.params if p.assigned}

@@ -22,7 +22,7 @@ layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 ca
 layout(set = 0, binding = 1) uniform Lights { vec4 data[9]; } lights;
 layout(set = 1, binding = 0) uniform Material { vec4 data[2]; } material;
 layout(set = 0, binding = 2) uniform texture2D l0_shadow_map;
-layout(set = 0, binding = 3) uniform sampler l0_shadow_map_smp;
+layout(set = 0, binding = 3) uniform sampler _smp_l0_shadow_map;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 0) out vec4 out_color;
@@ -75,12 +75,12 @@ vec3 directional_light_radiance(vec3 P, vec3 color) {
 }
 
 #line 18 "bricks/shadow/shadow_map.py"
-float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, texture2D shadow_map, sampler shadow_map_smp) {
+float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, texture2D shadow_map, sampler _smp_shadow_map) {
     vec4 c = (shadow_matrix * vec4(P, 1.0));
 #line 21 "bricks/shadow/shadow_map.py"
     vec3 p = (c.xyz / max(c.w, 1e-06));
     vec2 uv = ((p.xy * 0.5) + vec2(0.5));
-    float stored = textureLod(sampler2D(shadow_map, shadow_map_smp), uv, 0.0).x;
+    float stored = textureLod(sampler2D(shadow_map, _smp_shadow_map), uv, 0.0).x;
     return mix(0.0, 1.0, ((p.z - shadow_bias) <= stored));
 }
 
@@ -118,14 +118,14 @@ vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
-vec4 shade(vec3 P, vec3 Ng, vec3 V, float m_alpha, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D l0_shadow_map, sampler l0_shadow_map_smp) {
+vec4 shade(vec3 P, vec3 Ng, vec3 V, float m_alpha, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D l0_shadow_map, sampler _smp_l0_shadow_map) {
     vec3 N = vertex_normal(Ng);
     vec3 Lo = vec3(0.0);
     vec3 L0 = directional_light_dir(P, l0_direction);
     float NdotL0 = dot(N, L0);
     if (NdotL0 > 0.0) {
         vec3 c0 = directional_light_radiance(P, l0_color);
-        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
+        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
 #line 25 "<glue>"
@@ -146,5 +146,5 @@ void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);
     vec3 V = normalize(frame.camera_pos.xyz - P);
-    out_color = shade(P, Ng, V, material.data[0].x, material.data[1].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, l0_shadow_map, l0_shadow_map_smp);
+    out_color = shade(P, Ng, V, material.data[0].x, material.data[1].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, l0_shadow_map, _smp_l0_shadow_map);
 }

@@ -23,11 +23,11 @@ layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 ca
 layout(set = 0, binding = 1) uniform Lights { vec4 data[9]; } lights;
 layout(set = 1, binding = 0) uniform Material { vec4 data[3]; } material;
 layout(set = 1, binding = 1) uniform texture2D t_albedo_map;
-layout(set = 1, binding = 2) uniform sampler t_albedo_map_smp;
+layout(set = 1, binding = 2) uniform sampler _smp_t_albedo_map;
 layout(set = 1, binding = 3) uniform texture2D t_normal_map;
-layout(set = 1, binding = 4) uniform sampler t_normal_map_smp;
+layout(set = 1, binding = 4) uniform sampler _smp_t_normal_map;
 layout(set = 0, binding = 2) uniform texture2D l0_shadow_map;
-layout(set = 0, binding = 3) uniform sampler l0_shadow_map_smp;
+layout(set = 0, binding = 3) uniform sampler _smp_l0_shadow_map;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec4 v_tangent;
@@ -72,14 +72,14 @@ vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, floa
 }
 
 #line 12 "bricks/packing/normal/normal_map.py"
-vec3 normal_map_normal(vec3 N, vec3 T, vec3 B, vec2 uv, texture2D normal_map, sampler normal_map_smp) {
-    vec3 t = ((texture(sampler2D(normal_map, normal_map_smp), uv).xyz * 2.0) - vec3(1.0));
+vec3 normal_map_normal(vec3 N, vec3 T, vec3 B, vec2 uv, texture2D normal_map, sampler _smp_normal_map) {
+    vec3 t = ((texture(sampler2D(normal_map, _smp_normal_map), uv).xyz * 2.0) - vec3(1.0));
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
-vec3 albedo_texture_get_rho_d(vec2 uv, texture2D albedo_map, sampler albedo_map_smp, vec3 rho_d) {
-    return (rho_d * texture(sampler2D(albedo_map, albedo_map_smp), uv).xyz);
+vec3 albedo_texture_get_rho_d(vec2 uv, texture2D albedo_map, sampler _smp_albedo_map, vec3 rho_d) {
+    return (rho_d * texture(sampler2D(albedo_map, _smp_albedo_map), uv).xyz);
 }
 
 #line 17 "bricks/light/directional.py"
@@ -92,12 +92,12 @@ vec3 directional_light_radiance(vec3 P, vec3 color) {
 }
 
 #line 18 "bricks/shadow/shadow_map.py"
-float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, texture2D shadow_map, sampler shadow_map_smp) {
+float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, texture2D shadow_map, sampler _smp_shadow_map) {
     vec4 c = (shadow_matrix * vec4(P, 1.0));
 #line 21 "bricks/shadow/shadow_map.py"
     vec3 p = (c.xyz / max(c.w, 1e-06));
     vec2 uv = ((p.xy * 0.5) + vec2(0.5));
-    float stored = textureLod(sampler2D(shadow_map, shadow_map_smp), uv, 0.0).x;
+    float stored = textureLod(sampler2D(shadow_map, _smp_shadow_map), uv, 0.0).x;
     return mix(0.0, 1.0, ((p.z - shadow_bias) <= stored));
 }
 
@@ -135,15 +135,15 @@ vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
     return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
-vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D t_albedo_map, sampler t_albedo_map_smp, texture2D t_normal_map, sampler t_normal_map_smp, texture2D l0_shadow_map, sampler l0_shadow_map_smp) {
-    vec3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, t_albedo_map_smp, m_rho_d);
-    vec3 N = normal_map_normal(Ng, T, B, uv, t_normal_map, t_normal_map_smp);
+vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D t_albedo_map, sampler _smp_t_albedo_map, texture2D t_normal_map, sampler _smp_t_normal_map, texture2D l0_shadow_map, sampler _smp_l0_shadow_map) {
+    vec3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    vec3 N = normal_map_normal(Ng, T, B, uv, t_normal_map, _smp_t_normal_map);
     vec3 Lo = vec3(0.0);
     vec3 L0 = directional_light_dir(P, l0_direction);
     float NdotL0 = dot(N, L0);
     if (NdotL0 > 0.0) {
         vec3 c0 = directional_light_radiance(P, l0_color);
-        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
+        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
 #line 26 "<glue>"
@@ -167,5 +167,5 @@ void main() {
     vec3 T = normalize(v_tangent.xyz);
     vec3 B = cross(Ng, T) * v_tangent.w;
     vec2 uv = v_uv;
-    out_color = shade(P, Ng, V, T, B, uv, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, t_albedo_map, t_albedo_map_smp, t_normal_map, t_normal_map_smp, l0_shadow_map, l0_shadow_map_smp);
+    out_color = shade(P, Ng, V, T, B, uv, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, t_albedo_map, _smp_t_albedo_map, t_normal_map, _smp_t_normal_map, l0_shadow_map, _smp_l0_shadow_map);
 }

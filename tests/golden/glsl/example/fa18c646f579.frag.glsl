@@ -20,9 +20,9 @@ layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 ca
 layout(set = 0, binding = 1) uniform Lights { vec4 data[9]; } lights;
 layout(set = 1, binding = 0) uniform Material { vec4 data[3]; } material;
 layout(set = 1, binding = 1) uniform texture2D t_albedo_map;
-layout(set = 1, binding = 2) uniform sampler t_albedo_map_smp;
+layout(set = 1, binding = 2) uniform sampler _smp_t_albedo_map;
 layout(set = 0, binding = 2) uniform texture2D l0_shadow_map;
-layout(set = 0, binding = 3) uniform sampler l0_shadow_map_smp;
+layout(set = 0, binding = 3) uniform sampler _smp_l0_shadow_map;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 3) in vec2 v_uv;
@@ -45,8 +45,8 @@ vec3 vertex_normal(vec3 N) {
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
-vec3 albedo_texture_get_rho_d(vec2 uv, texture2D albedo_map, sampler albedo_map_smp, vec3 rho_d) {
-    return (rho_d * texture(sampler2D(albedo_map, albedo_map_smp), uv).xyz);
+vec3 albedo_texture_get_rho_d(vec2 uv, texture2D albedo_map, sampler _smp_albedo_map, vec3 rho_d) {
+    return (rho_d * texture(sampler2D(albedo_map, _smp_albedo_map), uv).xyz);
 }
 
 #line 17 "bricks/light/directional.py"
@@ -59,12 +59,12 @@ vec3 directional_light_radiance(vec3 P, vec3 color) {
 }
 
 #line 18 "bricks/shadow/shadow_map.py"
-float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, texture2D shadow_map, sampler shadow_map_smp) {
+float shadow_map_shadow(vec3 P, mat4 shadow_matrix, float shadow_bias, texture2D shadow_map, sampler _smp_shadow_map) {
     vec4 c = (shadow_matrix * vec4(P, 1.0));
 #line 21 "bricks/shadow/shadow_map.py"
     vec3 p = (c.xyz / max(c.w, 1e-06));
     vec2 uv = ((p.xy * 0.5) + vec2(0.5));
-    float stored = textureLod(sampler2D(shadow_map, shadow_map_smp), uv, 0.0).x;
+    float stored = textureLod(sampler2D(shadow_map, _smp_shadow_map), uv, 0.0).x;
     return mix(0.0, 1.0, ((p.z - shadow_bias) <= stored));
 }
 
@@ -95,15 +95,15 @@ vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
     return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
 }
 
-vec4 shade(vec3 P, vec3 Ng, vec3 V, vec2 uv, vec3 m_rho_d, float m_n, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D t_albedo_map, sampler t_albedo_map_smp, texture2D l0_shadow_map, sampler l0_shadow_map_smp) {
-    vec3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, t_albedo_map_smp, m_rho_d);
+vec4 shade(vec3 P, vec3 Ng, vec3 V, vec2 uv, vec3 m_rho_d, float m_n, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D t_albedo_map, sampler _smp_t_albedo_map, texture2D l0_shadow_map, sampler _smp_l0_shadow_map) {
+    vec3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     vec3 N = vertex_normal(Ng);
     vec3 Lo = vec3(0.0);
     vec3 L0 = directional_light_dir(P, l0_direction);
     float NdotL0 = dot(N, L0);
     if (NdotL0 > 0.0) {
         vec3 c0 = directional_light_radiance(P, l0_color);
-        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
+        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
 #line 19 "<glue>"
@@ -125,5 +125,5 @@ void main() {
     vec3 Ng = normalize(v_normal);
     vec3 V = normalize(frame.camera_pos.xyz - P);
     vec2 uv = v_uv;
-    out_color = shade(P, Ng, V, uv, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, t_albedo_map, t_albedo_map_smp, l0_shadow_map, l0_shadow_map_smp);
+    out_color = shade(P, Ng, V, uv, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, t_albedo_map, _smp_t_albedo_map, l0_shadow_map, _smp_l0_shadow_map);
 }

@@ -20,7 +20,7 @@ cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float
 cbuffer Lights : register(b1, space0) { float4 lights_data[9]; };
 cbuffer Material : register(b0, space1) { float4 material_data[2]; };
 [[vk::binding(2, 0)]] Texture2D l0_shadow_map : register(t2, space0);
-[[vk::binding(3, 0)]] SamplerState l0_shadow_map_smp : register(s3, space0);
+[[vk::binding(3, 0)]] SamplerState _smp_l0_shadow_map : register(s3, space0);
 
 struct PSIn {
     [[vk::location(0)]] float3 v_position : TEXCOORD0;
@@ -75,12 +75,12 @@ float3 directional_light_radiance(float3 P, float3 color) {
 }
 
 #line 18 "bricks/shadow/shadow_map.py"
-float shadow_map_shadow(float3 P, float4x4 shadow_matrix, float shadow_bias, Texture2D shadow_map, SamplerState shadow_map_smp) {
+float shadow_map_shadow(float3 P, float4x4 shadow_matrix, float shadow_bias, Texture2D shadow_map, SamplerState _smp_shadow_map) {
     float4 c = mul(shadow_matrix, float4(P, 1.0));
 #line 21 "bricks/shadow/shadow_map.py"
     float3 p = (c.xyz / max(c.w, 1e-06));
     float2 uv = ((p.xy * 0.5) + ((float2)(0.5)));
-    float stored = shadow_map.SampleLevel(shadow_map_smp, uv, 0.0).x;
+    float stored = shadow_map.SampleLevel(_smp_shadow_map, uv, 0.0).x;
     return (((p.z - shadow_bias) <= stored) ? 1.0 : 0.0);
 }
 
@@ -118,14 +118,14 @@ float3 brdf_lit(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
-float4 shade(float3 P, float3 Ng, float3 V, float m_alpha, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D l0_shadow_map, SamplerState l0_shadow_map_smp) {
+float4 shade(float3 P, float3 Ng, float3 V, float m_alpha, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D l0_shadow_map, SamplerState _smp_l0_shadow_map) {
     float3 N = vertex_normal(Ng);
     float3 Lo = ((float3)(0.0));
     float3 L0 = directional_light_dir(P, l0_direction);
     float NdotL0 = dot(N, L0);
     if (NdotL0 > 0.0) {
         float3 c0 = directional_light_radiance(P, l0_color);
-        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
+        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
 #line 25 "<glue>"
@@ -146,5 +146,5 @@ float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);
     float3 V = normalize(camera_pos.xyz - P);
-    return shade(P, Ng, V, material_data[0].x, material_data[1].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[6].x, lights_data[7].xyz, lights_data[8].xyz, l0_shadow_map, l0_shadow_map_smp);
+    return shade(P, Ng, V, material_data[0].x, material_data[1].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[6].x, lights_data[7].xyz, lights_data[8].xyz, l0_shadow_map, _smp_l0_shadow_map);
 }

@@ -21,11 +21,11 @@ cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float
 cbuffer Lights : register(b1, space0) { float4 lights_data[9]; };
 cbuffer Material : register(b0, space1) { float4 material_data[3]; };
 [[vk::binding(1, 1)]] Texture2D t_albedo_map : register(t1, space1);
-[[vk::binding(2, 1)]] SamplerState t_albedo_map_smp : register(s2, space1);
+[[vk::binding(2, 1)]] SamplerState _smp_t_albedo_map : register(s2, space1);
 [[vk::binding(3, 1)]] Texture2D t_normal_map : register(t3, space1);
-[[vk::binding(4, 1)]] SamplerState t_normal_map_smp : register(s4, space1);
+[[vk::binding(4, 1)]] SamplerState _smp_t_normal_map : register(s4, space1);
 [[vk::binding(2, 0)]] Texture2D l0_shadow_map : register(t2, space0);
-[[vk::binding(3, 0)]] SamplerState l0_shadow_map_smp : register(s3, space0);
+[[vk::binding(3, 0)]] SamplerState _smp_l0_shadow_map : register(s3, space0);
 
 struct PSIn {
     [[vk::location(0)]] float3 v_position : TEXCOORD0;
@@ -72,14 +72,14 @@ float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, fl
 }
 
 #line 12 "bricks/packing/normal/normal_map.py"
-float3 normal_map_normal(float3 N, float3 T, float3 B, float2 uv, Texture2D normal_map, SamplerState normal_map_smp) {
-    float3 t = ((normal_map.Sample(normal_map_smp, uv).xyz * 2.0) - ((float3)(1.0)));
+float3 normal_map_normal(float3 N, float3 T, float3 B, float2 uv, Texture2D normal_map, SamplerState _smp_normal_map) {
+    float3 t = ((normal_map.Sample(_smp_normal_map, uv).xyz * 2.0) - ((float3)(1.0)));
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
-float3 albedo_texture_get_rho_d(float2 uv, Texture2D albedo_map, SamplerState albedo_map_smp, float3 rho_d) {
-    return (rho_d * albedo_map.Sample(albedo_map_smp, uv).xyz);
+float3 albedo_texture_get_rho_d(float2 uv, Texture2D albedo_map, SamplerState _smp_albedo_map, float3 rho_d) {
+    return (rho_d * albedo_map.Sample(_smp_albedo_map, uv).xyz);
 }
 
 #line 17 "bricks/light/directional.py"
@@ -92,12 +92,12 @@ float3 directional_light_radiance(float3 P, float3 color) {
 }
 
 #line 18 "bricks/shadow/shadow_map.py"
-float shadow_map_shadow(float3 P, float4x4 shadow_matrix, float shadow_bias, Texture2D shadow_map, SamplerState shadow_map_smp) {
+float shadow_map_shadow(float3 P, float4x4 shadow_matrix, float shadow_bias, Texture2D shadow_map, SamplerState _smp_shadow_map) {
     float4 c = mul(shadow_matrix, float4(P, 1.0));
 #line 21 "bricks/shadow/shadow_map.py"
     float3 p = (c.xyz / max(c.w, 1e-06));
     float2 uv = ((p.xy * 0.5) + ((float2)(0.5)));
-    float stored = shadow_map.SampleLevel(shadow_map_smp, uv, 0.0).x;
+    float stored = shadow_map.SampleLevel(_smp_shadow_map, uv, 0.0).x;
     return (((p.z - shadow_bias) <= stored) ? 1.0 : 0.0);
 }
 
@@ -135,15 +135,15 @@ float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float alpha, float3 
     return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
-float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float3 m_rho_d, float m_alpha, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D t_albedo_map, SamplerState t_albedo_map_smp, Texture2D t_normal_map, SamplerState t_normal_map_smp, Texture2D l0_shadow_map, SamplerState l0_shadow_map_smp) {
-    float3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, t_albedo_map_smp, m_rho_d);
-    float3 N = normal_map_normal(Ng, T, B, uv, t_normal_map, t_normal_map_smp);
+float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float3 m_rho_d, float m_alpha, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D t_albedo_map, SamplerState _smp_t_albedo_map, Texture2D t_normal_map, SamplerState _smp_t_normal_map, Texture2D l0_shadow_map, SamplerState _smp_l0_shadow_map) {
+    float3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    float3 N = normal_map_normal(Ng, T, B, uv, t_normal_map, _smp_t_normal_map);
     float3 Lo = ((float3)(0.0));
     float3 L0 = directional_light_dir(P, l0_direction);
     float NdotL0 = dot(N, L0);
     if (NdotL0 > 0.0) {
         float3 c0 = directional_light_radiance(P, l0_color);
-        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
+        float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
 #line 26 "<glue>"
@@ -167,5 +167,5 @@ float4 main(PSIn i) : SV_Target0 {
     float3 T = normalize(i.v_tangent.xyz);
     float3 B = cross(Ng, T) * i.v_tangent.w;
     float2 uv = i.v_uv;
-    return shade(P, Ng, V, T, B, uv, material_data[0].xyz, material_data[1].x, material_data[2].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[6].x, lights_data[7].xyz, lights_data[8].xyz, t_albedo_map, t_albedo_map_smp, t_normal_map, t_normal_map_smp, l0_shadow_map, l0_shadow_map_smp);
+    return shade(P, Ng, V, T, B, uv, material_data[0].xyz, material_data[1].x, material_data[2].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[6].x, lights_data[7].xyz, lights_data[8].xyz, t_albedo_map, _smp_t_albedo_map, t_normal_map, _smp_t_normal_map, l0_shadow_map, _smp_l0_shadow_map);
 }

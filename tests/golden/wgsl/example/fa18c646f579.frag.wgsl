@@ -21,9 +21,9 @@ struct Lights { data: array<vec4<f32>, 9> }
 struct Material { data: array<vec4<f32>, 3> }
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var t_albedo_map: texture_2d<f32>;
-@group(1) @binding(2) var t_albedo_map_smp: sampler;
+@group(1) @binding(2) var _smp_t_albedo_map: sampler;
 @group(0) @binding(2) var l0_shadow_map: texture_2d<f32>;
-@group(0) @binding(3) var l0_shadow_map_smp: sampler;
+@group(0) @binding(3) var _smp_l0_shadow_map: sampler;
 
 fn lambert_diffuse(rho_d: vec3<f32>) -> vec3<f32> {
     return (rho_d * 0.3183098861837907f);
@@ -37,8 +37,8 @@ fn vertex_normal(N: vec3<f32>) -> vec3<f32> {
     return N;
 }
 
-fn albedo_texture_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, albedo_map_smp: sampler, rho_d: vec3<f32>) -> vec3<f32> {
-    return (rho_d * textureSample(albedo_map, albedo_map_smp, uv).xyz);
+fn albedo_texture_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, rho_d: vec3<f32>) -> vec3<f32> {
+    return (rho_d * textureSample(albedo_map, _smp_albedo_map, uv).xyz);
 }
 
 fn directional_light_dir(P: vec3<f32>, direction: vec3<f32>) -> vec3<f32> {
@@ -49,11 +49,11 @@ fn directional_light_radiance(P: vec3<f32>, color: vec3<f32>) -> vec3<f32> {
     return color;
 }
 
-fn shadow_map_shadow(P: vec3<f32>, shadow_matrix: mat4x4<f32>, shadow_bias: f32, shadow_map: texture_2d<f32>, shadow_map_smp: sampler) -> f32 {
+fn shadow_map_shadow(P: vec3<f32>, shadow_matrix: mat4x4<f32>, shadow_bias: f32, shadow_map: texture_2d<f32>, _smp_shadow_map: sampler) -> f32 {
     var c: vec4<f32> = (shadow_matrix * vec4<f32>(P, 1.0f));
     var p: vec3<f32> = (c.xyz / max(c.w, 1e-06f));
     var uv: vec2<f32> = ((p.xy * 0.5f) + vec2<f32>(0.5f));
-    var stored: f32 = textureSampleLevel(shadow_map, shadow_map_smp, uv, 0.0f).x;
+    var stored: f32 = textureSampleLevel(shadow_map, _smp_shadow_map, uv, 0.0f).x;
     return select(0.0f, 1.0f, ((p.z - shadow_bias) <= stored));
 }
 
@@ -79,15 +79,15 @@ fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, 
     return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
 }
 
-fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, uv: vec2<f32>, m_rho_d: vec3<f32>, m_n: f32, m_f0: vec3<f32>, l0_direction: vec3<f32>, l0_color: vec3<f32>, l0_shadow_matrix: mat4x4<f32>, l0_shadow_bias: f32, l1_position: vec3<f32>, l1_color: vec3<f32>, t_albedo_map: texture_2d<f32>, t_albedo_map_smp: sampler, l0_shadow_map: texture_2d<f32>, l0_shadow_map_smp: sampler) -> vec4<f32> {
-    var p_rho_d: vec3<f32> = albedo_texture_get_rho_d(uv, t_albedo_map, t_albedo_map_smp, m_rho_d);
+fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, uv: vec2<f32>, m_rho_d: vec3<f32>, m_n: f32, m_f0: vec3<f32>, l0_direction: vec3<f32>, l0_color: vec3<f32>, l0_shadow_matrix: mat4x4<f32>, l0_shadow_bias: f32, l1_position: vec3<f32>, l1_color: vec3<f32>, t_albedo_map: texture_2d<f32>, _smp_t_albedo_map: sampler, l0_shadow_map: texture_2d<f32>, _smp_l0_shadow_map: sampler) -> vec4<f32> {
+    var p_rho_d: vec3<f32> = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     var N: vec3<f32> = vertex_normal(Ng);
     var Lo: vec3<f32> = vec3<f32>(0.0f);
     var L0: vec3<f32> = directional_light_dir(P, l0_direction);
     var NdotL0: f32 = dot(N, L0);
     if (NdotL0 > 0.0f) {
         var c0: vec3<f32> = directional_light_radiance(P, l0_color);
-        var s0: f32 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, l0_shadow_map_smp);
+        var s0: f32 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793f * brdf_lit(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     var L1: vec3<f32> = point_light_dir(P, l1_position);
@@ -107,5 +107,5 @@ fn main(@location(0) v_position: vec3<f32>, @location(1) v_normal: vec3<f32>, @l
     let Ng = normalize(v_normal);
     let V = normalize(frame.camera_pos.xyz - P);
     let uv = v_uv;
-    return shade(P, Ng, V, uv, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4x4<f32>(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, t_albedo_map, t_albedo_map_smp, l0_shadow_map, l0_shadow_map_smp);
+    return shade(P, Ng, V, uv, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4x4<f32>(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, t_albedo_map, _smp_t_albedo_map, l0_shadow_map, _smp_l0_shadow_map);
 }
