@@ -41,7 +41,6 @@ import math
 import os
 import platform
 import sys
-from itertools import product
 from pathlib import Path
 
 import numpy as np
@@ -49,21 +48,13 @@ import numpy as np
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
-LANGS = ("glsl", "hlsl", "wgsl")
-REL_FLOOR = 1e-6  # sr⁻¹: below this an error is measured relative to 1e-6 (as in generator/accuracy.py)
+from generator import GPU_TARGETS as LANGS  # noqa: E402 (after the path)
+from generator.accuracy import REL_FLOOR, default_specs, hemisphere  # noqa: E402
+
 BASELINE = "lambert"
 
 
 # ------------------------------------------------------------------ what is measured
-
-def kernel_specs(lib) -> list[str]:
-    """Each diffuse and specular brick; slotted bricks with every combination of fillers."""
-    specs = [b.id for b in lib.of_kind("diffuse")]
-    for b in lib.of_kind("specular"):
-        choices = [[f"{s}={f.id}" for f in lib.of_kind(slot["kind"])] for s, slot in b.slots.items()]
-        specs += [f"{b.id}({','.join(c)})" if c else b.id for c in product(*choices)]
-    return specs
-
 
 def exact_model(node) -> str:
     """What a term is compared with (for the table)."""
@@ -113,22 +104,6 @@ def exact_brdf(spec: str, L, V, N, T, params: dict, lib, keep: str = "") -> np.n
     return total
 
 
-def hemisphere_pairs(k: int, seed: int):
-    """(L, V, N, T): a jittered k⁴ grid in (cos θ_l, φ_l, cos θ_v, φ_v), N = z, T = x."""
-    rng = np.random.default_rng(seed)
-    cells = np.stack(np.meshgrid(*(np.arange(k),) * 4, indexing="ij"), -1).reshape(-1, 4)
-    u = (cells + rng.random(cells.shape)) / k
-
-    def direction(c, phi):
-        s = np.sqrt((1.0 - c) * (1.0 + c))
-        return np.stack([s * np.cos(phi), s * np.sin(phi), c], -1)
-
-    L = direction(u[:, 0], 2.0 * np.pi * u[:, 1])
-    V = direction(u[:, 2], 2.0 * np.pi * u[:, 3])
-    n = len(L)
-    return L, V, np.tile([0.0, 0.0, 1.0], (n, 1)), np.tile([1.0, 0.0, 0.0], (n, 1))
-
-
 def timing_samples(n: int, seed: int) -> list[np.ndarray]:
     """float32 [L, V, N, T] (n, 3): L and V uniform over the hemisphere around random normals."""
     rng = np.random.default_rng(seed)
@@ -153,7 +128,8 @@ def errors(spec: str, params: dict, lib, k: int) -> dict:
     """rel_rms and max_rel of the GLSL kernel and of the float64 model against the exact model."""
     from generator.evaluate import evaluate
 
-    L, V, N, T = hemisphere_pairs(k, seed=1)
+    s = hemisphere(k, seed=1, rotate=False)  # a jittered k⁴ grid, N = z, T = x
+    L, V, N, T = s.L, s.V, s.N, s.T
     # The exact model sees the unit directions nearest to the float32 ones the kernel sees.
     L, V, N, T = (x.astype(np.float32).astype(np.float64) for x in (L, V, N, T))
     unit = [x / np.linalg.norm(x, axis=1, keepdims=True) for x in (L, V, N, T)]
@@ -366,7 +342,7 @@ def main(argv=None) -> int:
     lib = load_library()
     langs = tuple(args.languages.split(","))
     params = parse_params(args.param)
-    specs = kernel_specs(lib)
+    specs = default_specs(lib)
     load_start = os.getloadavg()[0]
     measured = measure(specs, langs, params, args.samples, args.repeats, args.grid, lib, sys.stderr.isatty())
     report = {

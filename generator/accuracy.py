@@ -25,6 +25,8 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from . import GPU_TARGETS
+
 # Below 1e-6 sr⁻¹ an error is measured relative to 1e-6: at unit light such a value is
 # ~1e-3 of an 8-bit step (π f_r c cos θ with f_r ≈ 1.3e-3 per step).
 REL_FLOOR = 1e-6
@@ -39,8 +41,6 @@ SWEEPS = {
     "sigma": (0.0, 0.3, 0.6, 1.2),
     "rho_d": (0.0, 1.0),
 }
-NUMPY_DTYPES = ("float64", "float32", "float16")
-GPU = ("glsl", "hlsl", "wgsl")
 
 
 # ------------------------------------------------------------------ sample domains
@@ -91,14 +91,17 @@ def _framed(name, params, L, V, labels, rotate: bool) -> SampleSet:
                      np.ascontiguousarray(N), np.ascontiguousarray(T), labels)
 
 
-def hemisphere(k: int = 12, seed: int = 0, params: dict | None = None) -> SampleSet:
-    """L and V jointly stratified over the hemisphere: a jittered k⁴ grid in (cos θ_l, φ_l, cos θ_v, φ_v)."""
+def hemisphere(k: int = 12, seed: int = 0, params: dict | None = None, rotate: bool = True) -> SampleSet:
+    """L and V jointly stratified over the hemisphere: a jittered k⁴ grid in (cos θ_l, φ_l, cos θ_v, φ_v).
+
+    rotate=False keeps the canonical frame N = z, T = x.
+    """
     rng = np.random.default_rng(seed)
     cells = np.stack(np.meshgrid(*(np.arange(k),) * 4, indexing="ij"), -1).reshape(-1, 4)
     u = (cells + rng.random(cells.shape)) / k
     L = direction(u[:, 0], 2.0 * np.pi * u[:, 1])
     V = direction(u[:, 2], 2.0 * np.pi * u[:, 3])
-    return _framed("hemisphere", dict(params or {}), L, V, ["hemisphere"] * len(L), rotate=True)
+    return _framed("hemisphere", dict(params or {}), L, V, ["hemisphere"] * len(L), rotate=rotate)
 
 
 def stress_geometry() -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -265,7 +268,7 @@ def default_specs(lib) -> list[str]:
 def default_targets() -> list[str]:
     """numpy, plus the GPU languages when a lavapipe device is present."""
     from .runtime.probe import lavapipe_present
-    return ["numpy"] + (list(GPU) if lavapipe_present() else [])
+    return ["numpy"] + (list(GPU_TARGETS) if lavapipe_present() else [])
 
 
 def runs(targets, dtypes) -> list[tuple[str, str]]:
@@ -273,7 +276,7 @@ def runs(targets, dtypes) -> list[tuple[str, str]]:
     out = []
     for t in targets:
         for d in dtypes:
-            if t == "numpy" or (t in GPU and d == "float32"):
+            if t == "numpy" or (t in GPU_TARGETS and d == "float32"):
                 out.append((t, d))
     return out
 
@@ -281,12 +284,8 @@ def runs(targets, dtypes) -> list[tuple[str, str]]:
 def declared_params(spec: str, lib) -> dict:
     """{name: (type, default, range)} of a BRDF spec's parameters, from the bricks' metadata."""
     from .permutation import parse_brdf
-    out = {}
-    for top in parse_brdf(spec, lib):
-        for node in top.walk():
-            for name, p in node.brick.params.items():
-                out.setdefault(name, (p.ty, p.default, p.range))
-    return out
+    from .reference import brdf_parameters
+    return brdf_parameters(parse_brdf(spec, lib))
 
 
 def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:
@@ -322,7 +321,7 @@ def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
                     got = evaluate(spec, *given, s.params, target=t, dtype=d, lib=lib)
                 stats[f"{t}/{d}"].add(got, refs[d][0], s.labels, s.params, refs[d][1])
         out[set_name] = stats
-    for t in sorted({t for t, _ in runs(targets, dtypes) if t in GPU}):
+    for t in sorted({t for t, _ in runs(targets, dtypes) if t in GPU_TARGETS}):
         gpu_kernel(spec, t, lib).release()  # its buffers have the largest batch's size; the pipeline stays
     return out
 

@@ -150,6 +150,11 @@ def builtin_library() -> Library:
     return _BUILTIN
 
 
+def library_or_builtin(lib: Library | None) -> Library:
+    """`lib`, or the built-in bricks when it is None."""
+    return lib if lib is not None else builtin_library()
+
+
 def _meta_error(shown: str, loc: ir.Loc, message: str, hint: str) -> SourceError:
     return SourceError(shown, loc.line, loc.col, message, hint)
 

@@ -22,12 +22,10 @@ import types
 
 import numpy as np
 
+from . import DTYPES, GPU_TARGETS, TARGETS  # defined in the package, where the CLI reads them without numpy
+from .bricks import library_or_builtin
 from .compose import EvalProgram, compose_eval, eval_program
 from .lang.errors import UserError
-
-TARGETS = ("reference", "numpy", "glsl", "hlsl", "wgsl")
-GPU_TARGETS = ("glsl", "hlsl", "wgsl")
-DTYPES = ("float64", "float32", "float16")
 
 
 class EvalError(UserError, ValueError):
@@ -44,14 +42,9 @@ _PROGRAMS: dict = {}  # (id(lib), spec) -> (lib, EvalProgram)
 _NUMPY: dict = {}     # (id(lib), spec, dtype) -> (lib, brdf function)
 
 
-def _library(lib):
-    from .bricks import builtin_library
-    return lib if lib is not None else builtin_library()
-
-
 def program(spec: str, lib=None) -> EvalProgram:
     """The linked eval program of a spec (cached per library and spec string)."""
-    lib = _library(lib)
+    lib = library_or_builtin(lib)
     hit = _PROGRAMS.get((id(lib), spec))
     if hit is None or hit[0] is not lib:
         hit = _PROGRAMS[(id(lib), spec)] = (lib, eval_program(spec, lib))
@@ -174,7 +167,7 @@ def gpu_kernel(spec: str, language: str, lib=None, device=None):
     """The cached EvalKernel of a spec in one language on `device` (default: the shared lavapipe device)."""
     from .runtime.eval_kernel import compile_kernel, shared_device
 
-    lib = _library(lib)
+    lib = library_or_builtin(lib)
     ep = program(spec, lib)
     device = device or shared_device()
     key = ("eval", id(lib), ep.spec, language)
@@ -216,7 +209,7 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
         dtype = dtype or "float64"
         if dtype not in DTYPES:
             raise EvalError(f"unknown dtype {dtype!r}", f"use one of {', '.join(DTYPES)}")
-    lib = _library(lib)
+    lib = library_or_builtin(lib)
     ep = program(spec, lib)
     values = resolve_params(ep, params)
     vecs = _vectors(L, V, N, T, ep.tangent, ep.spec)

@@ -16,9 +16,10 @@ import json
 import sys
 from pathlib import Path
 
+from .. import DTYPES, GPU_TARGETS
+
 HELP = "error of every target × dtype against the float64 references: hemisphere and stress set (Markdown/JSON)"
-TARGETS = ("numpy", "glsl", "hlsl", "wgsl")
-DTYPES = ("float64", "float32", "float16")
+TARGETS = ("numpy",) + GPU_TARGETS
 MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 s (K grows memory as K⁴)
 
 

@@ -13,9 +13,9 @@ import io
 import sys
 from pathlib import Path
 
+from .. import DTYPES, TARGETS
+
 HELP = "evaluate a BRDF spec on samples (.npy in, float64 f_r .npy out): reference, numpy or a GPU kernel"
-TARGETS = ("reference", "numpy", "glsl", "hlsl", "wgsl")
-DTYPES = ("float64", "float32", "float16")
 
 
 def add_arguments(p) -> None:

@@ -144,18 +144,13 @@ def vis_smith_schlick(g: Geometry, alpha):
 
 # ------------------------------------------------------------------ whole BRDFs
 
-def _library(lib):
-    from ..bricks import builtin_library
-    return lib if lib is not None else builtin_library()
-
-
 def brdf_parameters(nodes) -> dict:
-    """{name: (type, default)} of every parameter of a parsed BRDF spec (from the bricks' metadata)."""
+    """{name: (type, default, range)} of every parameter of a parsed BRDF spec (from the bricks' metadata)."""
     out = {}
     for top in nodes:
         for node in top.walk():
             for name, prm in node.brick.params.items():
-                out.setdefault(name, (prm.ty, prm.default))
+                out.setdefault(name, (prm.ty, prm.default, prm.range))
     return out
 
 
@@ -166,7 +161,7 @@ def _param_values(declared: dict, given: dict | None, count: int) -> dict:
         raise ValueError(f"unknown parameter(s) {', '.join(sorted(unknown))}; "
                          f"this BRDF has {', '.join(sorted(declared)) or 'none'}")
     out = {}
-    for name, (ty, default) in declared.items():
+    for name, (ty, default, _range) in declared.items():
         v = np.asarray(given.get(name, default), dtype=np.float64)
         if ty.kind == "vector":
             v = np.broadcast_to(v, (count, ty.components) if v.ndim < 2 else v.shape)
@@ -187,8 +182,9 @@ def reference_brdf(spec: str, L, V, N, T=None, params=None, lib=None) -> np.ndar
     params: {name: value}; a value is a scalar, an RGB triple, or one per sample
     ((N,) or (N, 3)). Missing parameters take the bricks' defaults.
     """
+    from ..bricks import library_or_builtin
     from ..permutation import parse_brdf
-    nodes = parse_brdf(spec, _library(lib))
+    nodes = parse_brdf(spec, library_or_builtin(lib))
     g = shading_geometry(L, V, N, T)
     p = _param_values(brdf_parameters(nodes), params, g.count)
     total = np.zeros((g.count, 3))
@@ -199,5 +195,6 @@ def reference_brdf(spec: str, L, V, N, T=None, params=None, lib=None) -> np.ndar
 
 def missing_references(lib=None) -> list[str]:
     """'kind/id' of every BRDF brick (terms and slot fillers) that has no reference."""
-    lib = _library(lib)
+    from ..bricks import library_or_builtin
+    lib = library_or_builtin(lib)
     return [f"{k}/{b.id}" for k in REFERENCES for b in lib.of_kind(k) if b.id not in REFERENCES[k]]
