@@ -122,7 +122,7 @@ def load_library(extra_dirs=(), strict: bool = True) -> Library:
     dirs = [BUILTIN_BRICKS, *[Path(d) for d in extra_dirs]]
     for d in dirs:
         if not d.is_dir():
-            raise SourceError(str(d), 1, 1, "brick directory not found", "pass an existing directory to --bricks")
+            raise SourceError(str(d), 1, 1, "brick directory not found", "check the path of the extra brick directory")
         for path in sorted(d.rglob("*.py")):
             try:
                 b = load_brick(path)
@@ -159,10 +159,17 @@ def _meta_error(shown: str, loc: ir.Loc, message: str, hint: str) -> SourceError
     return SourceError(shown, loc.line, loc.col, message, hint)
 
 
-def load_brick(path: Path) -> Brick:
-    """Parse one brick file and check its metadata against its functions."""
-    shown = display(path)
-    text = read_text(path, "brick")
+def load_brick(path: Path, text: str | None = None, shown: str | None = None) -> Brick:
+    """Parse one brick file (or `text` standing for it) and check its metadata against its functions.
+
+    The brick id is the file stem; `shown` names it in messages and #line directives.
+    """
+    shown = shown or display(path)
+    if '"' in shown or "\n" in shown:
+        raise SourceError(shown.replace("\n", " "), 1, 1, "the brick's path contains a quote or a line break",
+                          "rename the file or its directory: the path is written into #line directives")
+    if text is None:
+        text = read_text(path, "brick")
     meta, loc, doc = read_meta(text, shown)
     unknown = set(meta) - META_KEYS
     if unknown:

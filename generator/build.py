@@ -16,10 +16,11 @@ from pathlib import Path
 from . import __version__
 from .bricks import Library
 from .cache import atomic_write, sha256
-from .compose import LANGUAGES, Composed, compose_permutation
+from .compose import Composed, compose_permutation
 from .cost import entry_cost
 from .lang import SourceError
 from .scene import Scene
+from .targets import LANGUAGES
 from .toolchain import CompileJob, CompileResult, compile_many, tool_versions
 
 
@@ -79,17 +80,21 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> B
             entry["bricks"] = dict(sorted(c.bricks.items()))
             for src in c.sources:
                 r = results[job_key(h, src.stage, src.language)]
-                rel_src = f"{src.language}/{h}.{src.stage}.{src.language}"
-                rel_spv = f"{src.language}/{h}.{src.stage}.spv"
                 data = src.text.encode()
-                _count(res, atomic_write(out / rel_src, data))
-                item = {"source": rel_src, "source_sha256": sha256(data)}
                 if r.ok and r.spirv:
+                    rel_src = f"{src.language}/{h}.{src.stage}.{src.language}"
+                    rel_spv = f"{src.language}/{h}.{src.stage}.spv"
+                    _count(res, atomic_write(out / rel_src, data))
                     _count(res, atomic_write(out / rel_spv, r.spirv))
-                    item.update({"spirv": rel_spv, "spirv_sha256": sha256(r.spirv),
-                                 "cost": entry_cost(r.spirv).as_dict(histograms=False)})
+                    item = {"source": rel_src, "source_sha256": sha256(data), "spirv": rel_spv,
+                            "spirv_sha256": sha256(r.spirv), "cost": entry_cost(r.spirv).as_dict(histograms=False)}
                 else:
-                    errs += [str(d) for d in r.diagnostics if d.severity == "error"] or [f"{rel_src}: compile failed"]
+                    # A source that does not compile goes beside, under its own name: an earlier
+                    # build's source and SPIR-V stay a matching pair.
+                    rel_src = f"{src.language}/{h}.{src.stage}.failed.{src.language}"
+                    _count(res, atomic_write(out / rel_src, data))
+                    item = {"source": rel_src, "source_sha256": sha256(data)}
+                    errs += r.errors()
                 entry["languages"].setdefault(src.language, {})[src.stage] = item
         entry["status"] = "failed" if errs else "ok"
         if errs:

@@ -20,11 +20,10 @@ from .glue import Program, brdf_glue, brdf_params, check_packing, glue_header, s
 from .lang import SourceError
 from .lang.types import Type
 from .permutation import Node, Permutation, parse_brdf, resolve
-from .targets import get_target
+from .targets import LANGUAGES, get_target
 from .targets.base import Emitted
 
 TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
-LANGUAGES = ("glsl", "hlsl", "wgsl")
 STAGE_EXT = {"vert": "vert", "frag": "frag", "comp": "comp"}
 
 

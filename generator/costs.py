@@ -30,7 +30,6 @@ from the slot signature) and are loaded only here.
 """
 from __future__ import annotations
 
-import tempfile
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -169,7 +168,7 @@ class _Batch:
         stage = "comp" if unit.startswith("eval:") else "frag"
         r = self.results[job_key(c.hash, stage, language)]
         if not r.ok:
-            return "; ".join(str(d) for d in r.diagnostics if d.severity == "error") or "compile failed"
+            return "; ".join(r.errors())
         return entry_cost(r.spirv)
 
 
@@ -245,7 +244,11 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES) -> list[Row]:
         sub = standin(lib, kind)
         for b in (x for x in lib.of_kind(kind) if not is_standin(x)):
             if kind in BRDF_KINDS:  # a brick with slots is measured with its default fillers, named in full
-                subject = parse_brdf(b.id, lib)[0].canonical()
+                try:
+                    subject = parse_brdf(b.id, lib)[0].canonical()
+                except SpecError as e:  # e.g. a slot whose default filler does not exist
+                    plans.append(_Plan("brick", b.id, kind, batch.fail(b.id, str(e)), batch.fail(b.id, str(e))))
+                    continue
                 eval_plan("brick", subject, kind, pair(kind, b.id), pair(kind, sub.id))
             elif any(v["kind"] == kind for h in hosts for v in h.slots.values()):
                 for h in hosts:
@@ -321,7 +324,7 @@ def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES) -> list[R
                     if r.ok:
                         row.cost = entry_cost(r.spirv)
                     else:
-                        row.error = "; ".join(str(d) for d in r.diagnostics if d.severity == "error")
+                        row.error = "; ".join(r.errors())
                 rows.append(row)
     return rows
 
@@ -334,15 +337,11 @@ def load_cost_library(extra_dirs=()) -> Library:
     files in generator/cost_bricks.
     """
     lib = load_library([*extra_dirs, COST_BRICKS])
-    with tempfile.TemporaryDirectory(prefix="shadermatrix-standins-") as tmp:
-        for kind, k in KINDS.items():
-            if k.interface is None or standin(lib, kind) is not None:
-                continue
-            path = Path(tmp) / f"standin_{kind}.py"
-            path.write_text(_slot_standin(kind), encoding="utf-8")
-            b = load_brick(path)
-            b.display_path = f"<stand-in {kind}>"  # the temporary file is gone after loading
-            lib.bricks[(kind, b.id)] = b
+    for kind, k in KINDS.items():
+        if k.interface is None or standin(lib, kind) is not None:
+            continue
+        b = load_brick(COST_BRICKS / f"standin_{kind}.py", text=_slot_standin(kind), shown=f"<stand-in {kind}>")
+        lib.bricks[(kind, b.id)] = b
     return lib
 
 

@@ -65,6 +65,7 @@ from pathlib import Path
 from typing import Iterable
 
 from .lang.errors import UserError
+from .targets import LANGUAGES
 
 __all__ = ["Diagnostic", "CompileJob", "CompileResult", "ToolMissing",
            "compile_many", "tool_versions", "find_tool",
@@ -75,7 +76,6 @@ SPIRV_VERSION = "1.3"         # what glslc emits for vulkan1.1; naga is told the
 SPIRV_MAGIC = 0x07230203
 REPO_ROOT = Path(__file__).resolve().parent.parent
 TOOLS_BIN = REPO_ROOT / ".tools" / "bin"
-LANGUAGES = ("glsl", "hlsl", "wgsl")
 STAGES = ("vert", "frag", "comp")
 _SENTINEL = "SHADERMATRIX_SENTINEL"
 _MAX_BATCH = 256  # jobs per glslc process
@@ -116,6 +116,11 @@ class CompileResult:
     spirv: bytes | None        # validated SPIR-V (optimized when optimize=True); None unless ok
     spirv_unopt: bytes | None  # front-end output, kept whenever the front end produced one
     diagnostics: list[Diagnostic]
+
+    def errors(self) -> list[str]:
+        """The error diagnostics as text; never empty for a failed job."""
+        lines = [str(d) for d in self.diagnostics if d.severity == "error"]
+        return lines or ([] if self.ok else [f"{self.key}: compile failed"])
 
 
 class ToolMissing(UserError):

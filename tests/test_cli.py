@@ -178,6 +178,10 @@ def test_compiler_failure_names_the_brick_line_and_other_permutations_still_buil
     assert status == {"brdf=lambert+blinn_phong_normalized": "ok", "brdf=lambert": "failed"}
     failed = next(p for p in m["permutations"] if p["status"] == "failed")
     assert "spirv" in failed["languages"]["glsl"]["frag"] and "spirv" not in failed["languages"]["wgsl"]["frag"]
+    # The source that failed is kept for reading under its own name; no source/SPIR-V pair is half-replaced.
+    assert failed["languages"]["wgsl"]["frag"]["source"] == f"wgsl/{failed['hash']}.frag.failed.wgsl"
+    assert (out / failed["languages"]["wgsl"]["frag"]["source"]).is_file()
+    assert not (out / f"wgsl/{failed['hash']}.frag.wgsl").exists()
 
 
 @pytest.mark.toolchain
@@ -210,7 +214,6 @@ def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, to
     assert set(after) == set(before)
     changed = [p for p in after if after[p] != before[p]]
     assert len(changed) == 6, "files renamed before the interruption are complete new files; the rest untouched"
-    assert json.loads((out / "manifest.json").read_text()) == json.loads((out / "manifest.json").read_text())
     assert after["manifest.json"] == before["manifest.json"], "the manifest is written last"
 
 
@@ -253,3 +256,13 @@ def test_missing_tool_is_one_line_error(tmp_path, monkeypatch, capsys, command):
     assert main([a.format(tmp=tmp_path) for a in command]) == 1
     err = capsys.readouterr().err
     assert err.startswith("error: glslc not found — run `make setup`") and err.count("\n") == 1, err
+
+
+def test_brick_path_with_a_quote_is_refused_before_it_reaches_a_line_directive(tmp_path):
+    d = tmp_path / 'say "hi"'
+    d.mkdir()
+    (d / "lam.py").write_text('"""L."""\nBRICK = {"kind": "diffuse", "cite": "x"}\n\n'
+                              "def diffuse(NdotL: float) -> vec3:\n    return vec3(NdotL)\n")
+    r = run("bricks", "--bricks", d)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert "the brick's path contains a quote" in r.stderr and "rename the file or its directory" in r.stderr

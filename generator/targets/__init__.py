@@ -12,6 +12,7 @@ from .hlsl import HlslTarget
 from .wgsl import WgslTarget
 
 TARGETS: dict[str, Target] = {"glsl": GlslTarget(), "hlsl": HlslTarget(), "wgsl": WgslTarget()}
+LANGUAGES: tuple[str, ...] = ("glsl", "hlsl", "wgsl")  # the shading languages, in output order
 
 
 def get_target(name: str) -> Target:
@@ -26,4 +27,4 @@ def get_target(name: str) -> Target:
         raise ValueError(f"unknown target '{name}' (known: glsl, hlsl, numpy, wgsl)") from None
 
 
-__all__ = ["Emitted", "Target", "TARGETS", "get_target", "GlslTarget", "HlslTarget", "WgslTarget"]
+__all__ = ["Emitted", "Target", "TARGETS", "LANGUAGES", "get_target", "GlslTarget", "HlslTarget", "WgslTarget"]

@@ -67,7 +67,6 @@ class CLikeTarget(Target):
 
     reserved = reserved.ALL
     line_directives = True          # emit `#line N "brick"` before mapped lines
-    texture_bindings = 2            # bindings one declare_texture() occupies (B and B+1)
 
     # ---- tables a subclass fills in
     SCALARS: dict[str, str] = {}    # brick scalar -> spelling
