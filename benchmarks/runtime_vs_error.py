@@ -23,7 +23,8 @@ Schlick or none, and the exact separable Smith G of that NDF (Walter et al.
 that approximate nothing (Lambert, the normalized Phong lobes) are compared
 with their own reference: their error is float32 arithmetic. Errors are over
 a jittered, stratified k⁴ grid of (L, V) over the hemisphere (k = 12: 20736
-pairs) of the GLSL kernel's output on lavapipe:
+pairs) of the GLSL kernel's output on lavapipe, with the exact model evaluated
+at the float32-rounded vectors the kernel gets (as in generator/accuracy.py):
 - `rel_rms`: cosine-weighted relative RMS error over all samples and RGB
   channels, sqrt(Σ cosθ_l (f - f*)²) / sqrt(Σ cosθ_l f*²) — the error of the
   reflected radiance under uniform light;
@@ -49,7 +50,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from generator import GPU_TARGETS as LANGS  # noqa: E402 (after the path)
-from generator.accuracy import REL_FLOOR, default_specs, hemisphere  # noqa: E402
+from generator.accuracy import REL_FLOOR, default_specs, hemisphere, rounded_inputs  # noqa: E402
 
 BASELINE = "lambert"
 
@@ -128,13 +129,11 @@ def errors(spec: str, params: dict, lib, k: int) -> dict:
     """rel_rms and max_rel of the GLSL kernel and of the float64 model against the exact model."""
     from generator.evaluate import evaluate
 
-    s = hemisphere(k, seed=1, rotate=False)  # a jittered k⁴ grid, N = z, T = x
-    L, V, N, T = s.L, s.V, s.N, s.T
-    # The exact model sees the unit directions nearest to the float32 ones the kernel sees.
-    L, V, N, T = (x.astype(np.float32).astype(np.float64) for x in (L, V, N, T))
-    unit = [x / np.linalg.norm(x, axis=1, keepdims=True) for x in (L, V, N, T)]
-    exact = exact_brdf(spec, *unit, params, lib)
-    w = np.clip(np.sum(unit[0] * unit[2], 1), 0.0, None)[:, None]
+    # A jittered k⁴ grid (N = z, T = x) as rounded to float32: the very vectors the kernel gets, and
+    # the ones the exact model is evaluated at, so the error is not that of the input rounding.
+    L, V, N, T = rounded_inputs(hemisphere(k, seed=1, rotate=False), "float32")
+    exact = exact_brdf(spec, L, V, N, T, params, lib)
+    w = np.clip(np.sum(L * N, 1), 0.0, None)[:, None]
 
     def rel_rms(f, ref):
         if not np.isfinite(f).all():
@@ -151,8 +150,8 @@ def errors(spec: str, params: dict, lib, k: int) -> dict:
             "nonfinite": int(np.size(f) - np.count_nonzero(np.isfinite(f))),
         }
     if "microfacet" in spec:  # attribution: only the Fresnel, or only the geometry factor, approximated
-        out["fresnel_only"] = rel_rms(exact_brdf(spec, *unit, params, lib, keep="F"), exact)
-        out["geometry_only"] = rel_rms(exact_brdf(spec, *unit, params, lib, keep="G"), exact)
+        out["fresnel_only"] = rel_rms(exact_brdf(spec, L, V, N, T, params, lib, keep="F"), exact)
+        out["geometry_only"] = rel_rms(exact_brdf(spec, L, V, N, T, params, lib, keep="G"), exact)
     return out
 
 
@@ -252,8 +251,8 @@ def markdown(report: dict) -> str:
         f"LP_NUM_THREADS={env['lp_num_threads']}); {report['samples']:,} samples per dispatch, median of "
         f"{report['repeats']} dispatches (timestamp queries). `× Lambert`: median ratio of paired dispatches "
         f"with the Lambert kernel of the same language. Error: the GLSL kernel on lavapipe against the exact "
-        f"model in float64 over {report['error_samples']:,} stratified hemisphere pairs (cosine-weighted "
-        f"relative RMS; max relative with a floor of {REL_FLOOR:g} sr⁻¹); `model`: the float64 emission of "
+        f"model in float64 at the kernel's float32 inputs over {report['error_samples']:,} stratified "
+        f"hemisphere pairs (cosine-weighted relative RMS; max relative with a floor of {REL_FLOOR:g} sr⁻¹); `model`: the float64 emission of "
         f"the same IR, i.e. the approximation alone; `F alone` / `G alone`: float64 error when only the "
         f"kernel's Fresnel / only its geometry factor is approximated and the rest is exact. Pareto: among the kernels approximating the same "
         f"exact model, no other is both faster ({langs[0].upper()} ratio) and more accurate. Load average "
