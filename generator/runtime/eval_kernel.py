@@ -113,9 +113,8 @@ def compile_kernel(source, device: Device, tangent: bool, param_vec4s: int) -> E
     job = CompileJob(key, source.language, "comp", source.text, line_map=tuple(map(tuple, source.line_map)))
     res = compile_many([job])[key]
     if not res.ok:
-        found = [d for d in res.diagnostics if d.severity == "error"] or res.diagnostics
         raise KernelError(f"the {source.language} eval kernel does not compile: "
-                          + "; ".join(str(d).replace("\n", " ") for d in found)
+                          + "; ".join(e.replace("\n", " ") for e in res.errors())
                           + " — fix the brick at that line (or evaluate with another --target)")
     return EvalKernel(device, res.spirv, tangent, param_vec4s)
 
