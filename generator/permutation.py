@@ -15,12 +15,13 @@ from dataclasses import dataclass
 
 from .bricks import BRDF_KINDS, Brick, Library
 from .lang import SourceError
+from .lang.errors import UserError
 
 _TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[()+=,])")
 PRECISIONS = ("fp32",)  # fp16 is on the roadmap (issue: accuracy); the key keeps the axis
 
 
-class SpecError(ValueError):
+class SpecError(UserError, ValueError):
     """A bad spec string; `col` is the 1-based column inside the spec."""
 
     def __init__(self, spec: str, col: int, message: str, hint: str = ""):
