@@ -50,7 +50,7 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from generator import GPU_TARGETS as LANGS  # noqa: E402 (after the path)
-from generator.accuracy import REL_FLOOR, default_specs, hemisphere, rounded_inputs  # noqa: E402
+from generator.eval.accuracy import REL_FLOOR, default_specs, hemisphere, rounded_inputs  # noqa: E402
 
 BASELINE = "lambert"
 
@@ -86,7 +86,7 @@ def exact_brdf(spec: str, L, V, N, T, params: dict, lib, keep: str = "") -> np.n
     keep="F" or "G": the kernel's own Fresnel or geometry factor (float64) stays, the rest is
     exact, so the difference to the exact model is the error of the other approximation.
     """
-    from generator.permutation import parse_brdf
+    from generator.matrix.permutation import parse_brdf
     from generator.reference import reference_brdf, shading_geometry
 
     g = shading_geometry(L, V, N, T)
@@ -127,7 +127,7 @@ def timing_samples(n: int, seed: int) -> list[np.ndarray]:
 
 def errors(spec: str, params: dict, lib, k: int) -> dict:
     """rel_rms and max_rel of the GLSL kernel and of the float64 model against the exact model."""
-    from generator.evaluate import evaluate
+    from generator.eval.evaluate import evaluate
 
     # A jittered k⁴ grid (N = z, T = x) as rounded to float32: the very vectors the kernel gets, and
     # the ones the exact model is evaluated at, so the error is not that of the input rounding.
@@ -172,7 +172,7 @@ def time_pairs(kernel, baseline, repeats: int) -> tuple[list[float], list[float]
 def measure(specs, langs, params, samples, repeats, k, lib, progress) -> dict:
     from tqdm import tqdm
 
-    from generator.evaluate import _param_block, gpu_kernel, program, resolve_params
+    from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
     from generator.runtime.eval_kernel import shared_device
 
     device = shared_device()
@@ -199,7 +199,7 @@ def measure(specs, langs, params, samples, repeats, k, lib, progress) -> dict:
                 kern.release()
             bar.update()
         base.release()
-    from generator.permutation import parse_brdf
+    from generator.matrix.permutation import parse_brdf
     for s in specs:
         bar.set_description(f"error {s}")
         ep = program(s, lib)
@@ -334,9 +334,9 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     from generator import __version__
-    from generator.bricks import load_library
-    from generator.cache import atomic_write
-    from generator.commands.eval import parse_params
+    from generator.library.bricks import load_library
+    from generator.io import atomic_write
+    from generator.cli.commands.eval import parse_params
 
     lib = load_library()
     langs = tuple(args.languages.split(","))

@@ -2,13 +2,13 @@
 __version__ = "0.1.0"
 
 # Targets and dtypes of evaluate(), here so that the CLI's argument parser reads them without
-# importing generator.evaluate (numpy, jinja2, the emitters).
+# importing generator.eval (numpy, jinja2, the emitters).
 TARGETS = ("reference", "numpy", "glsl", "hlsl", "wgsl")
 GPU_TARGETS = ("glsl", "hlsl", "wgsl")
 DTYPES = ("float64", "float32", "float16")
 
 
 def evaluate(spec, L, V, N, T=None, params=None, target="reference", dtype=None, lib=None):
-    """f_r (N, 3) float64 of a BRDF spec on samples; see generator.evaluate.evaluate."""
-    from .evaluate import evaluate as _evaluate  # lazy: numpy and the targets load on first use
+    """f_r (N, 3) float64 of a BRDF spec on samples; see generator.eval.evaluate.evaluate."""
+    from .eval.evaluate import evaluate as _evaluate  # lazy: numpy and the targets load on first use
     return _evaluate(spec, L, V, N, T=T, params=params, target=target, dtype=dtype, lib=lib)

@@ -22,9 +22,9 @@ def slug(spec: str) -> str:
 
 def golden_sources() -> dict[str, tuple[str, str, str]]:
     """{relative path under tests/golden: (language, stage, text)} for every case."""
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
     from generator.compose import compose_eval, compose_permutation
-    from generator.scene import load_scene
+    from generator.matrix.scene import load_scene
 
     cases = tomllib.loads((GOLDEN / "cases.toml").read_text())
     lib = load_library()

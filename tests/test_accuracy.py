@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from generator import accuracy
-from generator.bricks import load_library
+from generator.eval import accuracy
+from generator.library.bricks import load_library
 from generator.cli import main
 from generator.reference import REFERENCES, reference
 from tests.lavapipe import device, no_validation_messages  # noqa: F401 (fixtures)
@@ -150,7 +150,7 @@ def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device):
 
 @pytest.mark.lavapipe
 def test_measure_releases_the_kernel_buffers_after_each_spec(device):
-    from generator.evaluate import gpu_kernel
+    from generator.eval.evaluate import gpu_kernel
 
     accuracy.measure("lambert", ["numpy", "glsl"], ["float32"], LIB, hemisphere_k=3)
     kernel = gpu_kernel("lambert", "glsl", LIB)

@@ -186,10 +186,10 @@ def test_compiler_failure_names_the_brick_line_and_other_permutations_still_buil
 
 @pytest.mark.toolchain
 def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, tools):
-    from generator import cache
-    from generator.bricks import load_library
+    from generator import io as cache
+    from generator.library.bricks import load_library
     from generator.build import build_scene
-    from generator.scene import load_scene
+    from generator.matrix.scene import load_scene
 
     lib = load_library()
     scene = load_scene(EXAMPLE, lib)
@@ -237,7 +237,7 @@ def test_brick_that_is_not_utf8_is_a_located_error(tmp_path):
 
 def test_cli_start_loads_neither_vulkan_nor_numpy():
     code = ("import sys; from generator.cli import parser; parser(); "
-            "print(sorted(m for m in ('vulkan', 'numpy', 'generator.evaluate') if m in sys.modules))")
+            "print(sorted(m for m in ('vulkan', 'numpy', 'generator.eval.evaluate') if m in sys.modules))")
     r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=60)
     assert r.returncode == 0 and r.stdout.strip() == "[]", (r.stdout, r.stderr)
 

@@ -40,8 +40,8 @@ def names(mod, ids) -> set[str]:
 
 
 def block_liveness(data: bytes):
-    from generator.cost import read
-    from generator.cost.liveness import analyze_function
+    from generator.analysis import read
+    from generator.analysis.liveness import analyze_function
     mod = read(data)
     fn = mod.functions[mod.entry_points["main"][1]]
     lv = analyze_function(mod, fn)
@@ -53,7 +53,7 @@ def block_liveness(data: bytes):
 # ------------------------------------------------------------------ SPIR-V fixtures
 
 def test_counts_fixture_classes_and_scalar_rules(tmp_path):
-    from generator.cost import entry_cost
+    from generator.analysis import entry_cost
     c = entry_cost(assemble("counts", tmp_path))
     assert (c.alu, c.transcendental, c.texture, c.branches, c.loads, c.stores, c.other) == (8, 4, 1, 1, 4, 1, 7)
     assert c.instructions == 26  # merge declarations are not counted
@@ -93,21 +93,21 @@ def test_loop_liveness_reaches_a_fixpoint(tmp_path):
 
 
 def test_calls_count_the_callee_per_call_site(tmp_path):
-    from generator.cost import entry_cost
+    from generator.analysis import entry_cost
     c = entry_cost(assemble("call", tmp_path))
     assert (c.calls, c.alu, c.alu_scalar) == (2, 3, 3)  # two inlined-equivalent FMul + one FAdd
     assert c.registers == 3  # y and the first result live across the second call, plus its peak
 
 
 def test_big_endian_module_reads_the_same(tmp_path):
-    from generator.cost import entry_cost
+    from generator.analysis import entry_cost
     data = assemble("counts", tmp_path)
     words = struct.unpack(f"<{len(data) // 4}I", data)
     assert entry_cost(struct.pack(f">{len(words)}I", *words)) == entry_cost(data)
 
 
 def test_malformed_modules_are_errors(tmp_path):
-    from generator.cost import SpirvError, entry_cost
+    from generator.analysis import SpirvError, entry_cost
     data = assemble("branch", tmp_path)
     with pytest.raises(SpirvError, match="magic"):
         entry_cost(b"\0" * 40)
@@ -140,9 +140,9 @@ def test_opcode_table_agrees_with_spirv_dis(tmp_path):
     for t in COMPILERS:
         require_tool(t)
     spirv_dis = require_tool("spirv-dis")
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
     from generator.compose import compose_eval
-    from generator.cost.spirv import GLSL_STD_450, OPCODES, instructions
+    from generator.analysis.spirv import GLSL_STD_450, OPCODES, instructions
     from generator.toolchain import CompileJob, compile_many
     lib = load_library()
     modules = [assemble(n, tmp_path) for n in ("counts", "branch", "loop", "call")]
@@ -163,7 +163,7 @@ def test_opcode_table_agrees_with_spirv_dis(tmp_path):
 def fixture_brick_rows():
     for t in COMPILERS:
         require_tool(t)
-    from generator.costs import brick_rows, load_cost_library
+    from generator.measure.plans import brick_rows, load_cost_library
     return brick_rows(load_cost_library([COST_BRICKS]))
 
 
@@ -195,7 +195,7 @@ def test_brick_of_known_cost_two_exponentials(fixture_brick_rows):
 
 @pytest.mark.toolchain
 def test_every_brick_and_slot_filler_has_a_row_and_no_stand_in_does(fixture_brick_rows):
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
     subjects = {r.subject for r in fixture_brick_rows if r.table == "brick"}
     assert not any("standin" in s.split("=")[-1].split("(")[0] for s in subjects)
     for (kind, bid), b in load_library().bricks.items():
@@ -218,7 +218,7 @@ def test_course_models_are_data_and_a_new_brick_adds_its_row(fixture_brick_rows)
         assert {(r.course.table, r.course.texture, r.course.alu) for r in rows} == tables
         variant = [r for r in rows if r.course.table == "shift-variant"]
         assert all(r.cost.texture == 1 for r in variant)  # the albedo texture
-    from generator.costs import brick_rows, course_models, load_cost_library
+    from generator.measure.plans import brick_rows, course_models, load_cost_library
     assert "Ashikhmin-Shirley" in {m.name for m in course_models()[0]}
     assert not any(r.subject == "Ashikhmin-Shirley" for r in fixture_brick_rows)
 
@@ -274,10 +274,10 @@ def test_scene_costs_markdown_and_csv(scene_json):
 
 @pytest.mark.toolchain
 def test_manifest_carries_the_same_costs(scene_json, tmp_path):
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
     from generator.build import build_scene
-    from generator.cost import entry_cost
-    from generator.scene import load_scene
+    from generator.analysis import entry_cost
+    from generator.matrix.scene import load_scene
     lib = load_library()
     res = build_scene(load_scene(EXAMPLE, lib), lib, tmp_path)
     assert res.ok
@@ -317,7 +317,7 @@ def test_cli_usage_errors(tmp_path):
 
 
 def test_stand_ins_stay_out_of_the_brick_list_and_scenes():
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
     assert not any(bid.startswith("standin") for _, bid in load_library().bricks)
     out = subprocess.run([sys.executable, "-m", "generator.cli", "bricks", "--json"], cwd=REPO,
                          capture_output=True, text=True, timeout=60)

@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from generator.evaluate import evaluate
+from generator.eval.evaluate import evaluate
 from generator.reference import (d_beckmann, d_ggx, lambda_beckmann, lambda_ggx, reference_brdf,
                                  smith_g_separable)
 

@@ -111,7 +111,7 @@ def assert_close(got, want, kappa, what):
 @pytest.mark.parametrize("params", list(PARAM_SETS), ids=list(PARAM_SETS))
 @pytest.mark.parametrize("spec", SPECS)
 def test_gpu_kernels_agree_with_numpy(device, samples, spec, params):
-    from generator.evaluate import evaluate, program, resolve_params
+    from generator.eval.evaluate import evaluate, program, resolve_params
 
     ep = program(spec)
     p = {k: v for k, v in PARAM_SETS[params].items() if k in ep.params}
@@ -134,7 +134,7 @@ def test_gpu_kernels_agree_with_numpy(device, samples, spec, params):
 
 @pytest.fixture(scope="module")
 def probe_lib():
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
 
     return load_library([REPO / "tests" / "eval_bricks"])
 
@@ -142,7 +142,7 @@ def probe_lib():
 @pytest.mark.parametrize("target", ("numpy",) + LANGS)
 def test_tangent_frame_and_parameter_layout(device, samples, probe_lib, target):
     """T is read from the fourth vec4 with B = cross(N, T); float, vec3 and mat4 parameters land in place."""
-    from generator.evaluate import evaluate
+    from generator.eval.evaluate import evaluate
 
     L, V, N, T = (x[:256] for x in samples)
     w, c, m = -1.5, [0.25, -2.0, 4.0], [float(i) / 8.0 - 1.0 for i in range(16)]  # m: columns, column-major
@@ -157,7 +157,7 @@ def test_tangent_frame_and_parameter_layout(device, samples, probe_lib, target):
 
 
 def test_errors_say_what_and_what_to_do(probe_lib):
-    from generator.evaluate import EvalError, evaluate
+    from generator.eval.evaluate import EvalError, evaluate
 
     L = V = N = np.tile([0.0, 0.0, 1.0], (4, 1))
     cases = [
@@ -183,7 +183,7 @@ def test_errors_say_what_and_what_to_do(probe_lib):
 
 
 def test_scalar_splats_and_defaults_apply():
-    from generator.evaluate import evaluate
+    from generator.eval.evaluate import evaluate
 
     L = V = N = np.tile([0.0, 0.0, 1.0], (2, 1))
     np.testing.assert_allclose(evaluate("lambert", L, V, N, params={"rho_d": 0.25}, target="numpy"),
@@ -192,10 +192,10 @@ def test_scalar_splats_and_defaults_apply():
     assert evaluate("lambert", L[:0], V[:0], N[:0], target="numpy").shape == (0, 3)
 
 
-def test_generator_evaluate_is_callable_before_and_after_the_module_import():
+def test_generator_evaluate_stays_the_function_after_the_module_import():
     code = ("import numpy as np, generator; x = np.tile([0.0, 0.0, 1.0], (1, 1)); "
             "a = generator.evaluate('lambert', x, x, x, target='numpy'); "
-            "import generator.evaluate as m; b = generator.evaluate('lambert', x, x, x, target='numpy'); "
+            "import generator.eval.evaluate as m; b = generator.evaluate('lambert', x, x, x, target='numpy'); "
             "from generator import evaluate; c = evaluate('lambert', x, x, x, target='numpy'); "
             "assert (a == b).all() and (b == c).all() and a.shape == (1, 3); print('ok')")
     r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=120)
@@ -217,7 +217,7 @@ def save(path, a):
 def test_cli_round_trip_matches_the_python_function(tmp_path, samples):
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
-    from generator.evaluate import evaluate
+    from generator.eval.evaluate import evaluate
     from generator.runtime.probe import lavapipe_present
 
     L, V, N, T = (x[:300] for x in samples)

@@ -1,9 +1,9 @@
 """The matrix model: spec strings, canonical keys, and which permutations a scene must and must not get."""
 import pytest
 
-from generator.bricks import load_library
-from generator.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
-from generator.scene import load_scene
+from generator.library.bricks import load_library
+from generator.matrix.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
+from generator.matrix.scene import load_scene
 from tests.regen_goldens import REPO
 
 

@@ -18,9 +18,9 @@ import math
 import numpy as np
 import pytest
 
-from generator import accuracy
-from generator.bricks import load_library
-from generator.evaluate import evaluate
+from generator.eval import accuracy
+from generator.library.bricks import load_library
+from generator.eval.evaluate import evaluate
 from generator.reference import (d_beckmann, d_blinn_phong, d_ggx, exact, fresnel_conductor,
                                  fresnel_dielectric, fresnel_dielectric_f0, fresnel_schlick, lambda_beckmann,
                                  lambda_ggx, missing_references, reference_brdf, shading_geometry,

@@ -109,7 +109,7 @@ def test_buffer_whose_memory_fails_leaks_nothing(monkeypatch, fails):
 
 def test_eval_kernel_chunks_large_inputs(device):
     """Inputs beyond one dispatch's workgroup limit run in chunks with the same results."""
-    from generator.evaluate import _param_block, gpu_kernel, program, resolve_params
+    from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
 
     spec = "lambert+blinn_phong_normalized"
     ep = program(spec)
@@ -130,8 +130,8 @@ def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
     """A chunk's samples and results each fit one storage descriptor (lavapipe: 128 MiB, 2.8 M samples)."""
     from types import SimpleNamespace
 
-    from generator.bricks import load_library
-    from generator.evaluate import gpu_kernel
+    from generator.library.bricks import load_library
+    from generator.eval.evaluate import gpu_kernel
     from generator.runtime.eval_kernel import WORKGROUP, max_dispatch_samples
 
     limit = int(device.limits.maxStorageBufferRange)
@@ -149,7 +149,7 @@ def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
 
 
 def test_eval_kernel_times_loaded_samples_and_releases_buffers(device):
-    from generator.evaluate import _param_block, gpu_kernel, program, resolve_params
+    from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
 
     spec = "lambert"
     ep = program(spec)

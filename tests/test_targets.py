@@ -382,9 +382,9 @@ def test_registry():
 @pytest.mark.toolchain
 def test_conditional_expressions_are_selects_not_branches_in_every_language(require_tool):
     """`a if c else b` must cost the same everywhere: OpSelect, no branch (GLSL's ?: would branch)."""
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
     from generator.compose import compose_eval
-    from generator.cost import entry_cost
+    from generator.analysis import entry_cost
     from generator.toolchain import CompileJob, compile_many
 
     for t in ("glslc", "naga", "spirv-opt", "spirv-val"):
@@ -401,10 +401,10 @@ def test_conditional_expressions_are_selects_not_branches_in_every_language(requ
 @pytest.mark.toolchain
 def test_wgsl_vertex_keeps_the_vulkan_coordinate_space(require_tool):
     """naga flips gl_Position.y unless told not to; all languages must place vertices alike."""
-    from generator.bricks import load_library
+    from generator.library.bricks import load_library
     from generator.compose import compose_permutation
-    from generator.cost import entry_cost
-    from generator.permutation import LightKey, Permutation
+    from generator.analysis import entry_cost
+    from generator.matrix.permutation import LightKey, Permutation
     from generator.toolchain import CompileJob, compile_many
 
     for t in ("glslc", "naga", "spirv-opt", "spirv-val"):

@@ -182,8 +182,8 @@ def reference_brdf(spec: str, L, V, N, T=None, params=None, lib=None) -> np.ndar
     params: {name: value}; a value is a scalar, an RGB triple, or one per sample
     ((N,) or (N, 3)). Missing parameters take the bricks' defaults.
     """
-    from ..bricks import library_or_builtin
-    from ..permutation import parse_brdf
+    from ..library.bricks import library_or_builtin
+    from ..matrix.permutation import parse_brdf
     nodes = parse_brdf(spec, library_or_builtin(lib))
     g = shading_geometry(L, V, N, T)
     p = _param_values(brdf_parameters(nodes), params, g.count)
@@ -195,6 +195,6 @@ def reference_brdf(spec: str, L, V, N, T=None, params=None, lib=None) -> np.ndar
 
 def missing_references(lib=None) -> list[str]:
     """'kind/id' of every BRDF brick (terms and slot fillers) that has no reference."""
-    from ..bricks import library_or_builtin
+    from ..library.bricks import library_or_builtin
     lib = library_or_builtin(lib)
     return [f"{k}/{b.id}" for k in REFERENCES for b in lib.of_kind(k) if b.id not in REFERENCES[k]]

@@ -13,7 +13,7 @@ import io
 import sys
 from pathlib import Path
 
-from .. import DTYPES, TARGETS
+from ... import DTYPES, TARGETS
 
 HELP = "evaluate a BRDF spec on samples (.npy in, float64 f_r .npy out): reference, numpy or a GPU kernel"
 
@@ -75,11 +75,11 @@ def load_samples(path: str):
 def run(args) -> int:
     import numpy as np
 
-    from ..bricks import load_library
-    from ..cache import atomic_write
-    from ..evaluate import EvalError, evaluate
-    from ..permutation import SpecError
-    from ..runtime.device import VulkanUnavailable
+    from ...library.bricks import load_library
+    from ...io import atomic_write
+    from ...eval.evaluate import EvalError, evaluate
+    from ...matrix.permutation import SpecError
+    from ...runtime.device import VulkanUnavailable
 
     try:
         params = parse_params(args.param)

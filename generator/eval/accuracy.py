@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from . import GPU_TARGETS
+from .. import GPU_TARGETS
 
 # Below 1e-6 sr⁻¹ an error is measured relative to 1e-6: at unit light such a value is
 # ~1e-3 of an 8-bit step (π f_r c cos θ with f_r ≈ 1.3e-3 per step).
@@ -267,7 +267,7 @@ def default_specs(lib) -> list[str]:
 
 def default_targets() -> list[str]:
     """numpy, plus the GPU languages when a lavapipe device is present."""
-    from .runtime.probe import lavapipe_present
+    from ..runtime.probe import lavapipe_present
     return ["numpy"] + (list(GPU_TARGETS) if lavapipe_present() else [])
 
 
@@ -283,8 +283,8 @@ def runs(targets, dtypes) -> list[tuple[str, str]]:
 
 def declared_params(spec: str, lib) -> dict:
     """{name: (type, default, range)} of a BRDF spec's parameters, from the bricks' metadata."""
-    from .permutation import parse_brdf
-    from .reference import brdf_parameters
+    from ..matrix.permutation import parse_brdf
+    from ..reference import brdf_parameters
     return brdf_parameters(parse_brdf(spec, lib))
 
 
@@ -300,7 +300,7 @@ def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:
 def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
     """Errors of every (target, dtype) against the reference for one spec: {set: {"target/dtype": Errors}}."""
     from .evaluate import evaluate, gpu_kernel
-    from .reference import reference_brdf
+    from ..reference import reference_brdf
 
     declared = declared_params(spec, lib)
     sets = {"hemisphere": [hemisphere(hemisphere_k)], "stress": stress_sets(declared)}

@@ -13,9 +13,9 @@ import hashlib
 import re
 from dataclasses import dataclass
 
-from .bricks import BRDF_KINDS, Brick, Library
-from .lang import SourceError
-from .lang.errors import UserError
+from ..library.bricks import BRDF_KINDS, Brick, Library
+from ..lang import SourceError
+from ..lang.errors import UserError
 
 _TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[()+=,])")
 PRECISIONS = ("fp32",)  # fp16 is on the roadmap (issue: accuracy); the key keeps the axis

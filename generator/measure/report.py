@@ -14,10 +14,10 @@ import io
 import json
 from collections import Counter
 
-from . import __version__
-from .cost import COUNT_FIELDS
-from .costs import REPORT_LANGUAGES, CourseModel, Row
-from .toolchain import tool_versions
+from .. import __version__
+from ..analysis import COUNT_FIELDS
+from .plans import REPORT_LANGUAGES, CourseModel, Row
+from ..toolchain import tool_versions
 
 # Markdown columns: (header, Cost field or derived name).
 MD_COLUMNS = [("tex", "texture"), ("ALU", "alu"), ("transc.", "transcendental"), ("ALU+T", "alu_t"),

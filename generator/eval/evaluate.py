@@ -17,15 +17,13 @@ splats. Every bad input raises :class:`EvalError` ("what — what to do").
 """
 from __future__ import annotations
 
-import sys
-import types
 
 import numpy as np
 
-from . import DTYPES, GPU_TARGETS, TARGETS  # defined in the package, where the CLI reads them without numpy
-from .bricks import library_or_builtin
-from .compose import EvalProgram, compose_eval, eval_program
-from .lang.errors import UserError
+from .. import DTYPES, GPU_TARGETS, TARGETS  # defined in the package, where the CLI reads them without numpy
+from ..library.bricks import library_or_builtin
+from ..compose import EvalProgram, compose_eval, eval_program
+from ..lang.errors import UserError
 
 
 class EvalError(UserError, ValueError):
@@ -55,7 +53,7 @@ def program(spec: str, lib=None) -> EvalProgram:
 
 def resolve_params(ep: EvalProgram, params: dict | None) -> dict[str, list[float]]:
     """Every parameter of the BRDF as a flat list of floats (defaults filled in, ranges checked)."""
-    from .bricks import check_value
+    from ..library.bricks import check_value
 
     params = dict(params or {})
     unknown = sorted(set(params) - set(ep.params))
@@ -131,7 +129,7 @@ def _numpy_arg(ty, vals: list[float], dtype) -> np.ndarray:
 # ------------------------------------------------------------------ targets
 
 def _run_reference(ep: EvalProgram, vecs, values, n: int) -> np.ndarray:
-    from .reference import reference_brdf
+    from ..reference import reference_brdf
 
     ref_params = {k: (v[0] if ep.params[k].kind == "scalar" else list(v)) for k, v in values.items()}
     T = vecs[3] if len(vecs) > 3 else None
@@ -140,7 +138,7 @@ def _run_reference(ep: EvalProgram, vecs, values, n: int) -> np.ndarray:
 
 
 def _numpy_brdf(ep: EvalProgram, lib, dtype: str):
-    from .targets.numpy import NumpyTarget
+    from ..targets.numpy import NumpyTarget
 
     key = (id(lib), ep.spec, dtype)
     hit = _NUMPY.get(key)
@@ -165,7 +163,7 @@ def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int) -> np.nda
 
 def gpu_kernel(spec: str, language: str, lib=None, device=None):
     """The cached EvalKernel of a spec in one language on `device` (default: the shared lavapipe device)."""
-    from .runtime.eval_kernel import compile_kernel, shared_device
+    from ..runtime.eval_kernel import compile_kernel, shared_device
 
     lib = library_or_builtin(lib)
     ep = program(spec, lib)
@@ -222,13 +220,3 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
         return _run_numpy(ep, lib, vecs, values, dtype, n)
     return _run_gpu(ep, lib, target, vecs, values)
 
-
-class _CallableModule(types.ModuleType):
-    """Importing generator.evaluate sets the package attribute `evaluate` to this module, hiding
-    the wrapper function of generator/__init__.py; so the module itself calls evaluate()."""
-
-    def __call__(self, *args, **kwargs):
-        return evaluate(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule

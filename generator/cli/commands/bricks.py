@@ -28,7 +28,7 @@ def rows(lib) -> list[dict]:
 
 
 def run(args) -> int:
-    from ..bricks import load_library
+    from ...library.bricks import load_library
     table = rows(load_library(args.bricks or ()))
     if args.json:
         print(json.dumps(table, indent=2))

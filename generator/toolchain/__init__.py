@@ -64,8 +64,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable
 
-from .lang.errors import UserError
-from .targets import LANGUAGES
+from ..lang.errors import UserError
+from ..targets import LANGUAGES
 
 __all__ = ["Diagnostic", "CompileJob", "CompileResult", "ToolMissing",
            "compile_many", "tool_versions", "find_tool",
@@ -74,7 +74,7 @@ __all__ = ["Diagnostic", "CompileJob", "CompileResult", "ToolMissing",
 TARGET_ENV = "vulkan1.1"      # every tool gets this target environment
 SPIRV_VERSION = "1.3"         # what glslc emits for vulkan1.1; naga is told the same
 SPIRV_MAGIC = 0x07230203
-REPO_ROOT = Path(__file__).resolve().parent.parent
+REPO_ROOT = Path(__file__).resolve().parents[2]
 TOOLS_BIN = REPO_ROOT / ".tools" / "bin"
 STAGES = ("vert", "frag", "comp")
 _SENTINEL = "SHADERMATRIX_SENTINEL"

@@ -20,16 +20,16 @@ def run(args) -> int:
         print("error: give a SCENE or --bricks (one of them) — e.g. `shadermatrix costs scenes/example.toml` "
               "or `shadermatrix costs --bricks`", file=sys.stderr)
         return 2
-    from ..costs import brick_rows, course_models, load_cost_library, scene_rows
-    from ..costs_report import markdown, to_csv, to_json
+    from ...measure.plans import brick_rows, course_models, load_cost_library, scene_rows
+    from ...measure.report import markdown, to_csv, to_json
 
     models = None
     if args.bricks:
         rows = brick_rows(load_cost_library(args.brick_dir))
         subject, title, models = "bricks", "Costs per brick", course_models()[0]
     else:
-        from ..bricks import load_library
-        from ..scene import load_scene
+        from ...library.bricks import load_library
+        from ...matrix.scene import load_scene
         lib = load_library(args.brick_dir)
         scene = load_scene(args.scene, lib)
         rows = scene_rows(scene, lib)

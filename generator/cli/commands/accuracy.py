@@ -16,7 +16,7 @@ import json
 import sys
 from pathlib import Path
 
-from .. import DTYPES, GPU_TARGETS
+from ... import DTYPES, GPU_TARGETS
 
 HELP = "error of every target × dtype against the float64 references: hemisphere and stress set (Markdown/JSON)"
 TARGETS = ("numpy",) + GPU_TARGETS
@@ -49,13 +49,13 @@ def _list(value: str, allowed: tuple, what: str) -> list[str]:
 
 
 def run(args) -> int:
-    from .. import accuracy
-    from ..bricks import load_library
-    from ..cache import atomic_write
-    from ..evaluate import EvalError
-    from ..permutation import SpecError
-    from ..reference import ReferenceMissing
-    from ..runtime.device import VulkanUnavailable
+    from ...eval import accuracy
+    from ...library.bricks import load_library
+    from ...io import atomic_write
+    from ...eval.evaluate import EvalError
+    from ...matrix.permutation import SpecError
+    from ...reference import ReferenceMissing
+    from ...runtime.device import VulkanUnavailable
 
     try:
         if not 1 <= args.samples <= MAX_STRATA:

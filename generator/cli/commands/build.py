@@ -15,9 +15,9 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    from ..bricks import load_library
-    from ..build import build_scene
-    from ..scene import load_scene
+    from ...library.bricks import load_library
+    from ...build import build_scene
+    from ...matrix.scene import load_scene
     lib = load_library(args.bricks or ())
     scene = load_scene(args.scene, lib)
     res = build_scene(scene, lib, Path(args.out))

@@ -12,8 +12,8 @@ import re
 import sys
 import tomllib
 
-from generator import toolchain
-from generator.runtime import probe
+from .. import toolchain
+from ..runtime import probe
 
 # tool -> (pin key in pyproject, version pattern in `tool --version`)
 _TOOLS = {

@@ -7,8 +7,9 @@ import pkgutil
 import signal
 import sys
 
-from . import __version__, commands
-from .lang.errors import UserError
+from .. import __version__
+from . import commands
+from ..lang.errors import UserError
 
 
 def _command_names() -> list[str]:
@@ -48,7 +49,3 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("interrupted; earlier outputs are intact", file=sys.stderr)
         return 130
-
-
-if __name__ == "__main__":
-    sys.exit(main())

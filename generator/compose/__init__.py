@@ -14,16 +14,16 @@ from pathlib import Path
 
 import jinja2
 
-from . import __version__
-from .bricks import Library
-from .glue import Program, brdf_glue, brdf_params, check_packing, glue_header, shade_glue
-from .lang import SourceError
-from .lang.types import Type
-from .permutation import Node, Permutation, parse_brdf, resolve
-from .targets import LANGUAGES, get_target
-from .targets.base import Emitted
+from .. import __version__
+from ..library.bricks import Library
+from ..link.glue import Program, brdf_glue, brdf_params, check_packing, glue_header, shade_glue
+from ..lang import SourceError
+from ..lang.types import Type
+from ..matrix.permutation import Node, Permutation, parse_brdf, resolve
+from ..targets import LANGUAGES, get_target
+from ..targets.base import Emitted
 
-TEMPLATES = Path(__file__).resolve().parent.parent / "templates"
+TEMPLATES = Path(__file__).resolve().parents[2] / "templates"
 STAGE_EXT = {"vert": "vert", "frag": "frag", "comp": "comp"}
 
 

@@ -15,10 +15,10 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .bricks import Library, check_value
-from .glue import brdf_params, check_packing
-from .lang import SourceError
-from .lang.errors import read_text
+from ..library.bricks import Library, check_value
+from ..link.glue import brdf_params, check_packing
+from ..lang import SourceError
+from ..lang.errors import read_text
 from .permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec, resolve
 
 

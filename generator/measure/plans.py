@@ -34,19 +34,19 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .bricks import BRDF_KINDS, KINDS, Brick, Library, load_brick, load_library
-from .build import compile_scene, job_key, show_progress
-from .compose import Composed, compose_eval, compose_permutation
-from .cost import Cost, entry_cost
-from .lang import SourceError
-from .permutation import LightKey, Permutation, SpecError, parse_brdf, parse_spec
-from .scene import Scene
-from .toolchain import CompileJob, compile_many
+from ..library.bricks import BRDF_KINDS, KINDS, Brick, Library, load_brick, load_library
+from ..build import compile_scene, job_key, show_progress
+from ..compose import Composed, compose_eval, compose_permutation
+from ..analysis import Cost, entry_cost
+from ..lang import SourceError
+from ..matrix.permutation import LightKey, Permutation, SpecError, parse_brdf, parse_spec
+from ..matrix.scene import Scene
+from ..toolchain import CompileJob, compile_many
 
 __all__ = ["Row", "CourseFigure", "CourseModel", "course_models", "course_figure", "brick_rows",
            "scene_rows", "load_cost_library", "standin", "is_standin", "COST_BRICKS", "REPORT_LANGUAGES"]
 
-COST_BRICKS = Path(__file__).resolve().parent / "cost_bricks"
+COST_BRICKS = Path(__file__).resolve().parent / "standins"
 COURSE_FILE = Path(__file__).resolve().parent / "course_costs.toml"
 REPORT_LANGUAGES = ("hlsl", "glsl", "wgsl")  # column order of the reports
 STANDIN_CITE = "shadermatrix cost baseline (no model)"  # what marks a stand-in brick

@@ -11,11 +11,11 @@ from __future__ import annotations
 import copy
 from dataclasses import dataclass, field
 
-from .bricks import GEOMETRY, KINDS, SURFACE, Brick
-from .lang import Signature, SourceError, parse_module
-from .lang import ir
-from .lang.types import TEXTURE2D, Type
-from .permutation import Node, Resolved
+from ..library.bricks import GEOMETRY, KINDS, SURFACE, Brick
+from ..lang import Signature, SourceError, parse_module
+from ..lang import ir
+from ..lang.types import TEXTURE2D, Type
+from ..matrix.permutation import Node, Resolved
 
 GLUE_PATH = "<glue>"
 

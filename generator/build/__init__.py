@@ -13,15 +13,15 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import __version__
-from .bricks import Library
-from .cache import atomic_write, sha256
-from .compose import Composed, compose_permutation
-from .cost import entry_cost
-from .lang import SourceError
-from .scene import Scene
-from .targets import LANGUAGES
-from .toolchain import CompileJob, CompileResult, compile_many, tool_versions
+from .. import __version__
+from ..library.bricks import Library
+from ..io import atomic_write, sha256
+from ..compose import Composed, compose_permutation
+from ..analysis import entry_cost
+from ..lang import SourceError
+from ..matrix.scene import Scene
+from ..targets import LANGUAGES
+from ..toolchain import CompileJob, CompileResult, compile_many, tool_versions
 
 
 @dataclass

@@ -8,12 +8,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .lang import Signature, SourceError, parse_module, read_meta
-from .lang.errors import read_text
-from .lang import ir
-from .lang.types import BUILTIN_TYPES, FLOAT, VEC3, Type
+from ..lang import Signature, SourceError, parse_module, read_meta
+from ..lang.errors import read_text
+from ..lang import ir
+from ..lang.types import BUILTIN_TYPES, FLOAT, VEC3, Type
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 BUILTIN_BRICKS = REPO / "bricks"
 
 

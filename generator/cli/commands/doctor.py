@@ -7,5 +7,5 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    from ..doctor import run_doctor
+    from ..doctor_report import run_doctor
     return run_doctor()

@@ -1,0 +1,1 @@
+"""Cost plans (per permutation, per brick against stand-ins) and their reports."""
