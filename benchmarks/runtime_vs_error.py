@@ -74,7 +74,7 @@ def _microfacet_factors(node, g, params: dict) -> dict:
     fill = {slot: n.brick.id for slot, n in node.fillers}
     alpha, f0 = float(params["alpha"]), np.broadcast_to(np.asarray(params["f0"], np.float64), (g.count, 3))
     lam = lambda_ggx if fill["ndf"] == "ggx" else lambda_beckmann
-    return {"D": lookup("ndf", fill["ndf"])(g.NdotH, g.sin2_h, alpha),
+    return {"D": lookup("ndf", fill["ndf"])(g.NdotH, g.NxH2, alpha),
             "F": lookup("fresnel", fill["fresnel"])(f0, g.VdotH), "F_exact": fresnel_dielectric_f0(f0, g.VdotH),
             "G": lookup("visibility", fill["vis"])(g, alpha),
             "G_exact": smith_g_separable(g.NdotL, g.NdotV, alpha, lam)}

@@ -130,7 +130,7 @@ def test_policy_no_light_from_below_and_view_below_the_horizon_shades_as_grazing
 def test_undefined_half_vector_is_zero_and_gives_finite_values():
     L = np.array([[0.6, 0.0, 0.8]])
     g = shading_geometry(L, -L, [0.0, 0.0, 1.0])
-    assert g.NdotH[0] == 0.0 and g.VdotH[0] == 0.0 and g.sin2_h[0] == 1.0
+    assert g.NdotH[0] == 0.0 and g.VdotH[0] == 0.0 and g.NxH2[0] == 1.0
     for spec in SPECS:
         f = reference_brdf(spec, L, -L, [0.0, 0.0, 1.0])
         assert np.all(np.isfinite(f)), spec

@@ -9,7 +9,7 @@ Whole BRDFs (models.py)
   REFERENCES[kind][brick_id], reference(kind, id) (decorator), lookup(kind, id),
   missing_references(lib), brdf_parameters(nodes), ReferenceMissing.
 Geometry (geometry.py)
-  shading_geometry(L, V, N, T=None) -> Geometry (NdotL, NdotV, NdotH, sin2_h, VdotH, ...), NV_MIN.
+  shading_geometry(L, V, N, T=None) -> Geometry (NdotL, NdotV, NdotH, NxH2, VdotH, ...: the inputs table), NV_MIN.
 Exact quantities (exact.py); cosines in [0, 1], alpha = GGX α or Beckmann m
   NDFs:     d_ggx(cos_h, sin2_h, alpha), d_beckmann(...), d_blinn_phong(...),
             blinn_phong_exponent(alpha), cos_power(cos, sin2, n)

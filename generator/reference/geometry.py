@@ -11,14 +11,16 @@ they apply the same documented policy (NOTES.md, "Shading conventions"):
 
 Everything else is exact float64: h is normalized exactly, and sin²θ_h is
 |n × h|² near h = n, where 1 - cos² would lose its digits (ACCURACY-FACTS pitfall 4).
+The formulas are the inputs table's float64 column (generator/library/inputs.py):
+the references share that table with the glue, never the bricks' code.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-NV_MIN = 1e-4  # the n·v clamp of the policy (Filament's clampNoV)
+from ..library.inputs import INPUTS, NV_MIN, float64_geometry
 
 
 def _dot(a, b):
@@ -37,13 +39,16 @@ def _rows(x, name: str, n: int) -> np.ndarray:
 
 @dataclass
 class Geometry:
-    """Cosines of one batch of (l, v, n[, t]) samples, after the shading policy; arrays of shape (N,)."""
+    """The shading inputs of one batch of (l, v, n[, t]) samples, after the shading policy.
+
+    Fields carry the names of the inputs table (generator/library/inputs.py); scalars are (N,).
+    """
 
     lit: np.ndarray  # n·l > 0
     NdotL: np.ndarray  # min(n·l, 1); only meaningful where lit
     NdotV: np.ndarray  # clamp(n·v, 1e-4, 1)
     NdotH: np.ndarray  # clamp(n·h, 0, 1); 0 for l = -v
-    sin2_h: np.ndarray  # sin²θ_h = |n × h|² (1 where n·h <= 0 or h is undefined)
+    NxH2: np.ndarray  # sin²θ_h = |n × h|² (1 where n·h <= 0 or h is undefined)
     VdotH: np.ndarray  # clamp(v·h, 0, 1) = l·h
     LdotH: np.ndarray
     LdotV: np.ndarray  # l·v (unclamped)
@@ -53,38 +58,25 @@ class Geometry:
     N: np.ndarray
     H: np.ndarray  # unit half vector, or 0 where l = -v
     T: np.ndarray | None = None
+    tangent: dict = field(default_factory=dict)  # B, HdotT, HdotB, LdotT, VdotT, LdotB, VdotB when T is given
 
     @property
     def count(self) -> int:
         return self.lit.shape[0]
 
+    def __getitem__(self, name: str) -> np.ndarray:
+        """Any row of the inputs table by name."""
+        if name in self.tangent:
+            return self.tangent[name]
+        return getattr(self, name)
+
 
 def shading_geometry(L, V, N, T=None) -> Geometry:
-    """The geometric inputs of a BRDF, in float64, under the NOTES.md shading policy."""
+    """The shading inputs of a BRDF in float64, from the inputs table's formulas (NOTES.md policy)."""
     n = max(np.shape(x)[0] if np.ndim(x) == 2 else 1 for x in (L, V, N))
     L, V, N = _rows(L, "L", n), _rows(V, "V", n), _rows(N, "N", n)
     T = None if T is None else _rows(T, "T", n)
-    nl = _dot(N, L)
-    nv = _dot(N, V)
-    s = L + V
-    s2 = _dot(s, s)
-    ok = s2 > 0.0
-    H = np.where(ok[:, None], s / np.sqrt(np.where(ok, s2, 1.0))[:, None], 0.0)
-    nh = _dot(N, H)
-    # sin²θ_h in its well-conditioned form: |n × h|² near h = n, (1 - c)(1 + c) elsewhere.
-    cross = np.cross(N, H)
-    sin2 = np.where(nh * nh > 0.5, _dot(cross, cross), (1.0 - nh) * (1.0 + nh))
-    sin2 = np.where(ok & (nh > 0.0), sin2, 1.0)
-    R = 2.0 * nl[:, None] * N - L
-    return Geometry(
-        lit=nl > 0.0,
-        NdotL=np.minimum(nl, 1.0),
-        NdotV=np.clip(nv, NV_MIN, 1.0),
-        NdotH=np.clip(nh, 0.0, 1.0),
-        sin2_h=np.minimum(sin2, 1.0),
-        VdotH=np.clip(_dot(V, H), 0.0, 1.0),
-        LdotH=np.clip(_dot(L, H), 0.0, 1.0),
-        LdotV=_dot(L, V),
-        RdotV=np.clip(_dot(R, V), 0.0, 1.0),
-        L=L, V=V, N=N, H=H, T=T,
-    )
+    g = float64_geometry(L, V, N, T)
+    fields = {f: g[f] for f in ("NdotL", "NdotV", "NdotH", "NxH2", "VdotH", "LdotH", "LdotV", "RdotV", "H")}
+    tangent = {r.name: g[r.name] for r in INPUTS if r.tangent and r.name != "T" and r.name in g}
+    return Geometry(lit=_dot(N, L) > 0.0, L=L, V=V, N=N, T=T, tangent=tangent, **fields)

@@ -73,7 +73,7 @@ def phong_normalized(g: Geometry, p: dict, slots: dict) -> np.ndarray:
 def blinn_phong_normalized(g: Geometry, p: dict, slots: dict) -> np.ndarray:
     """f = (n+4)/(8π) R_F(0) cos^n θ_h (Hoffman & Baker 2006, normalized Blinn-Phong)."""
     n = p["n"]
-    return p["f0"] * _rgb((n + 4.0) / (8.0 * np.pi) * exact.cos_power(g.NdotH, g.sin2_h, n))
+    return p["f0"] * _rgb((n + 4.0) / (8.0 * np.pi) * exact.cos_power(g.NdotH, g.NxH2, n))
 
 
 @reference("specular", "microfacet")
@@ -81,7 +81,7 @@ def microfacet(g: Geometry, p: dict, slots: dict) -> np.ndarray:
     """f = F(v·h) D(h) G(l, v) / (4 (n·l)(n·v)) (Walter et al. 2007 eq. 20; RTR3 eq. 7.51;
     Cook & Torrance 1982 with the 1/4 of the half-vector Jacobian)."""
     a = p["alpha"]
-    D = slots["ndf"](g.NdotH, g.sin2_h, a)
+    D = slots["ndf"](g.NdotH, g.NxH2, a)
     G = slots["vis"](g, a)
     F = slots["fresnel"](p["f0"], g.VdotH)
     with np.errstate(divide="ignore", invalid="ignore"):
