@@ -12,37 +12,14 @@ import ast
 
 from . import ir
 from .errors import SourceError
+from .annotations import check_identifier, node_error, parse_type  # noqa: F401  (re-exported)
 from .intrinsics import CONSTANTS, INTRINSICS
-from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, TEXTURE2D, Type, vector
+from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, TEXTURE2D, TEXTURECUBE, UINT, Type, vector
 
 ARITH = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Mod: "%"}
 _CMP = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
 F32_MAX = 3.4028234663852886e38
 _SWZ = {"x": "x", "y": "y", "z": "z", "w": "w", "r": "x", "g": "y", "b": "z", "a": "w"}
-
-
-def _node_error(path: str, node, message: str, hint: str = "") -> SourceError:
-    return SourceError(path, getattr(node, "lineno", 1), getattr(node, "col_offset", 0) + 1, message, hint)
-
-
-def parse_type(path: str, node, structs: dict[str, Type]) -> Type:
-    """A type annotation: a builtin type name or a struct declared in the same brick."""
-    if isinstance(node, ast.Name):
-        if node.id in BUILTIN_TYPES:
-            return BUILTIN_TYPES[node.id]
-        if node.id in structs:
-            return structs[node.id]
-    if isinstance(node, ast.Constant) and node.value is None:
-        raise _node_error(path, node, "functions must return a value", "bricks are pure: return a float, vector or struct")
-    names = ", ".join(sorted(BUILTIN_TYPES))
-    shown = ast.unparse(node) if isinstance(node, ast.AST) else str(node)
-    raise _node_error(path, node, f"unknown type '{shown}'", f"use one of {names} or a struct declared in this brick")
-
-
-def check_identifier(path: str, node, name: str) -> None:
-    if name.startswith("_") or "__" in name:
-        raise _node_error(path, node, f"identifier '{name}' starts with or contains '__' / '_'",
-                   "names beginning with '_' or containing '__' are reserved for the generator; rename it")
 
 
 class ExprChecker:
@@ -137,22 +114,31 @@ class ExprChecker:
                 return ir.Member(ft, loc, base, n.attr)
             raise self.err(n, f"{base.ty} has no attribute '{n.attr}'", "swizzle vectors (v.xy), read struct fields (s.f)")
         if isinstance(n, ast.Subscript):
-            base = self.expr(n.value)
-            idx = self.expr(n.slice)
-            if idx.ty != INT:
-                raise self.err(n.slice, f"index must be int, got {idx.ty}", "use an int expression")
-            if base.ty.kind == "vector":
-                if isinstance(idx, ir.Const) and not 0 <= idx.value < base.ty.size:
-                    raise self.err(n.slice, f"index {idx.value} is out of range for {base.ty}", f"use 0..{base.ty.size - 1}")
-                return ir.Index(vector(base.ty.scalar, 1), loc, base, idx)
-            if base.ty.kind == "matrix":
-                return ir.Index(vector("float", base.ty.size), loc, base, idx)
-            raise self.err(n, f"cannot index {base.ty}", "index vectors and matrices")
+            return self.subscript(n)
         kinds = {"List": "lists", "Tuple": "tuples", "Dict": "dicts", "Lambda": "lambdas",
                  "ListComp": "comprehensions", "JoinedStr": "strings"}
         kind = type(n).__name__
         raise self.err(n, f"{kinds.get(kind, kind)} are not allowed in a brick expression",
                        "use arithmetic, comparisons, calls, swizzles and `a if c else b`")
+
+    def subscript(self, n: ast.Subscript) -> ir.Expr:
+        loc = self.loc(n)
+        base = self.expr(n.value)
+        idx = self.expr(n.slice)
+        if idx.ty not in (INT, UINT):
+            raise self.err(n.slice, f"index must be int or uint, got {idx.ty}", "use an int expression")
+        size = {"vector": base.ty.size, "array": base.ty.size}.get(base.ty.kind, 0)
+        if base.ty.kind == "buffer" and base.ty.space == "uniform":
+            size = base.ty.size
+        if size and isinstance(idx, ir.Const) and not 0 <= idx.value < size:
+            raise self.err(n.slice, f"index {idx.value} is out of range for {base.ty}", f"use 0..{size - 1}")
+        if base.ty.kind == "vector":
+            return ir.Index(vector(base.ty.scalar, 1), loc, base, idx)
+        if base.ty.kind == "matrix":
+            return ir.Index(vector("float", base.ty.size), loc, base, idx)
+        if base.ty.kind in ("array", "buffer"):
+            return ir.Index(base.ty.elem, loc, base, idx)
+        raise self.err(n, f"cannot index {base.ty}", "index vectors, matrices, arrays and buffers")
 
     def name(self, n: ast.Name) -> ir.Expr:
         loc = self.loc(n)
@@ -160,6 +146,9 @@ class ExprChecker:
         if found is not None:
             ty, scope = found
             return ir.Var(ty, loc, n.id, "local" if scope == "loopvar" else scope)
+        resources = getattr(self, "globals", None) or {}
+        if n.id in resources:
+            return ir.Var(resources[n.id].ty, loc, n.id, "global")
         if n.id in self.constants:
             c = self.constants[n.id]
             return ir.Const(c.ty, loc, c.value)
@@ -231,7 +220,7 @@ class ExprChecker:
     def construct(self, n, ty: Type, args) -> ir.Expr:
         loc = self.loc(n)
         if ty.kind == "texture":
-            raise self.err(n, "textures cannot be constructed", "declare a texture2d parameter")
+            raise self.err(n, "textures cannot be constructed", f"declare a {ty} parameter")
         if ty.kind == "scalar":
             if len(args) != 1 or args[0].ty.kind != "scalar":
                 raise self.err(n, f"{ty}(...) converts one scalar", f"write {ty}(x)")
@@ -273,7 +262,8 @@ class ExprChecker:
         loc = self.loc(n)
         sig = INTRINSICS[name]["sig"]
         arity = {"gen": 1, "gen2": 2, "gen3": 3, "mix": 3, "minmax": 2, "absign": 1, "dot": 2, "length": 1,
-                 "cross": 2, "normalize": 1, "reflect": 2, "step": 2, "select": 3, "sample": 2, "sample_lod": 3}[sig]
+                 "cross": 2, "normalize": 1, "reflect": 2, "step": 2, "select": 3, "sample": 2, "sample_lod": 3,
+                 "buffer_length": 1}[sig]
         if len(args) != arity:
             raise self.err(n, f"{name} takes {arity} argument{'s' if arity != 1 else ''}, got {len(args)}",
                            "see the intrinsics table in generator/lang/intrinsics.py")
@@ -320,10 +310,17 @@ class ExprChecker:
                 raise fail("(bool, T, T) with T a scalar or vector (WGSL select)")
             return ir.Intrinsic(types[1], loc, name, args)
         if sig in ("sample", "sample_lod"):
-            want = [TEXTURE2D, vector("float", 2)] + ([FLOAT] if sig == "sample_lod" else [])
+            coord = vector("float", 3) if types[0] == TEXTURECUBE else vector("float", 2)
+            tex = TEXTURECUBE if types[0] == TEXTURECUBE else TEXTURE2D
+            want = [tex, coord] + ([FLOAT] if sig == "sample_lod" else [])
             if types != want:
-                raise fail("(" + ", ".join(map(str, want)) + ")")
+                lod = ", float" if sig == "sample_lod" else ""
+                raise fail(f"(texture2d, vec2{lod}) or (texturecube, vec3{lod})")
             if not isinstance(args[0], ir.Var) or args[0].scope != "param":
-                raise self.err(n, "sample() takes a texture2d parameter", "pass the texture as a function parameter")
+                raise self.err(n, f"{name}() takes a texture parameter", "pass the texture as a function parameter")
             return ir.Intrinsic(vector("float", 4), loc, name, args)
+        if sig == "buffer_length":
+            if types[0].kind != "buffer":
+                raise fail("a buffer declared at the top level of the brick")
+            return ir.Intrinsic(UINT, loc, name, args)
         raise AssertionError(sig)

@@ -17,8 +17,10 @@ Typing rules (`sig`):
   reflect    f(vN, vN) -> vN
   step       f(T, T) -> T
   select     f(bool, T, T) -> T           select(cond, if_true, if_false)
-  sample     f(texture2d, vec2) -> vec4
-  sample_lod f(texture2d, vec2, float) -> vec4
+  sample     f(texture2d, vec2) -> vec4       also f(texturecube, vec3 direction) -> vec4
+  sample_lod f(texture2d, vec2, float) -> vec4  also f(texturecube, vec3, float) -> vec4
+  buffer_length f(buffer) -> uint         elements in a storage buffer (run time),
+                                          a uniform buffer's capacity (constant)
 
 Where a rule takes T, a float scalar given for a vector T is splatted explicitly
 in the IR (clamp(v, 0.0, 1.0) becomes clamp(v, vec3(0.0), vec3(1.0))), because
@@ -60,6 +62,7 @@ INTRINSICS: dict[str, dict] = {
     "select": {"sig": "select", "cls": "alu"},
     "sample": {"sig": "sample", "cls": "texture"},
     "sample_level": {"sig": "sample_lod", "cls": "texture"},
+    "buffer_length": {"sig": "buffer_length", "cls": "alu"},
 }
 
 # Named constants usable in every brick (float64 values; emitted with 9+ digits).

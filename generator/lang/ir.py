@@ -2,13 +2,33 @@
 
 Every node carries its source location; every expression carries its type.
 Emitters (generator/targets/) walk these nodes; nothing else reads brick text.
+
+Every node is a plain dataclass, so glue (the link stage) builds IR directly,
+without brick text. The rules the checker enforces on parsed bricks hold for
+built IR too; the emitters assume them:
+
+- Arrays (`types.array(elem, n)`): read with Index(elem, base, i) (i int or uint),
+  written with Assign(target=Index(...)); an array value is built only as
+  Decl(value=Construct(array_type, [n elements])) (HLSL has no array expression),
+  and functions never return arrays.
+- Buffers (`types.storage_buffer(struct)`, `types.uniform_buffer(struct, n)`) are
+  global resources: declared by a Global (or a template calling the target's
+  declare_buffer), referenced as Var(buffer_type, loc, name, "global") and only as
+  the base of an Index (the element, a struct) or the argument of
+  Intrinsic(UINT, loc, "buffer_length", [var]). They are never written, passed or
+  stored.
+- Textures (`TEXTURE2D`, `TEXTURECUBE`) are parameters or globals, passed by name.
+- Switch selectors are int or uint; case values are distinct ints in the
+  selector's range; a case never falls through.
+- A runtime For bound is an int or uint expression that the body does not change
+  (the shading languages re-evaluate it before every iteration).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any
 
-from .types import Type
+from .types import INT, Type
 
 
 @dataclass(frozen=True)
@@ -143,11 +163,37 @@ class If(Stmt):
 
 @dataclass
 class For(Stmt):
-    """for var in range(count): count is a compile-time int constant."""
+    """for var in range(count) with a compile-time int constant count, or
+    for var in range(bound) with a runtime int/uint expression (then `count` is unused, 0).
+
+    The loop variable is int, or uint when the bound is uint (`var_type`). A runtime
+    bound is read before every iteration in GLSL/HLSL/WGSL: the body must not
+    assign anything it reads (the checker enforces this for bricks).
+    """
 
     var: str
     count: int
     body: list[Stmt]
+    bound: Expr | None = None
+
+    @property
+    def var_type(self) -> Type:
+        return self.bound.ty if self.bound is not None and self.bound.ty.scalar == "uint" else INT
+
+
+@dataclass
+class Switch(Stmt):
+    """match selector: case v0 | v1: ... case _: ... (`match` in bricks; `switch` in the targets).
+
+    selector: an int or uint expression. cases: [((v, ...), body), ...] with every
+    value a Python int, distinct across the switch and in the selector's range.
+    default: the body of `case _` ([] when there is none). No fallthrough: a
+    body that does not return ends with `break;` in GLSL/HLSL.
+    """
+
+    selector: Expr
+    cases: list[tuple[tuple[int, ...], list[Stmt]]]
+    default: list[Stmt] = field(default_factory=list)
 
 
 @dataclass
@@ -181,6 +227,25 @@ class Function:
 
 
 @dataclass
+class Global:
+    """A global resource declaration: a buffer or texture that functions read as Var(..., "global").
+
+    ty: a buffer type (types.storage_buffer / uniform_buffer) or a texture type.
+    set, binding: its descriptor set and binding (a texture takes B and B+1 for its
+    sampler). Emitters declare it with Target.declare_global(g) between the
+    structs and the functions (Target.emit(..., globals=[...])). Bricks declare
+    buffers at top level (`lights: storage_buffer[Light]`) with set = binding = -1:
+    the link stage assigns the real ones.
+    """
+
+    name: str
+    ty: Type
+    set: int = -1
+    binding: int = -1
+    loc: Loc | None = None
+
+
+@dataclass
 class Module:
     """One parsed brick file."""
 
@@ -192,6 +257,7 @@ class Module:
     constants: dict[str, Const]
     functions: dict[str, Function]
     source_hash: str
+    globals: dict[str, Global] = field(default_factory=dict)  # top-level buffer declarations
 
 
 # ---------------------------------------------------------------- traversal
@@ -217,7 +283,9 @@ def children(node) -> list:
     if isinstance(node, If):
         return [node.cond, *node.then, *node.orelse]
     if isinstance(node, For):
-        return list(node.body)
+        return ([node.bound] if node.bound is not None else []) + list(node.body)
+    if isinstance(node, Switch):
+        return [node.selector, *(s for _, body in node.cases for s in body), *node.default]
     if isinstance(node, Return):
         return [node.value] if node.value is not None else []
     return []

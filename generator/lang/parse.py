@@ -2,7 +2,9 @@
 
 A brick file holds a docstring, a literal `BRICK = {...}` metadata dict (read
 with ast.literal_eval), optional UPPERCASE literal constants, optional structs
-(`class Name:` with annotated fields only) and typed pure functions.
+(`class Name:` with annotated fields only), read-only buffer declarations
+(`lights: storage_buffer[Light]`, `table: uniform_buffer[Entry, 16]`: global
+resources the functions read by name; ir.Module.globals) and typed pure functions.
 """
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ from dataclasses import dataclass
 from . import ir
 from .errors import SourceError
 from .intrinsics import CONSTANTS
-from .exprs import check_identifier, parse_type
+from .annotations import check_identifier, parse_type
 from .typecheck import Checker
 from .types import BUILTIN_TYPES, Type, struct
 
@@ -68,6 +70,7 @@ def parse_module(text: str, path: str, externals: dict[str, Signature] | None = 
     structs: dict[str, Type] = {}
     constants: dict[str, ir.Const] = {}
     fdefs: list[ast.FunctionDef] = []
+    resources: dict[str, ir.Global] = {}
     for i, node in enumerate(tree.body):
         if i == 0 and isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str):
             continue
@@ -78,17 +81,21 @@ def parse_module(text: str, path: str, externals: dict[str, Signature] | None = 
                 continue
             constants[name] = _module_constant(path, node, name, node.value)
             continue
+        if isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and node.value is None:
+            name = node.target.id
+            resources[name] = _resource(path, node, name, structs, constants, resources)
+            continue
         if isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and node.value is not None:
             name = node.target.id
             c = _module_constant(path, node, name, node.value)
-            want = parse_type(path, node.annotation, structs)
+            want = parse_type(path, node.annotation, structs, constants)
             if c.ty != want:
                 raise _err(path, node.value, f"constant {name} is declared {want} but its value is {c.ty}",
                            "write a float literal with a decimal point (1.0) for float constants")
             constants[name] = c
             continue
         if isinstance(node, ast.ClassDef):
-            structs[node.name] = _parse_struct(path, node, structs)
+            structs[node.name] = _parse_struct(path, node, structs, constants)
             continue
         if isinstance(node, ast.FunctionDef):
             fdefs.append(node)
@@ -97,7 +104,7 @@ def parse_module(text: str, path: str, externals: dict[str, Signature] | None = 
             raise _err(path, node, "imports are not allowed in a brick",
                        "bricks are parsed, never executed; intrinsics (pow, dot, ...) and constants (PI) need no import")
         raise _err(path, node, f"'{type(node).__name__}' is not allowed at the top level of a brick",
-                   "a brick holds a docstring, BRICK = {...}, UPPERCASE constants, structs and functions")
+                   "a brick holds a docstring, BRICK = {...}, UPPERCASE constants, structs, buffers and functions")
     if meta is None:
         raise SourceError(path, 1, 1, "no BRICK metadata dict", 'add BRICK = {"kind": "...", "params": {...}} at top level')
 
@@ -107,14 +114,31 @@ def parse_module(text: str, path: str, externals: dict[str, Signature] | None = 
         check_identifier(path, f, f.name)
         if f.name in sigs:
             raise _err(path, f, f"function '{f.name}' is defined twice or shadows a slot", "rename one of them")
-        sigs[f.name] = _signature(path, f, structs)
+        if f.name in resources:
+            raise _err(path, f, f"function '{f.name}' has the name of a buffer", "rename one of them")
+        sigs[f.name] = _signature(path, f, structs, constants)
     functions: dict[str, ir.Function] = {}
     for f in fdefs:
-        checker = Checker(path, structs, constants, sigs, set(externals or {}))
+        checker = Checker(path, structs, constants, sigs, set(externals or {}), resources)
         functions[f.name] = checker.function(f, sigs[f.name])
     _reject_recursion(path, functions, fdefs)
     digest = hashlib.sha256(text.encode()).hexdigest()
-    return ir.Module(path, doc, meta, meta_loc, structs, constants, functions, digest)
+    return ir.Module(path, doc, meta, meta_loc, structs, constants, functions, digest, resources)
+
+
+def _resource(path, node: ast.AnnAssign, name, structs, constants, resources) -> ir.Global:
+    """`name: storage_buffer[S]` or `name: uniform_buffer[S, N]` at the top level."""
+    check_identifier(path, node.target, name)
+    if name.isupper():
+        raise _err(path, node, f"constant {name} has no value", f"write {name}: {ast.unparse(node.annotation)} = <literal>")
+    ty = parse_type(path, node.annotation, structs, constants, resource=True)
+    if ty.kind != "buffer":
+        raise _err(path, node, f"'{name}: {ty}' at the top level declares nothing",
+                   "top-level declarations without a value are buffers (storage_buffer[S], uniform_buffer[S, N]); "
+                   "textures are function parameters")
+    if name in resources or name in structs or name in CONSTANTS or name in BUILTIN_TYPES:
+        raise _err(path, node, f"'{name}' is declared twice or shadows a type or constant", "rename the buffer")
+    return ir.Global(name, ty, -1, -1, _loc(path, node))
 
 
 def _module_constant(path, node, name, value) -> ir.Const:
@@ -134,7 +158,7 @@ def _module_constant(path, node, name, value) -> ir.Const:
     raise _err(path, value, f"constant {name} must be a number literal", "write e.g. K = 0.5 or N = 4")
 
 
-def _parse_struct(path, node: ast.ClassDef, structs) -> Type:
+def _parse_struct(path, node: ast.ClassDef, structs, constants) -> Type:
     check_identifier(path, node, node.name)
     if node.bases or node.keywords or node.decorator_list:
         raise _err(path, node, "a struct is a plain class with annotated fields", "remove base classes and decorators")
@@ -144,7 +168,7 @@ def _parse_struct(path, node: ast.ClassDef, structs) -> Type:
             continue
         if isinstance(item, ast.AnnAssign) and isinstance(item.target, ast.Name) and item.value is None:
             check_identifier(path, item, item.target.id)
-            fields.append((item.target.id, parse_type(path, item.annotation, structs)))
+            fields.append((item.target.id, parse_type(path, item.annotation, structs, constants)))
             continue
         raise _err(path, item, "a struct body holds only annotated fields (name: type)",
                    "move functions to the top level; remove default values")
@@ -153,7 +177,7 @@ def _parse_struct(path, node: ast.ClassDef, structs) -> Type:
     return struct(node.name, fields)
 
 
-def _signature(path, f: ast.FunctionDef, structs) -> Signature:
+def _signature(path, f: ast.FunctionDef, structs, constants) -> Signature:
     a = f.args
     if a.vararg or a.kwarg or a.kwonlyargs or a.defaults or a.posonlyargs or a.kw_defaults:
         raise _err(path, f, "only plain positional parameters with type annotations are allowed",
@@ -165,10 +189,14 @@ def _signature(path, f: ast.FunctionDef, structs) -> Signature:
         check_identifier(path, arg, arg.arg)
         if arg.annotation is None:
             raise _err(path, arg, f"parameter '{arg.arg}' has no type", f"annotate it, e.g. {arg.arg}: float")
-        params.append((arg.arg, parse_type(path, arg.annotation, structs)))
+        params.append((arg.arg, parse_type(path, arg.annotation, structs, constants)))
     if f.returns is None:
         raise _err(path, f, f"function '{f.name}' has no return type", "annotate it, e.g. -> vec3")
-    return Signature(tuple(params), parse_type(path, f.returns, structs))
+    ret = parse_type(path, f.returns, structs, constants)
+    if ret.kind == "array":
+        raise _err(path, f.returns, f"function '{f.name}' returns an array (HLSL functions cannot)",
+                   "return a struct with an array field, or write into the caller's array")
+    return Signature(tuple(params), ret)
 
 
 def _reject_recursion(path, functions: dict[str, ir.Function], fdefs) -> None:

@@ -1,6 +1,7 @@
 """Lowering of function bodies (ast) to typed IR: functions, scopes and statements.
 
-Expressions are typed by generator/lang/exprs.py (ExprChecker, the base class).
+Expressions are typed by generator/lang/exprs.py (ExprChecker, a base class);
+loops and switches by generator/lang/control.py (ControlChecker).
 """
 from __future__ import annotations
 
@@ -8,17 +9,19 @@ import ast
 
 from . import ir
 from .errors import SourceError
+from .control import ControlChecker, always_returns
 from .exprs import ARITH, ExprChecker, check_identifier, parse_type
 from .intrinsics import CONSTANTS, INTRINSICS
-from .types import BOOL, BUILTIN_TYPES, INT
+from .types import BOOL, BUILTIN_TYPES, Type
 
 
-class Checker(ExprChecker):
-    """Lowers one function; holds its scopes."""
+class Checker(ControlChecker, ExprChecker):
+    """Lowers one function; holds its scopes. `globals`: the module's resources {name: ir.Global}."""
 
-    def __init__(self, path, structs, constants, sigs, externals):
+    def __init__(self, path, structs, constants, sigs, externals, globals=None):
         self.path, self.structs, self.constants = path, structs, constants
         self.sigs, self.externals = sigs, externals
+        self.globals: dict[str, ir.Global] = dict(globals or {})
         self.scopes: list[dict[str, tuple[Type, str]]] = []
         self.params: dict[str, ir.Param] = {}
         self.calls: list[str] = []
@@ -43,8 +46,9 @@ class Checker(ExprChecker):
         self.ret = sig.ret
         params = [ir.Param(n, t, self.loc(a)) for (n, t), a in zip(sig.params, f.args.args)]
         for p, a in zip(params, f.args.args):
-            if p.name in self.sigs or p.name in self.structs or p.name in CONSTANTS or p.name in BUILTIN_TYPES or p.name in INTRINSICS:
-                raise self.err(a, f"parameter '{p.name}' shadows a function, type, intrinsic or constant",
+            if (p.name in self.sigs or p.name in self.structs or p.name in CONSTANTS or p.name in BUILTIN_TYPES
+                    or p.name in INTRINSICS or p.name in self.globals):
+                raise self.err(a, f"parameter '{p.name}' shadows a function, type, intrinsic, constant or buffer",
                                "rename the parameter")
         self.params = {p.name: p for p in params}
         self.scopes = [{p.name: (p.ty, "param") for p in params}]
@@ -53,7 +57,7 @@ class Checker(ExprChecker):
         if doc:
             body_nodes = body_nodes[1:]
         body = self.block(body_nodes)
-        if not _always_returns(body):
+        if not always_returns(body):
             raise self.err(f, f"function '{f.name}' can reach its end without returning",
                            "end every path with a return statement")
         return ir.Function(f.name, params, sig.ret, body, self.loc(f), doc, self.calls)
@@ -84,7 +88,7 @@ class Checker(ExprChecker):
         if isinstance(n, ast.AnnAssign):
             if not isinstance(n.target, ast.Name) or n.value is None:
                 raise self.err(n, "an annotated assignment declares one local with a value", "write x: float = 0.0")
-            ty = parse_type(self.path, n.annotation, self.structs)
+            ty = parse_type(self.path, n.annotation, self.structs, self.constants)
             return self.declare(n, n.target, ty, n.value)
         if isinstance(n, ast.Assign):
             if len(n.targets) != 1 or isinstance(n.targets[0], (ast.Tuple, ast.List)):
@@ -99,6 +103,9 @@ class Checker(ExprChecker):
                                "types never convert implicitly; use float(...), vec3(...) or another name")
             if target.ty.kind == "texture":
                 raise self.err(t, "textures cannot be reassigned", "pass the texture you want directly")
+            if isinstance(n.value, ast.List):
+                raise self.err(n.value, "an array literal only initializes a declaration (HLSL has no array expression)",
+                               "declare a new array: w: array[float, 3] = [a, b, c], or assign element by element")
             return ir.Assign(loc, target, None, value)
         if isinstance(n, ast.AugAssign):
             op = ARITH.get(type(n.op))
@@ -115,6 +122,8 @@ class Checker(ExprChecker):
             return ir.If(loc, cond, self.block(n.body), self.block(n.orelse))
         if isinstance(n, ast.For):
             return self.for_loop(n)
+        if isinstance(n, ast.Match):
+            return self.match_stmt(n)
         if isinstance(n, ast.Expr):
             raise self.err(n, "an expression statement does nothing in a pure brick",
                            "assign its value or remove it (docstrings go first in a function)")
@@ -131,21 +140,29 @@ class Checker(ExprChecker):
         check_identifier(self.path, target, name)
         if self.lookup(name) is not None:
             raise self.err(target, f"'{name}' is already declared", "assign without an annotation, or use a new name")
-        if name in self.constants or name in CONSTANTS or name in BUILTIN_TYPES or name in INTRINSICS or name in self.sigs or name in self.structs:
+        if (name in self.constants or name in CONSTANTS or name in BUILTIN_TYPES or name in INTRINSICS
+                or name in self.sigs or name in self.structs or name in self.globals):
             raise self.err(target, f"'{name}' shadows a constant, type, intrinsic or function", "pick another name")
-        value = self.expr(value_node)
+        if isinstance(value_node, ast.List):
+            value = self.array_literal(value_node, ty, name)
+        else:
+            value = self.expr(value_node)
         if ty is not None:
             if value.ty != ty:
                 raise self.err(value_node, f"'{name}' is declared {ty} but the value is {value.ty}",
                                "types never convert implicitly; use float(...) or vec3(...)")
         if value.ty.kind == "texture":
             raise self.err(target, "textures cannot be stored in locals", "pass the texture parameter directly")
+        if value.ty.kind == "buffer":
+            raise self.err(target, "buffers cannot be stored in locals", "read elements by index: lights[i]")
         self.scopes[-1][name] = (value.ty, "local")
         return ir.Decl(self.loc(n), name, value.ty, value)
 
     def lvalue(self, t) -> ir.Expr:
         if isinstance(t, ast.Name):
             found = self.lookup(t.id)
+            if found is None and t.id in self.globals:
+                raise self.err(t, f"buffer '{t.id}' is read-only", "copy the element into a local and change that")
             if found is None:
                 raise self.err(t, f"'{t.id}' is not declared", "assign it first")
             ty, scope = found
@@ -167,42 +184,20 @@ class Checker(ExprChecker):
             return e
         raise self.err(t, "cannot assign to this expression", "assign to a local, a component (v.x) or a field (s.f)")
 
+    def array_literal(self, node: ast.List, ty: Type | None, name: str) -> ir.Construct:
+        if ty is None or ty.kind != "array":
+            raise self.err(node, "lists are not allowed except to initialize a local declared as an array",
+                           f"annotate it: {name}: array[float, {len(node.elts)}] = [...]")
+        elems = [self.expr(e) for e in node.elts]
+        if len(elems) != ty.size:
+            raise self.err(node, f"{ty} needs {ty.size} elements, got {len(elems)}", "give one value per element")
+        for e, en in zip(elems, node.elts):
+            if e.ty != ty.elem:
+                raise self.err(en, f"element is {e.ty}, the array holds {ty.elem}", "types never convert implicitly")
+        return ir.Construct(ty, self.loc(node), elems)
+
     def condition(self, node) -> ir.Expr:
         c = self.expr(node)
         if c.ty != BOOL:
             raise self.err(node, f"condition is {c.ty}, not bool", "compare explicitly, e.g. x > 0.0")
         return c
-
-    def for_loop(self, n: ast.For):
-        ok = (isinstance(n.iter, ast.Call) and isinstance(n.iter.func, ast.Name) and n.iter.func.id == "range"
-              and len(n.iter.args) == 1 and not n.iter.keywords and isinstance(n.target, ast.Name) and not n.orelse)
-        if not ok:
-            raise self.err(n, "only `for i in range(N)` loops are allowed", "N is an int literal or UPPERCASE int constant")
-        count_node = n.iter.args[0]
-        count = None
-        if isinstance(count_node, ast.Constant) and type(count_node.value) is int:
-            count = count_node.value
-        elif isinstance(count_node, ast.Name) and count_node.id in self.constants and self.constants[count_node.id].ty == INT:
-            count = self.constants[count_node.id].value
-        if count is None or count < 0:
-            raise self.err(count_node, "the loop count must be a non-negative int constant",
-                           "write range(4) or range(N) with N = 4 at the top of the brick")
-        check_identifier(self.path, n.target, n.target.id)
-        if self.lookup(n.target.id) is not None:
-            raise self.err(n.target, f"loop variable '{n.target.id}' is already declared", "use a new name")
-        self.scopes.append({n.target.id: (INT, "loopvar")})
-        body = self.block(n.body)
-        self.scopes.pop()
-        return ir.For(self.loc(n), n.target.id, count, body)
-
-
-def _always_returns(body: list[ir.Stmt]) -> bool:
-    if not body:
-        return False
-    last = body[-1]
-    if isinstance(last, ir.Return):
-        return True
-    if isinstance(last, ir.If):
-        return _always_returns(last.then) and _always_returns(last.orelse)
-    return False
-

@@ -1,4 +1,4 @@
-"""Types of the brick language: scalars, vectors, matrices, textures and structs."""
+"""Types of the brick language: scalars, vectors, matrices, textures, structs, arrays and buffers."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -10,11 +10,21 @@ SCALARS = ("float", "int", "uint", "bool")
 class Type:
     """A brick-language type.
 
-    kind: "scalar" | "vector" | "matrix" | "texture" | "struct" | "void".
+    kind: "scalar" | "vector" | "matrix" | "texture" | "struct" | "array" | "buffer" | "void".
     scalar: element scalar for scalar/vector/matrix ("float", "int", "uint", "bool").
-    size: vector width or matrix order (mat3 → 3); 1 for scalars.
-    name: the struct name for structs, the canonical spelling otherwise.
+    size: vector width or matrix order (mat3 → 3); 1 for scalars; the element count N of
+        array[T, N]; a buffer's capacity (0: a runtime-sized storage buffer).
+    name: the struct name for structs, the canonical spelling otherwise
+        ("texture2d", "texturecube", "array[Lobe, 4]", "storage_buffer[Light]").
     fields: for structs, ((field, Type), ...).
+    elem: the element type of an array or buffer (None otherwise).
+    space: for buffers, "storage" (read-only storage buffer, runtime-sized array of
+        structs) or "uniform" (uniform block holding array[elem, size]); "" otherwise.
+
+    Construct arrays, buffers and cube textures with array(), storage_buffer(),
+    uniform_buffer() and TEXTURECUBE below; buffers are global resources only
+    (never parameters, locals or struct fields) and their element structs obey
+    buffer_layout_error().
     """
 
     kind: str
@@ -22,6 +32,8 @@ class Type:
     size: int = 1
     name: str = ""
     fields: tuple = ()
+    elem: "Type | None" = None
+    space: str = ""
 
     def __str__(self) -> str:
         return self.name
@@ -43,12 +55,31 @@ class Type:
         return self.kind in ("scalar", "vector", "matrix") and self.scalar == "float"
 
     @property
+    def is_array(self) -> bool:
+        return self.kind == "array"
+
+    @property
+    def is_buffer(self) -> bool:
+        return self.kind == "buffer"
+
+    @property
+    def dim(self) -> str:
+        """A texture's dimension: "2d" or "cube" ("" for other types)."""
+        return {"texture2d": "2d", "texturecube": "cube"}.get(self.name, "") if self.kind == "texture" else ""
+
+    @property
     def components(self) -> int:
-        """Number of 32-bit scalar components (for layouts and costs)."""
+        """Number of 32-bit scalar components (for layouts and costs).
+
+        An array or uniform buffer counts size × its element; a runtime-sized storage
+        buffer counts 0 (its length is known only at run time).
+        """
         if self.kind == "matrix":
             return self.size * self.size
         if self.kind == "struct":
             return sum(t.components for _, t in self.fields)
+        if self.kind in ("array", "buffer"):
+            return self.size * self.elem.components
         return self.size
 
     def field(self, name: str) -> "Type | None":
@@ -86,11 +117,12 @@ BOOL = scalar("bool")
 VEC2, VEC3, VEC4 = vector("float", 2), vector("float", 3), vector("float", 4)
 MAT3, MAT4 = matrix(3), matrix(4)
 TEXTURE2D = Type("texture", "float", 1, "texture2d")
+TEXTURECUBE = Type("texture", "float", 1, "texturecube")
 VOID = Type("void", "", 0, "void")
 
 BUILTIN_TYPES: dict[str, Type] = {
     "float": FLOAT, "int": INT, "uint": UINT, "bool": BOOL,
-    "mat3": MAT3, "mat4": MAT4, "texture2d": TEXTURE2D,
+    "mat3": MAT3, "mat4": MAT4, "texture2d": TEXTURE2D, "texturecube": TEXTURECUBE,
 }
 for _s, _p in _VEC_PREFIX.items():
     for _n in (2, 3, 4):
@@ -100,3 +132,69 @@ for _s, _p in _VEC_PREFIX.items():
 def with_scalar(t: Type, s: str) -> Type:
     """The same shape with another element scalar (vec3 → bvec3)."""
     return vector(s, t.size) if t.kind in ("scalar", "vector") else t
+
+
+# ---------------------------------------------------------------- arrays and buffers
+
+ARRAY_ELEMENT_KINDS = ("scalar", "vector", "matrix", "struct")
+
+
+def array(elem: Type, n: int) -> Type:
+    """array[elem, n]: a fixed-capacity array (elem a scalar, vector, matrix or struct; n ≥ 1)."""
+    assert elem.kind in ARRAY_ELEMENT_KINDS, f"no arrays of {elem}"
+    assert type(n) is int and n >= 1, f"array size {n!r}"
+    return Type("array", "", n, f"array[{elem}, {n}]", (), elem)
+
+
+def storage_buffer(elem: Type) -> Type:
+    """A read-only storage buffer holding a runtime-sized array of elem (a struct)."""
+    _check_layout(elem)
+    return Type("buffer", "", 0, f"storage_buffer[{elem}]", (), elem, "storage")
+
+
+def uniform_buffer(elem: Type, capacity: int) -> Type:
+    """A uniform block holding array[elem, capacity] (elem a struct)."""
+    _check_layout(elem)
+    assert type(capacity) is int and capacity >= 1, f"uniform buffer capacity {capacity!r}"
+    return Type("buffer", "", capacity, f"uniform_buffer[{elem}, {capacity}]", (), elem, "uniform")
+
+
+BUFFER_LEAVES = ("vec4", "ivec4", "uvec4")
+
+
+def buffer_layout_error(elem: Type) -> str | None:
+    """Why `elem` cannot be a buffer element, or None.
+
+    The rule: a buffer element is a struct whose every leaf member is a 4-component
+    32-bit vector (vec4, ivec4, uvec4), directly, in nested structs or in fixed
+    arrays of those. Every member then starts on a 16-byte boundary and has a
+    16-byte-multiple size, so std430 (GLSL storage), std140 (GLSL uniform), HLSL
+    structured buffers and cbuffers (through glslang) and WGSL storage/uniform
+    layouts are byte-identical: member k of a flat struct sits at 16·k, the array
+    stride is 16 × the number of leaves. Pack scalars into vec4 components and
+    store a mat4 as four vec4 columns.
+    """
+    if elem.kind != "struct":
+        return f"a buffer holds structs, not {elem}"
+
+    def bad(t: Type, where: str) -> str | None:
+        if t.kind == "struct":
+            for f, ft in t.fields:
+                found = bad(ft, f"{where}.{f}")
+                if found:
+                    return found
+            return None
+        if t.kind == "array":
+            return bad(t.elem, f"{where}[]")
+        if t.name in BUFFER_LEAVES:
+            return None
+        return f"buffer member {where} is {t}, not one of {', '.join(BUFFER_LEAVES)}"
+
+    return bad(elem, elem.name)
+
+
+def _check_layout(elem: Type) -> None:
+    why = buffer_layout_error(elem)
+    if why:
+        raise ValueError(f"{why} (every buffer member must be a 16-byte vector so std140, std430, "
+                         "HLSL and WGSL layouts agree; pack scalars into a vec4)")
