@@ -16,15 +16,12 @@ import jinja2
 
 from .. import __version__
 from ..library.bricks import Library
-from ..link.glue import Program, brdf_glue, brdf_params, check_packing, glue_header, shade_glue
-from ..lang import SourceError
-from ..lang.types import Type
-from ..matrix.permutation import Node, Permutation, parse_brdf, resolve
+from ..link import EvalProgram, Interface, Slot, eval_program, link_permutation
+from ..matrix.permutation import Permutation
 from ..targets import LANGUAGES, get_target
 from ..targets.base import Emitted
 
 TEMPLATES = Path(__file__).resolve().parents[2] / "templates"
-STAGE_EXT = {"vert": "vert", "frag": "frag", "comp": "comp"}
 
 
 def jinja_env() -> jinja2.Environment:
@@ -50,29 +47,6 @@ def env() -> jinja2.Environment:
 
 
 @dataclass
-class Slot:
-    """A value read from a uniform array of vec4: `name` of type `ty` starting at vec4 index `index`."""
-
-    name: str
-    ty: Type
-    index: int
-
-    @property
-    def width(self) -> int:
-        return 4 if self.ty.kind == "matrix" else 1
-
-
-def layout(values: list[tuple[str, Type]]) -> tuple[list[Slot], int]:
-    """One vec4 per scalar/vector, four per mat4; returns the slots and the vec4 count."""
-    slots, i = [], 0
-    for name, ty in values:
-        s = Slot(name, ty, i)
-        slots.append(s)
-        i += s.width
-    return slots, i
-
-
-@dataclass
 class Source:
     language: str
     stage: str
@@ -89,10 +63,9 @@ class Composed:
     sources: list[Source]
     bricks: dict[str, str]  # display path -> source hash
     templates: dict[str, str]  # template name -> hash
+    interface: Interface
     material: list[Slot] = field(default_factory=list)
     lights: list[list[Slot]] = field(default_factory=list)
-    textures: list[dict] = field(default_factory=list)
-    inputs: list[str] = field(default_factory=list)
 
 
 def _template_hash(name: str) -> str:
@@ -131,64 +104,9 @@ def _provenance(kind: str, key: str, h: str, bricks: dict, templates: dict) -> l
 
 # ------------------------------------------------------------------ eval kernel
 
-@dataclass
-class EvalProgram:
-    """The linked program of one BRDF spec's eval kernel: brick functions plus the brdf() glue."""
-
-    spec: str  # canonical spec
-    nodes: list[Node]
-    program: Program
-    params: dict[str, Type]  # material parameters in kernel order
-    signature: list[tuple[str, Type]]  # brdf()'s parameters: L, V, N[, T, B], params...
-    slots: list[Slot]  # params in the vec4 parameter array
-    param_vec4s: int
-    tangent: bool  # brdf() reads T and B
-
-    @property
-    def hash(self) -> str:
-        return hashlib.sha256(("eval:" + self.spec).encode()).hexdigest()[:12]
-
-    def defaults(self) -> dict[str, object]:
-        """Each parameter's default, from the first brick of the spec that declares it."""
-        out: dict[str, object] = {}
-        for top in self.nodes:
-            for n in top.walk():
-                for name, p in n.brick.params.items():
-                    out.setdefault(name, p.default)
-        return out
-
-    def ranges(self) -> dict[str, tuple | None]:
-        """Each parameter's allowed range (the narrowest over the bricks that declare it)."""
-        out: dict[str, tuple | None] = {}
-        for top in self.nodes:
-            for n in top.walk():
-                for name, p in n.brick.params.items():
-                    old = out.get(name)
-                    if p.range is None or old is None:
-                        out[name] = old or p.range
-                    else:
-                        out[name] = (max(old[0], p.range[0]), min(old[1], p.range[1]))
-        return out
-
-
-def eval_program(spec: str, lib: Library) -> EvalProgram:
-    """Link a BRDF spec into the program its eval kernel runs (every target emits this IR)."""
-    nodes = parse_brdf(spec, lib)
-    canon = "+".join(n.canonical() for n in nodes)
-    prog = Program()
-    for n in nodes:
-        prog.link(n)
-    params = brdf_params(nodes)
-    text, sig = brdf_glue(prog, nodes, params)
-    prog.add_glue(glue_header("BRDF glue") + text)
-    slots, count = layout(list(params.items()))
-    tangent = any(name == "T" for name, _ in sig)
-    return EvalProgram(canon, nodes, prog, params, sig, slots, count, tangent)
-
-
-def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
-    """The compute eval kernel of one BRDF spec: f_r for each (L, V, N[, T]) sample."""
-    ep = eval_program(spec, lib)
+def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram | None = None) -> Composed:
+    """The compute eval kernel of one BRDF spec (or a linked `ep`): f_r for each (L, V, N[, T]) sample."""
+    ep = ep or eval_program(spec, lib)
     prog, canon, h = ep.program, ep.spec, ep.hash
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
@@ -201,48 +119,32 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES) -> Composed:
         templates.update(used)
         ctx = {"provenance": _provenance("eval", canon, h, bricks, used),
                "params": ep.slots, "param_vec4s": max(ep.param_vec4s, 1), "tangent": ep.tangent,
-               "brdf": target.ident("brdf")}
+               "brdf": target.ident(ep.entry), "switch": ep.entry == "brdf_switch",
+               "textures": ep.interface.textures}
         sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
-    return Composed(canon, h, sources, bricks, templates, material=ep.slots,
-                    inputs=["L", "V", "N"] + (["T"] if ep.tangent else []))
+    return Composed(canon, h, sources, bricks, templates, ep.interface)
 
 
 # ------------------------------------------------------------------ permutation
 
 def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) -> Composed:
     """Vertex and fragment shaders of one permutation in each language."""
-    r = resolve(perm, lib)
-    problem = check_packing(r)
-    if problem:
-        raise SourceError("<key>", 1, 1, problem, "use the constants packing for this BRDF")
-    prog = Program()
-    g = shade_glue(prog, r)
-    textures, inputs, sig = g.textures, g.inputs, g.signature
-    material, light_values = g.material, [v for vals in g.lights for v in vals]
-
-    # Descriptor bindings: two per texture (image, then sampler) in every language,
-    # so one descriptor layout serves all three. Set 0: frame, lights, light textures;
-    # set 1: material constants and material textures.
-    next_binding = {"light": 2, "material": 1}
-    for t in textures:
-        t["set"] = 0 if t["group"] == "light" else 1
-        t["binding"] = next_binding[t["group"]]
-        next_binding[t["group"]] += 2
-    mat_slots, mat_count = layout(material)
-    light_slots, light_count = layout(light_values)
+    lp = link_permutation(perm, lib)
+    prog, g, iface = lp.program, lp.glue, lp.interface
     h = perm.hash
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
     sources = []
-    slots = {s.name: ("material", s) for s in mat_slots} | {s.name: ("lights", s) for s in light_slots}
+    slots = {s.name: ("material", s) for s in lp.material} | {s.name: ("lights", s) for ls in lp.lights for s in ls}
     call_args = []  # how the template passes each shade() parameter
-    for name, ty in sig:
+    for name, ty in g.signature:
         if ty.kind == "texture":
             call_args.append({"kind": "texture", "name": name})
         elif name in slots:
             call_args.append({"kind": slots[name][0], "name": name, "slot": slots[name][1]})
         else:
             call_args.append({"kind": "local", "name": name})
+    mat, lights = iface.block("Material"), iface.block("Lights")
     for lang in languages:
         target = get_target(lang)
         emitted = target.emit(prog.structs, prog.functions)
@@ -251,11 +153,9 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
             used = _templates_used(lang, tname)
             templates.update(used)
             ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, used),
-                   "inputs": inputs, "material_vec4s": mat_count, "light_vec4s": light_count,
-                   "textures": textures, "call_args": call_args, "shade": target.ident("shade")}
+                   "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
+                   "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
+                   "textures": iface.textures, "call_args": call_args, "shade": target.ident("shade")}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
-    return Composed(perm.canonical(), h, sources, bricks, templates, material=mat_slots,
-                    lights=[[s for s in light_slots if s.name.startswith(f"l{i}_")] for i in range(len(r.lights))],
-                    textures=textures, inputs=inputs)
-
+    return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)

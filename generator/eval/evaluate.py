@@ -22,7 +22,8 @@ import numpy as np
 
 from .. import DTYPES, GPU_TARGETS, TARGETS  # defined in the package, where the CLI reads them without numpy
 from ..library.bricks import library_or_builtin
-from ..compose import EvalProgram, compose_eval, eval_program
+from ..compose import compose_eval
+from ..link import EvalProgram, eval_program
 from ..lang.errors import UserError
 
 
@@ -36,25 +37,19 @@ class EvalError(UserError, ValueError):
 
 # ------------------------------------------------------------------ caches
 
-_PROGRAMS: dict = {}  # (id(lib), spec) -> (lib, EvalProgram)
-_NUMPY: dict = {}     # (id(lib), spec, dtype) -> (lib, brdf function)
-
-
 def program(spec: str, lib=None) -> EvalProgram:
-    """The linked eval program of a spec (cached per library and spec string)."""
+    """The linked eval program of a spec (kept in the library's memo, per spec string)."""
     lib = library_or_builtin(lib)
-    hit = _PROGRAMS.get((id(lib), spec))
-    if hit is None or hit[0] is not lib:
-        hit = _PROGRAMS[(id(lib), spec)] = (lib, eval_program(spec, lib))
-    return hit[1]
+    key = ("eval_program", spec)
+    if key not in lib.memo:
+        lib.memo[key] = eval_program(spec, lib)
+    return lib.memo[key]
 
 
 # ------------------------------------------------------------------ inputs
 
 def resolve_params(ep: EvalProgram, params: dict | None) -> dict[str, list[float]]:
     """Every parameter of the BRDF as a flat list of floats (defaults filled in, ranges checked)."""
-    from ..library.bricks import check_value
-
     params = dict(params or {})
     unknown = sorted(set(params) - set(ep.params))
     if unknown:
@@ -70,7 +65,7 @@ def resolve_params(ep: EvalProgram, params: dict | None) -> dict[str, list[float
         except (TypeError, ValueError):
             raise EvalError(f"parameter '{name}' = {raw!r} is not numeric",
                             f"give {ty} as numbers, RGB as f0=0.9,0.6,0.3") from None
-        problem = check_value(ty, ranges[name], vals if ty.kind != "scalar" or len(vals) != 1 else vals[0])
+        problem = ep.specs[name].check(vals if ty.kind != "scalar" or len(vals) != 1 else vals[0])
         if problem:
             rng = ranges[name]
             if "outside the range" in problem:
@@ -140,13 +135,12 @@ def _run_reference(ep: EvalProgram, vecs, values, n: int) -> np.ndarray:
 def _numpy_brdf(ep: EvalProgram, lib, dtype: str):
     from ..targets.numpy import NumpyTarget
 
-    key = (id(lib), ep.spec, dtype)
-    hit = _NUMPY.get(key)
-    if hit is None or hit[0] is not lib:
+    key = ("numpy_brdf", ep.spec, dtype)
+    if key not in lib.memo:
         t = NumpyTarget()
         fns = t.load(t.emit(ep.program.structs, ep.program.functions), np.dtype(dtype))
-        hit = _NUMPY[key] = (lib, fns["brdf"])
-    return hit[1]
+        lib.memo[key] = fns["brdf"]
+    return lib.memo[key]
 
 
 def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int) -> np.ndarray:
@@ -168,12 +162,11 @@ def gpu_kernel(spec: str, language: str, lib=None, device=None):
     lib = library_or_builtin(lib)
     ep = program(spec, lib)
     device = device or shared_device()
-    key = ("eval", id(lib), ep.spec, language)
-    hit = device.cache.get(key)
-    if hit is None or hit[0] is not lib:
-        src = compose_eval(ep.spec, lib, (language,)).sources[0]
-        hit = device.cache[key] = (lib, compile_kernel(src, device, ep.tangent, ep.param_vec4s))
-    return hit[1]
+    key = ("eval", lib.serial, ep.spec, language)  # kernels live on their device
+    if key not in device.cache:
+        src = compose_eval(ep.spec, lib, (language,), ep=ep).sources[0]
+        device.cache[key] = compile_kernel(src, device, ep.tangent, ep.param_vec4s)
+    return device.cache[key]
 
 
 def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values) -> np.ndarray:

@@ -5,56 +5,22 @@ comes from its BRICK metadata. Bricks are parsed (generator.lang), never importe
 """
 from __future__ import annotations
 
+import difflib
+import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..lang import Signature, SourceError, parse_module, read_meta
 from ..lang.errors import read_text
 from ..lang import ir
-from ..lang.types import BUILTIN_TYPES, FLOAT, VEC3, Type
+from ..lang.types import BUILTIN_TYPES, Type
+from .inputs import SHADING, SURFACE
+from .kinds import BRDF_KINDS, KINDS, Kind
 
 REPO = Path(__file__).resolve().parents[2]
 BUILTIN_BRICKS = REPO / "bricks"
 
 
-@dataclass(frozen=True)
-class Kind:
-    """What a kind of brick must define.
-
-    entries: function names the kind must define (the generator calls them).
-    interface: for slot kinds called from inside another brick, the fixed
-      signature of the single entry; None when arguments are bound by name
-      from the shading context (geometry, parameters, textures).
-    ret: the return type of every entry.
-    """
-
-    entries: tuple[str, ...]
-    ret: Type
-    interface: tuple | None = None
-    prefix_entries: str = ""  # packing: every function named get_<input> is an entry
-
-
-KINDS: dict[str, Kind] = {
-    "diffuse": Kind(("diffuse",), VEC3),
-    "specular": Kind(("specular",), VEC3),
-    "ndf": Kind(("ndf",), FLOAT, (("NdotH", FLOAT), ("NxH2", FLOAT), ("alpha", FLOAT))),
-    "fresnel": Kind(("fresnel",), VEC3, (("f0", VEC3), ("VdotH", FLOAT))),
-    "visibility": Kind(("vis",), FLOAT, (("NdotL", FLOAT), ("NdotV", FLOAT), ("NdotH", FLOAT),
-                                          ("VdotH", FLOAT), ("alpha", FLOAT))),
-    "light": Kind(("light_dir", "light_radiance"), VEC3),
-    "shadow": Kind(("shadow",), FLOAT),
-    "packing": Kind((), VEC3, prefix_entries="get_"),
-    "normal": Kind(("normal",), VEC3),
-    "output": Kind(("output",), BUILTIN_TYPES["vec4"], (("color", VEC3),)),
-}
-BRDF_KINDS = ("diffuse", "specular")
-
-# Geometric inputs a BRDF entry may name as parameters (DESIGN.md conventions).
-GEOMETRY = {"L": VEC3, "V": VEC3, "N": VEC3, "H": VEC3, "T": VEC3, "B": VEC3,
-            "NdotL": FLOAT, "NdotV": FLOAT, "NdotH": FLOAT, "NxH2": FLOAT, "LdotH": FLOAT, "VdotH": FLOAT,
-            "LdotV": FLOAT, "RdotV": FLOAT}
-# Shading-context inputs of light, shadow, packing and normal bricks.
-SURFACE = {"P": VEC3, "N": VEC3, "T": VEC3, "B": VEC3, "uv": BUILTIN_TYPES["vec2"]}
 PARAM_TYPES = ("float", "vec2", "vec3", "vec4", "mat4")
 META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc"}
 
@@ -88,7 +54,10 @@ class Brick:
         k = KINDS[self.kind]
         if k.prefix_entries:
             return [f for n, f in self.module.functions.items() if n.startswith(k.prefix_entries)]
-        return [self.module.functions[n] for n in k.entries]
+        return [self.module.functions[e.name] for e in k.entries]
+
+
+_SERIALS = itertools.count(1)
 
 
 @dataclass
@@ -97,6 +66,8 @@ class Library:
 
     bricks: dict[tuple[str, str], Brick] = field(default_factory=dict)
     errors: list[SourceError] = field(default_factory=list)
+    memo: dict = field(default_factory=dict)  # what later stages derive from these bricks (linked programs)
+    serial: int = field(default_factory=lambda: next(_SERIALS))  # names this library in other caches; never reused
 
     def get(self, kind: str, brick_id: str) -> Brick | None:
         return self.bricks.get((kind, brick_id))
@@ -190,9 +161,9 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         raise _meta_error(shown, loc, "'textures' must be a dict", 'write "textures": {"albedo_map": {"srgb": True}}')
     externals = {}
     for sname, s in slots.items():
-        iface = KINDS[s["kind"]].interface
-        if iface is not None:
-            externals[sname] = Signature(iface, KINDS[s["kind"]].ret)
+        k = KINDS[s["kind"]]
+        if k.slot:  # called from this brick's code, type-checked against the contract's arguments
+            externals[sname] = Signature(k.signature(k.entries[0].name), k.entries[0].ret)
     module = parse_module(text, shown, externals)
     brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip())
     _check_entries(brick, loc)
@@ -249,46 +220,51 @@ def check_value(ty: Type, rng, value) -> str:
 
 
 def _check_entries(b: Brick, loc) -> None:
+    """Every entry the kind's contract names is defined, returns its type and reads only what it may."""
     k = KINDS[b.kind]
     fns = b.module.functions
-    for name in k.entries:
-        if name not in fns:
-            raise _meta_error(b.display_path, loc, f"a {b.kind} brick must define '{name}'",
-                              f"add def {name}(...) -> {k.ret}")
+    for e in k.entries:
+        if e.name not in fns:
+            args = ", ".join(f"{a.name}: {a.ty}" for a in e.args if a.required)
+            raise _meta_error(b.display_path, loc, f"a {b.kind} brick must define '{e.name}'",
+                              f"add def {e.name}({args}) -> {e.ret}")
+    inputs = SHADING if k.reads == "shading" else SURFACE
     for f in b.entries:
-        ret = k.ret
-        if f.ret != ret:
-            raise SourceError(b.display_path, f.loc.line, f.loc.col, f"'{f.name}' must return {ret}, not {f.ret}",
+        contract = k.entry(f.name)
+        if f.ret != contract.ret:
+            raise SourceError(b.display_path, f.loc.line, f.loc.col, f"'{f.name}' must return {contract.ret}, not {f.ret}",
                               "fix the return annotation")
-        if k.interface is not None:
-            got = tuple((p.name, p.ty) for p in f.params)
-            if got != k.interface:
-                want = ", ".join(f"{n}: {t}" for n, t in k.interface)
+        args = {a.name: a.ty for a in contract.args}
+        declared = {p.name for p in f.params}
+        for a in contract.args:
+            if a.required and a.name not in declared:
                 raise SourceError(b.display_path, f.loc.line, f.loc.col,
-                                  f"'{f.name}' must have the {b.kind} slot signature ({want})",
-                                  "keep every parameter, even unused ones, in this order")
-            continue
-        allowed = dict(GEOMETRY if b.kind in BRDF_KINDS else SURFACE)
+                                  f"'{f.name}' must take '{a.name}: {a.ty}' (the {b.kind} contract)",
+                                  f"add the parameter {a.name}: {a.ty}")
         for p in f.params:
-            want = allowed.get(p.name) or (b.params[p.name].ty if p.name in b.params else None)
             if p.ty.kind == "texture":
                 if p.name not in b.textures:
                     raise SourceError(b.display_path, p.loc.line, p.loc.col, f"texture '{p.name}' is not declared",
                                       f'add "textures": {{"{p.name}": {{"srgb": False}}}} to BRICK')
                 continue
+            want = args.get(p.name) or inputs.get(p.name) or (b.params[p.name].ty if p.name in b.params else None)
             if want is None and b.kind == "packing":
                 continue  # a material parameter of the BRDF, bound when composed
             if want is None:
+                allowed = sorted(set(args) | set(inputs))
+                close = difflib.get_close_matches(p.name, allowed + sorted(b.params), n=1)
+                hint = f"did you mean '{close[0]}'? " if close else ""
                 raise SourceError(b.display_path, p.loc.line, p.loc.col,
-                                  f"parameter '{p.name}' is neither a shading input nor a declared param",
-                                  f"use one of {', '.join(sorted(allowed))}, or declare '{p.name}' in BRICK['params']")
+                                  f"parameter '{p.name}' is neither an argument of the {b.kind} contract, "
+                                  f"a {k.reads} input nor a declared param",
+                                  f"{hint}use one of {', '.join(allowed)}, or declare '{p.name}' in BRICK['params']")
             if want != p.ty:
                 raise SourceError(b.display_path, p.loc.line, p.loc.col,
                                   f"parameter '{p.name}' is {p.ty} here but {want} by convention or declaration",
                                   f"annotate it {want}")
     needs = b.module.meta.get("needs")
     if needs is not None:
-        used = sorted({p.name for f in b.entries for p in f.params if p.name in GEOMETRY})
+        used = sorted({p.name for f in b.entries for p in f.params if p.name in SHADING})
         if sorted(needs) != used:
             raise _meta_error(b.display_path, loc, f"BRICK['needs'] {sorted(needs)} differs from the inputs the entry reads {used}",
-                              "list exactly the geometric inputs named as parameters (or drop 'needs')")
+                              "list exactly the shading inputs named as parameters (or drop 'needs')")

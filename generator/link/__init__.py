@@ -1,1 +1,141 @@
-"""The link stage: resolved brick nodes → one IR program and its typed Interface; the glue, built as IR."""
+"""The link stage: resolved brick nodes → one IR program plus its typed Interface.
+
+Three glue builders over one program (link/glue.py): the eval kernel of one BRDF
+(`eval_program`), the eval kernel of several BRDFs behind a switch on an id
+(`switch_program`), and the fragment shading of a permutation (`link_permutation`).
+Function names are keyed by canonical node (link/program.py), so any set of bricks
+links into one program, deterministically.
+"""
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+from ..lang import SourceError
+from ..lang.types import Type
+from ..library.bricks import Library
+from ..library.params import ParamSpec
+from ..matrix.permutation import Node, Permutation, check_packing, parse_brdf, resolve
+from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue
+from .interface import (FRAME_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
+                        vec4_array_block)
+from .program import Program, function_name
+
+__all__ = ["EvalProgram", "LinkedPermutation", "Program", "Interface", "Slot", "Block", "Texture", "layout",
+           "eval_program", "switch_program", "link_permutation", "function_name"]
+
+EVAL_INFO = {"name": "info", "type": "uvec4", "offset": 0, "size": 16}
+
+
+@dataclass
+class EvalProgram:
+    """The linked program of an eval kernel: brick functions, the brdf glue, and its interface."""
+
+    spec: str  # canonical spec ('|'-joined for a switch over several BRDFs)
+    nodes: list[Node]
+    program: Program
+    specs: dict[str, ParamSpec]  # the one parameter policy (library/params.py)
+    signature: list[tuple[str, Type]]  # the entry's parameters
+    slots: list[Slot]  # params in the vec4 parameter array
+    param_vec4s: int
+    tangent: bool  # the entry reads T and B
+    interface: Interface
+    entry: str = "brdf"
+    textures: tuple = ()  # (name, type, declaration) of textures the BRDF reads
+    specs_of: tuple = ()  # for a switch: the canonical spec of each id
+
+    @property
+    def params(self) -> dict[str, Type]:
+        return {k: p.ty for k, p in self.specs.items()}
+
+    @property
+    def hash(self) -> str:
+        return hashlib.sha256(("eval:" + self.spec).encode()).hexdigest()[:12]
+
+    def defaults(self) -> dict[str, object]:
+        return {k: p.default for k, p in self.specs.items()}
+
+    def ranges(self) -> dict[str, tuple | None]:
+        return {k: p.range for k, p in self.specs.items()}
+
+
+def _eval_interface(specs: dict[str, ParamSpec], tangent: bool, reads: list[str], textures) -> tuple[list[Slot], int, Interface]:
+    slots, count = layout([(k, k, p.ty, p, None) for k, p in specs.items()])
+    params = vec4_array_block("Params", 0, 2, slots, max(count, 1), header=[EVAL_INFO])
+    samples = Block("Samples", 0, 0, "storage", [{"name": "data", "type": "vec4[]", "offset": 0, "size": 0,
+                                                  "array_stride": 16}])
+    result = Block("Result", 0, 1, "storage", [{"name": "data", "type": "vec4[]", "offset": 0, "size": 0,
+                                                "array_stride": 16}], readonly=False)
+    texs = [Texture(n, n, "material", bool(d.get("srgb")), d.get("dim", "2d")) for n, _, d in textures]
+    assign_bindings(texs, {"material": 3})
+    for t in texs:
+        t.set = 0
+    iface = Interface({"comp": "main"}, reads, [], [samples, result, params], texs, [],
+                      params={"material": specs})
+    return slots, count, iface
+
+
+def eval_program(spec: str, lib: Library) -> EvalProgram:
+    """Link a BRDF spec into the program its eval kernel runs (every target emits this IR)."""
+    nodes = parse_brdf(spec, lib)
+    canon = "+".join(n.canonical() for n in nodes)
+    prog = Program()
+    g: BrdfGlue = brdf_glue(prog, nodes)
+    slots, count, iface = _eval_interface(g.params, g.tangent, g.reads, g.textures)
+    return EvalProgram(canon, nodes, prog, g.params, g.signature, slots, count, g.tangent, iface,
+                       textures=tuple(g.textures))
+
+
+def switch_program(specs: list[str], lib: Library) -> EvalProgram:
+    """Several BRDFs in one program behind `brdf_switch(id, ...)`: id k evaluates specs[k]."""
+    brdfs = [parse_brdf(s, lib) for s in specs]
+    canon = [("+".join(n.canonical() for n in nodes)) for nodes in brdfs]
+    prog = Program()
+    f, glues = brdf_switch(prog, brdfs)
+    from ..library.params import spec_params
+    union = spec_params([n for nodes in brdfs for n in nodes])
+    tangent = any(g.tangent for g in glues)
+    reads = sorted({r for g in glues for r in g.reads}, key=lambda r: [x for g in glues for x in g.reads].index(r))
+    textures = [t for g in glues for t in g.textures]
+    slots, count, iface = _eval_interface(union, tangent, reads, textures)
+    sig = [(p.name, p.ty) for p in f.params]
+    return EvalProgram("|".join(canon), [n for nodes in brdfs for n in nodes], prog, union, sig, slots, count,
+                       tangent, iface, entry="brdf_switch", textures=tuple(textures), specs_of=tuple(canon))
+
+
+@dataclass
+class LinkedPermutation:
+    """A permutation's program (brick functions + shade glue) and its interface."""
+
+    perm: Permutation
+    program: Program
+    glue: ShadeGlue
+    interface: Interface
+    material: list[Slot]
+    lights: list[list[Slot]]
+
+
+def link_permutation(perm: Permutation, lib: Library) -> LinkedPermutation:
+    """Link the bricks of a permutation and lay out what its fragment shader reads."""
+    r = resolve(perm, lib)
+    problem = check_packing(r)
+    if problem:
+        raise SourceError("<key>", 1, 1, problem, "use the constants packing for this BRDF")
+    prog = Program()
+    g = shade_glue(prog, r)
+    assign_bindings(g.textures, {"light": 2, "material": 1})
+    mat_slots, mat_count = layout([(n, p, t, s, None) for n, p, t, s in g.material])
+    light_slots, light_count = layout([(n, p, t, s, i) for i, vals in enumerate(g.lights) for n, p, t, s in vals])
+    blocks = [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK))]
+    if light_count:
+        blocks.append(vec4_array_block("Lights", 0, 1, light_slots, light_count))
+    if mat_count:
+        blocks.append(vec4_array_block("Material", 1, 0, mat_slots, mat_count))
+    from ..library.params import spec_params
+    params = {"material": {p: s for _, p, _, s in g.material}}
+    for i, (lb, sh) in enumerate(r.lights):
+        params[f"light{i}"] = spec_params([Node(lb, ()), sh])
+    iface = Interface({"vert": "main", "frag": "main"}, g.brdf.reads, g.surface, blocks, g.textures,
+                      [Location(0, "out_color", "vec4")], params=params)
+    lights = [[s for s in light_slots if s.light == i] for i in range(len(r.lights))]
+    return LinkedPermutation(perm, prog, g, iface, mat_slots, lights)

@@ -1,190 +1,113 @@
-"""Linking brick functions into one program, and the generated glue functions.
+"""The glue, built as IR: the BRDF from its terms, the light loop, the switch over BRDFs.
 
-Linking copies each brick's functions under the name `<brick id>_<function>`
-and points slot calls at the filler's entry. The glue — `brdf` (the BRDF from
-its terms and the geometric inputs they read) and `shade` (packing, normal,
-the unrolled light loop, output) — is generated as brick-language text and
-parsed like any brick, so every target emits it from the same IR.
+- `brdf_lit(L, V, N[, T, B], params..., textures...) -> vec3`: the shading inputs
+  the terms read (from the inputs table, in its order) and the sum of the terms.
+- `brdf(...)`: 0 below the horizon, else brdf_lit (the eval kernel's entry).
+- `brdf_switch(id, ...)`: one `brdf_<k>` per BRDF behind a switch on an integer id.
+- `shade(P, Ng, V[, T, B][, uv], material..., lights..., textures...) -> vec4`: the
+  packing's material inputs, the shading normal, the unrolled light loop
+  L_o += π f_r c_light (n·l) visibility (Hoffman & Baker 2006), the output brick.
+Entry parameters are bound by name (library/kinds.py): shading inputs, surface
+inputs, parameters and textures.
 """
 from __future__ import annotations
 
-import copy
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from ..library.bricks import GEOMETRY, KINDS, SURFACE, Brick
-from ..lang import Signature, SourceError, parse_module
-from ..lang import ir
-from ..lang.types import TEXTURE2D, Type
+from ..lang import SourceError, ir
+from ..lang.types import FLOAT, INT, TEXTURE2D, VEC3, VEC4, Type
+from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
+from ..library.params import ParamSpec, spec_params
 from ..matrix.permutation import Node, Resolved
+from .interface import Texture
+from .irgen import Builder
+from .program import Program
 
-GLUE_PATH = "<glue>"
-
-# Geometric inputs in evaluation order: (name, brick-language expression, inputs it uses).
-# Policy (DESIGN notes): f_r is 0 for n.l <= 0; n.v is clamped to [1e-4, 1] so a view
-# below the horizon after normal mapping shades as grazing instead of black or NaN.
-NEEDS = [
-    ("NdotL", "min(dot(N, L), 1.0)", ()),
-    ("NdotV", "clamp(dot(N, V), 0.0001, 1.0)", ()),
-    ("Hsum", "L + V", ()),
-    # |l + v|² is floored so that l = -v (possible only for v below the horizon) gives H = 0, not
-    # NaN. The floor is a normal float32 far below the mirror configuration at grazing, where
-    # |l + v|² = 4 cos²θ (a floor of 1e-12 left H unnormalized, n·h wrong, for cos θ < 5e-7).
-    ("H", "Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30))", ("Hsum",)),
-    ("NdotH", "clamp(dot(N, H), 0.0, 1.0)", ("H",)),
-    # sin²θ_h = |n × h|² (Filament): keeps its digits as h → n, where 1 - (n·h)² is all rounding
-    # in float32 (ACCURACY-FACTS pitfall 4); 1 where n·h is clamped to 0, as 1 - 0².
-    ("NxH", "cross(N, H)", ("H",)),
-    ("NxH2", "dot(NxH, NxH) if NdotH > 0.0 else 1.0", ("NxH", "NdotH")),
-    ("LdotH", "clamp(dot(L, H), 0.0, 1.0)", ("H",)),
-    ("VdotH", "clamp(dot(V, H), 0.0, 1.0)", ("H",)),
-    ("LdotV", "dot(L, V)", ()),
-    ("RdotV", "clamp(dot(reflect(-L, N), V), 0.0, 1.0)", ()),
-]
+TEXTURE_TYPES = ("texture",)
 
 
-def mangle(brick: Brick, fname: str) -> str:
-    return f"{brick.id}_{fname}"
+def _texture_decl(nodes, name: str) -> dict:
+    for top in nodes:
+        for n in (top.walk() if hasattr(top, "walk") else [top]):
+            b = getattr(n, "brick", n)
+            if name in b.textures:
+                return b.textures[name]
+    return {}
 
 
 @dataclass
-class Program:
-    """Linked brick functions (callees first) and the signatures of their entries."""
+class BrdfGlue:
+    """brdf_lit (and brdf) of one BRDF, with the parameters they take."""
 
-    functions: list[ir.Function] = field(default_factory=list)
-    structs: list[Type] = field(default_factory=list)
-    signatures: dict[str, Signature] = field(default_factory=dict)
-    bricks: dict[str, Brick] = field(default_factory=dict)  # display path -> brick
-    _done: set = field(default_factory=set)
+    lit: ir.Function
+    guarded: ir.Function | None
+    frame: list[tuple[str, Type]]  # L, V, N[, T, B]
+    params: dict[str, ParamSpec]  # material parameters, in spec order
+    textures: list[tuple[str, Type, dict]]  # (name, type, declaration) of textures the terms read
+    reads: list[str]  # shading inputs read (frame rows included)
 
-    def link(self, node: Node) -> None:
-        """Add a brick with its fillers; entries become callable as <id>_<entry>."""
-        for _, filler in node.fillers:
-            self.link(filler)
-        b = node.brick
-        key = node.canonical() + "@" + b.kind
-        if key in self._done:
-            return
-        self._done.add(key)
-        self.bricks[b.display_path] = b
-        rename = {name: mangle(b, name) for name in b.module.functions}
-        for slot, filler in node.fillers:
-            entry = KINDS[filler.brick.kind].entries[0] if KINDS[filler.brick.kind].entries else None
-            if KINDS[b.slots[slot]["kind"]].interface is not None and entry:
-                rename[slot] = mangle(filler.brick, entry)
-        for name in _call_order(b.module):
-            f = copy.deepcopy(b.module.functions[name])
-            new = rename[name]
-            if new in self.signatures:
-                raise SourceError(b.display_path, f.loc.line, f.loc.col,
-                                  f"function name '{new}' is generated twice when linking",
-                                  "two bricks produce the same <id>_<function> name; rename a function")
-            f.name = new
-            for node_ in ir.walk_body(f.body):
-                if isinstance(node_, ir.Call):
-                    node_.func = rename[node_.func]
-            f.calls = [rename[c] for c in f.calls]
-            self.functions.append(f)
-            self.signatures[new] = Signature(tuple((p.name, p.ty) for p in f.params), f.ret)
-        for st in b.module.structs.values():
-            if st not in self.structs:
-                self.structs.append(st)
+    @property
+    def tangent(self) -> bool:
+        return any(n == "T" for n, _ in self.frame)
 
-    def add_glue(self, text: str) -> list[ir.Function]:
-        """Parse generated glue against the linked signatures and append its functions."""
-        module = parse_module(text, GLUE_PATH, dict(self.signatures))
-        fns = [module.functions[n] for n in _call_order(module)]
-        for f in fns:
-            self.signatures[f.name] = Signature(tuple((p.name, p.ty) for p in f.params), f.ret)
-        self.functions.extend(fns)
-        return fns
+    @property
+    def signature(self) -> list[tuple[str, Type]]:
+        return self.frame + [(k, p.ty) for k, p in self.params.items()] + [(n, t) for n, t, _ in self.textures]
 
 
-def _call_order(module: ir.Module) -> list[str]:
-    """Function names of a module, callees before callers, otherwise in file order."""
-    order: list[str] = []
+def brdf_glue(prog: Program, nodes: list[Node], suffix: str = "", guarded: bool = True,
+              b: Builder | None = None) -> BrdfGlue:
+    """Link a BRDF's terms into `prog` and add brdf_lit<suffix> (and brdf<suffix> when `guarded`)."""
+    b = b or Builder()
+    for n in nodes:
+        prog.link(n)
+    entries = [prog.entry(n, n.brick.entries[0].name) for n in nodes]
+    params = spec_params(nodes)
+    reads = sorted({p.name for f in entries for p in f.params if p.name in SHADING},
+                   key=lambda k: list(BY_NAME).index(k))
+    textures = []
+    for f in entries:
+        for p in f.params:
+            if p.ty.kind == "texture" and p.name not in {t[0] for t in textures}:
+                textures.append((p.name, p.ty, _texture_decl(nodes, p.name)))
+    unknown = [p for f in entries for p in f.params
+               if p.name not in SHADING and p.name not in params and p.ty.kind != "texture"]
+    if unknown:
+        p = unknown[0]
+        raise SourceError(p.loc.path, p.loc.line, p.loc.col, f"'{p.name}' is bound by nothing in this BRDF",
+                          "name a shading input, a declared parameter or a texture")
+    tangent = any(BY_NAME[r].tangent for r in reads)
+    frame = [(n, BY_NAME[n].ty) for n in FRAME + (TANGENT_FRAME if tangent else ())]
+    sig = frame + [(k, p.ty) for k, p in params.items()] + [(n, t) for n, t, _ in textures]
 
-    def visit(name):
-        if name in order or name not in module.functions:
-            return
-        for c in module.functions[name].calls:
-            visit(c)
-        order.append(name)
+    def lit_body():
+        body = []
+        for name in closure(reads):
+            body.append(b.decl(name, b.copy(expression(name))))
+        env = dict(sig) | {name: BY_NAME[name].ty for name in closure(reads)}
+        terms = [b.call(f, [b.var(p.name, env[p.name]) for p in f.params]) for f in entries]
+        total = terms[0]
+        for t in terms[1:]:
+            total = b.arith("+", total, t)
+        body.append(b.ret(total))
+        return body
 
-    for name in module.functions:
-        visit(name)
-    return order
-
-
-def glue_header(doc: str) -> str:
-    return f'"""{doc}"""\nBRICK = {{"kind": "glue"}}\n\n'
-
-
-def entry_args(f: ir.Function, bind) -> str:
-    """Arguments for a call to entry `f`, each parameter bound by name through `bind`."""
-    return ", ".join(bind(p) for p in f.params)
-
-
-def brdf_params(nodes: list[Node]) -> dict[str, Type]:
-    """Material parameters of a BRDF (union over its bricks; a shared name must agree on type)."""
-    out: dict[str, Type] = {}
-    for top in nodes:
-        for n in top.walk():
-            for name, p in n.brick.params.items():
-                if name in out and out[name] != p.ty:
-                    raise SourceError(n.brick.display_path, 1, 1,
-                                      f"parameter '{name}' is {p.ty} here but {out[name]} in another brick of the BRDF",
-                                      "canonical parameter names have one type (DESIGN.md)")
-                out.setdefault(name, p.ty)
-    return out
-
-
-def _signature(sig: list[tuple[str, Type]]) -> str:
-    return ", ".join(f"{n}: {t}" for n, t in sig)
-
-
-def brdf_glue(prog: Program, nodes: list[Node], params: dict[str, Type],
-              guarded: bool = True) -> tuple[str, list[tuple[str, Type]]]:
-    """Glue text for `brdf_lit(L, V, N[, T, B], params...) -> vec3` and its parameter list.
-
-    `brdf_lit` computes the geometric inputs the terms read and sums the terms,
-    for n·l > 0. With `guarded`, also `brdf`, which returns 0 below the horizon
-    and calls it (the eval kernel's entry). The light loop tests n·l itself, to
-    skip shadow and radiance work, so shade() calls `brdf_lit` and gets no `brdf`.
-    """
-    entries = [(n.brick, n.brick.entries[0]) for n in nodes]
-    used = {p.name for _, f in entries for p in f.params if p.name in GEOMETRY}
-    frame = [("L", GEOMETRY["L"]), ("V", GEOMETRY["V"]), ("N", GEOMETRY["N"])]
-    if used & {"T", "B"}:
-        frame += [("T", GEOMETRY["T"]), ("B", GEOMETRY["B"])]
-    sig = frame + [(name, ty) for name, ty in params.items()]
-    lines = [f"def brdf_lit({_signature(sig)}) -> vec3:"]
-    needed = set(used)
-    for name, _, deps in reversed(NEEDS):
-        if name in needed:
-            needed.update(deps)
-    for name, expr, _ in NEEDS:
-        if name in needed:
-            lines.append(f"    {name} = {expr}")
-    terms = [f"{mangle(b, f.name)}({entry_args(f, lambda p: p.name)})" for b, f in entries]
-    lines.append(f"    return {' + '.join(terms)}")
+    lit = prog.add(b.function(f"brdf_lit{suffix}", sig, VEC3, lit_body))
+    g = None
     if guarded:
-        lines += ["", "",
-                  f"def brdf({_signature(sig)}) -> vec3:",
-                  "    if dot(N, L) <= 0.0:",
-                  "        return vec3(0.0)",
-                  f"    return brdf_lit({', '.join(n for n, _ in sig)})"]
-    return "\n".join(lines) + "\n", sig
+        def guarded_body():
+            below = b.compare("<=", b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var("L", VEC3)), b.const(0.0))
+            return [b.if_(below, [b.ret(b.construct(VEC3, b.const(0.0)))]),
+                    b.ret(b.call(lit, [b.var(n, t) for n, t in sig]))]
+        g = prog.add(b.function(f"brdf{suffix}", sig, VEC3, guarded_body))
+    return BrdfGlue(lit, g, frame, params, textures, frame_names(frame) + [r for r in reads if r not in FRAME + TANGENT_FRAME])
 
 
-def check_packing(r: Resolved) -> str:
-    """'' when the packing fits the BRDF, else why not (a provided input the BRDF does not read)."""
-    params = brdf_params(r.brdf)
-    for f in r.packing.brick.entries:
-        name = f.name[len("get_"):]
-        if name not in params:
-            return (f"packing '{r.packing.brick.id}' provides {name}, which BRDF "
-                    f"'{'+'.join(n.canonical() for n in r.brdf)}' does not read")
-    return ""
+def frame_names(frame) -> list[str]:
+    return [n for n, _ in frame]
+
+
+# ------------------------------------------------------------------ fragment shading
 
 
 @dataclass
@@ -192,95 +115,179 @@ class ShadeGlue:
     """The fragment glue of a permutation and what its template must feed `shade()`."""
 
     signature: list[tuple[str, Type]]  # shade()'s parameters, in order
-    inputs: list[str]  # interpolants read: P, N, then T, B and uv where needed
-    material: list[tuple[str, Type]]  # m_<param>: BRDF, packing and normal parameters
-    lights: list[list[tuple[str, Type]]]  # l<i>_<param> per light: light and shadow parameters
-    textures: list[dict]  # {"name", "srgb", "group": "material" | "light"}
+    surface: list[str]  # interpolants read: P, N, then T, B and uv where needed
+    material: list[tuple[str, str, Type, ParamSpec | None]]  # (glue name, param, type, spec)
+    lights: list[list[tuple[str, str, Type, ParamSpec | None]]]  # per light
+    textures: list[Texture]
+    brdf: BrdfGlue
 
 
-class _Calls:
+class _Binder:
     """Binds entry parameters by name to shade()'s locals, parameters and textures."""
 
-    def __init__(self):
-        self.textures: list[dict] = []
-        self.entries: list[ir.Function] = []
+    def __init__(self, b: Builder):
+        self.b = b
+        self.textures: list[Texture] = []
+        self.params: dict[str, Type] = {}  # shade() parameters for values (m_*, l<i>_*, o_*)
+        self.surface: set[str] = set()
 
-    def call(self, brick: Brick, f: ir.Function, param_prefix: str, texture_prefix: str, group: str) -> str:
-        self.entries.append(f)
-        args = []
+    def call(self, prog: Program, node: Node, fname: str, prefix: str, group: str, light: int | None,
+             locals_: dict[str, Type], args: dict[str, ir.Expr] | None = None) -> ir.Call:
+        f = prog.entry(node, fname)
+        out = []
         for p in f.params:
-            if p.ty.kind == "texture":
-                name = texture_prefix + p.name
-                if name not in {t["name"] for t in self.textures}:
-                    self.textures.append({"name": name, "srgb": bool(brick.textures[p.name].get("srgb")),
-                                          "group": group})
-                args.append(name)
+            if args and p.name in args:
+                out.append(args[p.name])
+            elif p.ty.kind == "texture":
+                name = ("t_" if group == "material" else prefix) + p.name
+                if name not in {t.name for t in self.textures}:
+                    decl = _texture_decl([node], p.name)
+                    self.textures.append(Texture(name, p.name, group, bool(decl.get("srgb")),
+                                                 decl.get("dim", "2d"), light))
+                out.append(self.b.var(name, p.ty, "param"))
             elif p.name == "N":
-                args.append("Ng")  # surface bricks read the interpolated normal
+                self.surface.add("N")
+                out.append(self.b.var("Ng", VEC3, "param"))  # surface bricks read the interpolated normal
+            elif p.name in locals_:
+                out.append(self.b.var(p.name, locals_[p.name]))
             elif p.name in SURFACE:
-                args.append(p.name)
+                self.surface.add(p.name)
+                out.append(self.b.var(p.name, SURFACE[p.name], "param"))
             else:
-                args.append(param_prefix + p.name)
-        return f"{mangle(brick, f.name)}({', '.join(args)})"
+                self.params[prefix + p.name] = p.ty
+                out.append(self.b.var(prefix + p.name, p.ty, "param"))
+        return self.b.call(f, out)
 
 
 def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
-    """Link a permutation's bricks into `prog` and add the brdf() and shade() glue.
-
-    shade(P, Ng, V[, T, B][, uv], material..., lights..., textures...) -> vec4:
-    the packing's material inputs, the shading normal, the unrolled light loop
-    L_o += pi f_r c_light (n.l) visibility (Hoffman & Baker 2006), the output.
-    """
-    for n in r.brdf:
-        prog.link(n)
-    params = brdf_params(r.brdf)
-    brdf_text, brdf_sig = brdf_glue(prog, r.brdf, params, guarded=False)
+    """Link a permutation's bricks into `prog` and add the brdf_lit() and shade() glue."""
+    b = Builder()
+    bg = brdf_glue(prog, r.brdf, guarded=False, b=b)
     normal = dict(r.packing.fillers)["normal"]
     prog.link(r.packing)
     for lb, sh in r.lights:
         prog.link(Node(lb, ()))
         prog.link(sh)
-    prog.link(Node(r.output, ()))
-
-    material = [(f"m_{k}", t) for k, t in params.items()]
-    for n in r.packing.walk():
-        material += [(f"m_{k}", p.ty) for k, p in n.brick.params.items()]
-    calls = _Calls()
-    body, provided = [], {}
-    for f in r.packing.brick.entries:
-        name = f.name[len("get_"):]
-        body.append(f"    p_{name} = {calls.call(r.packing.brick, f, 'm_', 't_', 'material')}")
-        provided[name] = f"p_{name}"
-    body.append(f"    N = {calls.call(normal.brick, normal.brick.entries[0], 'm_', 't_', 'material')}")
-    body.append("    Lo = vec3(0.0)")
-    tangent = any(n == "T" for n, _ in brdf_sig)
-    brdf_args = ["V", "N"] + (["T", "B"] if tangent else []) + [provided.get(k, f"m_{k}") for k in params]
+    out_node = Node(r.output, ())
+    prog.link(out_node)
+    bind = _Binder(b)
+    provided: dict[str, ir.Expr] = {}
+    packing_params = spec_params([r.packing])
+    output_params = spec_params([out_node])
     lights = []
+
+    def body():
+        stmts = []
+        for f in r.packing.brick.entries:
+            name = f.name[len("get_"):]
+            call = bind.call(prog, r.packing, f.name, "m_", "material", None, {})
+            stmts.append(b.decl(f"p_{name}", call))
+            provided[name] = b.var(f"p_{name}", call.ty)
+        stmts.append(b.decl("N", bind.call(prog, normal, normal.brick.entries[0].name, "m_", "material", None, {})))
+        stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
+        locals_ = {"N": VEC3}
+        for k, spec in bg.params.items():
+            if k not in provided:
+                bind.params[f"m_{k}"] = spec.ty
+        for i, (lb, sh) in enumerate(r.lights):
+            pre = f"l{i}_"
+            ln = Node(lb, ())
+            Li = f"L{i}"
+            stmts.append(b.decl(Li, bind.call(prog, ln, "light_dir", pre, "light", i, locals_)))
+            cos = b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var(Li, VEC3))
+            stmts.append(b.decl(f"NdotL{i}", cos))
+            c = b.decl(f"c{i}", bind.call(prog, ln, "light_radiance", pre, "light", i, locals_))
+            s = b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_))
+            brdf_args = []
+            for n, t in bg.signature:
+                if n == "L":
+                    brdf_args.append(b.var(Li, VEC3))
+                elif n == "N":
+                    brdf_args.append(b.var("N", VEC3))
+                elif n in ("V", "T", "B"):
+                    brdf_args.append(b.var(n, t, "param"))
+                elif n in provided:
+                    brdf_args.append(b.copy(provided[n]))
+                elif t.kind == "texture":
+                    brdf_args.append(bind_texture(bind, n, t, r.brdf))
+                else:
+                    brdf_args.append(b.var(f"m_{n}", t, "param"))
+            f_r = b.call(bg.lit, brdf_args)
+            term = b.arith("*", b.arith("*", b.arith("*", b.named_const("PI"), f_r), b.var(f"c{i}", VEC3)),
+                           b.arith("*", b.var(f"NdotL{i}", FLOAT), b.var(f"s{i}", FLOAT)))
+            add = b.assign(b.var("Lo", VEC3), term, "+")
+            stmts.append(b.if_(b.compare(">", b.var(f"NdotL{i}", FLOAT), b.const(0.0)), [c, s, add]))
+            lights.append(pre)
+        stmts.append(b.ret(bind.call(prog, out_node, "output", "o_", "material", None, {},
+                                     args={"color": b.var("Lo", VEC3)})))
+        return stmts
+
+    # The body is built first: it decides which parameters shade() takes.
+    stmts = body()
+    surface = ["P", "N"] + (["T", "B"] if bg.tangent or bind.surface & {"T", "B"} else []) \
+        + (["uv"] if "uv" in bind.surface else [])
+    sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")]
+    material = [(f"m_{k}", k, p.ty, p) for k, p in bg.params.items() if k not in provided or f"m_{k}" in bind.params]
+    material += [(f"m_{k}", k, p.ty, p) for k, p in packing_params.items()]
+    material += [(f"o_{k}", k, p.ty, p) for k, p in output_params.items()]
+    light_values = []
     for i, (lb, sh) in enumerate(r.lights):
-        values = [(f"l{i}_{k}", p.ty) for k, p in lb.params.items()]
-        for n in sh.walk():
-            values += [(f"l{i}_{k}", p.ty) for k, p in n.brick.params.items()]
-        lights.append(values)
-        fns = lb.module.functions
-        pre = f"l{i}_"
-        body += [f"    L{i} = {calls.call(lb, fns['light_dir'], pre, pre, 'light')}",
-                 f"    NdotL{i} = dot(N, L{i})",
-                 f"    if NdotL{i} > 0.0:",
-                 f"        c{i} = {calls.call(lb, fns['light_radiance'], pre, pre, 'light')}",
-                 f"        s{i} = {calls.call(sh.brick, sh.brick.entries[0], pre, pre, 'light')}",
-                 f"        Lo += PI * brdf_lit({', '.join([f'L{i}'] + brdf_args)}) * c{i} * (NdotL{i} * s{i})"]
-    body.append(f"    return {mangle(r.output, 'output')}(Lo)")
+        lp = spec_params([Node(lb, ()), sh])
+        light_values.append([(f"l{i}_{k}", k, p.ty, p) for k, p in lp.items()])
+    values = [(n, t) for n, _, t, _ in material] + [(n, t) for vals in light_values for n, _, t, _ in vals]
+    missing = [n for n in bind.params if n not in dict(values)]
+    assert not missing, f"shade() binds {missing}, which no brick declares"
+    sig += values + [(t.name, _texture_type(t)) for t in bind.textures]
 
-    surf = surface_inputs(calls.entries)
-    inputs = ["P", "N"] + (["T", "B"] if tangent or surf & {"T", "B"} else []) + (["uv"] if "uv" in surf else [])
-    sig = [("P", GEOMETRY["L"]), ("Ng", GEOMETRY["N"]), ("V", GEOMETRY["V"])]
-    sig += [(x, SURFACE[x]) for x in inputs if x in ("T", "B", "uv")]
-    sig += material + [v for vals in lights for v in vals] + [(t["name"], TEXTURE2D) for t in calls.textures]
-    shade = f"def shade({_signature(sig)}) -> vec4:\n" + "\n".join(body) + "\n"
-    prog.add_glue(glue_header("BRDF and shading glue") + brdf_text + "\n\n" + shade)
-    return ShadeGlue(sig, inputs, material, lights, calls.textures)
+    def shade_body():
+        return stmts
+    prog.add(b.function("shade", sig, VEC4, shade_body))
+    return ShadeGlue(sig, surface, material, light_values, bind.textures, bg)
 
 
-def surface_inputs(fns: list[ir.Function]) -> set[str]:
-    """Which of P, N, T, B, uv the given entries read."""
-    return {p.name for f in fns for p in f.params if p.name in SURFACE}
+def _texture_type(t: Texture) -> Type:
+    return TEXTURE2D
+
+
+def bind_texture(bind: _Binder, name: str, ty: Type, nodes) -> ir.Var:
+    """A BRDF texture in shade(): a material texture t_<name>."""
+    tname = f"t_{name}"
+    if tname not in {t.name for t in bind.textures}:
+        decl = _texture_decl(nodes, name)
+        bind.textures.append(Texture(tname, name, "material", bool(decl.get("srgb")), decl.get("dim", "2d")))
+    return bind.b.var(tname, ty, "param")
+
+
+# ------------------------------------------------------------------ several BRDFs in one program
+
+
+def brdf_switch(prog: Program, brdfs: list[list[Node]], b: Builder | None = None) -> tuple[ir.Function, list[BrdfGlue]]:
+    """`brdf_switch(id: int, L, V, N[, T, B], params...) -> vec3`: brdf_<k> for id k, 0 for another id.
+
+    The parameters are the union over the BRDFs (a shared name must agree on type:
+    library/params.py checks it across all of them).
+    """
+    b = b or Builder()
+    glues = [brdf_glue(prog, nodes, suffix=f"_{k}", b=b) for k, nodes in enumerate(brdfs)]
+    union = spec_params([n for nodes in brdfs for n in nodes])
+    tangent = any(g.tangent for g in glues)
+    frame = [(n, BY_NAME[n].ty) for n in FRAME + (TANGENT_FRAME if tangent else ())]
+    textures = []
+    for g in glues:
+        for t in g.textures:
+            if t[0] not in {x[0] for x in textures}:
+                textures.append(t)
+    sig = [("id", INT)] + frame + [(k, p.ty) for k, p in union.items()] + [(n, t) for n, t, _ in textures]
+    env = dict(sig)
+
+    def body():
+        cases = []
+        for k, g in enumerate(glues):
+            call = b.call(g.guarded, [b.var(n, env[n]) for n, _ in g.signature])
+            cases.append(((k,), [b.ret(call)]))
+        return [ir.Switch(b.loc(), b.var("id", INT), cases, [b.ret(b.construct(VEC3, b.const(0.0)))])]
+    f = prog.add(b.function("brdf_switch", sig, VEC3, body))
+    return f, glues
+
+
+__all__ = ["BrdfGlue", "ShadeGlue", "brdf_glue", "shade_glue", "brdf_switch", "TEXTURE_TYPES", "VEC4"]

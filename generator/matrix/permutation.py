@@ -178,10 +178,6 @@ class Permutation:
         return hashlib.sha256(self.canonical().encode()).hexdigest()[:12]
 
 
-def spec_hash(text: str) -> str:
-    return hashlib.sha256(text.encode()).hexdigest()[:12]
-
-
 @dataclass
 class Resolved:
     """A permutation's bricks, resolved from its key."""
@@ -210,3 +206,16 @@ def resolve(perm: Permutation, lib: Library) -> Resolved:
         raise SourceError("<key>", 1, 1, f"unknown output brick '{perm.output}'",
                           f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
     return Resolved(brdf, packing[0], lights, out)
+
+
+def check_packing(r: Resolved) -> str:
+    """'' when the packing fits the BRDF, else why not (a provided input the BRDF does not read)."""
+    from ..library.params import spec_params
+
+    params = spec_params(r.brdf)
+    for f in r.packing.brick.entries:
+        name = f.name[len("get_"):]
+        if name not in params:
+            return (f"packing '{r.packing.brick.id}' provides {name}, which BRDF "
+                    f"'{'+'.join(n.canonical() for n in r.brdf)}' does not read")
+    return ""

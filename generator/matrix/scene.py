@@ -10,16 +10,18 @@ Only (material × light set) pairs that some object uses become permutations.
 """
 from __future__ import annotations
 
+import difflib
 import re
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..library.bricks import Library, check_value
-from ..link.glue import brdf_params, check_packing
+from ..library.bricks import Library
+from ..library.params import spec_params
 from ..lang import SourceError
 from ..lang.errors import read_text
-from .permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec, resolve
+from .permutation import (PRECISIONS, LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf,
+                          parse_spec, resolve)
 
 
 class Locator:
@@ -128,10 +130,12 @@ def load_scene(path, lib: Library) -> Scene:
         packing = _spec(loc, f"materials.{name}", "packing", m.get("packing", "constants"),
                         lambda s: canonical(parse_spec(s, lib, ("packing",))))
         nodes = parse_brdf(brdf, lib)
-        types = brdf_params(nodes)
-        ranges = {k: p.range for n in nodes for x in n.walk() for k, p in x.brick.params.items()}
+        try:
+            specs = spec_params(nodes) | spec_params(parse_spec(packing, lib, ("packing",)))
+        except SourceError as e:
+            raise loc.error(where, e.message, e.hint) from None
         params = m.get("params", {})
-        _check_params(loc, f"materials.{name}", params, types, ranges, f"BRDF '{brdf}'")
+        _check_params(loc, f"materials.{name}", params, specs, f"BRDF '{brdf}'")
         problem = check_packing(resolve(Permutation(brdf, (), packing, output), lib))
         if problem:
             raise loc.error(loc.find(f"materials.{name}", "packing"), problem, "use the constants packing for this BRDF")
@@ -148,13 +152,12 @@ def load_scene(path, lib: Library) -> Scene:
         shadow = _spec(loc, f"lights.{name}", "shadow", li.get("shadow", "none"),
                        lambda s: canonical(parse_spec(s, lib, ("shadow",))))
         snode = parse_spec(shadow, lib, ("shadow",))[0]
-        types = {k: p.ty for k, p in lb.params.items()}
-        ranges = {k: p.range for k, p in lb.params.items()}
-        for n in snode.walk():
-            types.update({k: p.ty for k, p in n.brick.params.items()})
-            ranges.update({k: p.range for k, p in n.brick.params.items()})
+        try:
+            specs = spec_params([lb, snode])
+        except SourceError as e:
+            raise loc.error(where, e.message, e.hint) from None
         params = li.get("params", {})
-        _check_params(loc, f"lights.{name}", params, types, ranges, f"light '{ltype}' with shadow '{shadow}'")
+        _check_params(loc, f"lights.{name}", params, specs, f"light '{ltype}' with shadow '{shadow}'")
         scene.lights[name] = Light(name, ltype, shadow, params)
 
     for name, members in _table(loc, data, "light_sets").items():
@@ -223,14 +226,17 @@ def _spec(loc: Locator, header: str, key: str, value, resolve) -> str:
         raise loc.error((line, col), e.message, e.hint) from None
 
 
-def _check_params(loc: Locator, header: str, params, types: dict, ranges: dict, owner: str) -> None:
+def _check_params(loc: Locator, header: str, params, specs: dict, owner: str) -> None:
+    """Scene values against the one parameter policy (library/params.py)."""
     if not isinstance(params, dict):
         raise loc.error(loc.find(header, "params"), "params must be a table", "write params = { n = 64.0 }")
     for k, v in params.items():
         where = loc.find(header, "params", k)
-        if k not in types:
+        if k not in specs:
+            close = difflib.get_close_matches(k, list(specs), n=1)
+            hint = f"did you mean '{close[0]}'? " if close else ""
             raise loc.error(where, f"unknown parameter '{k}' for {owner}",
-                            f"its parameters: {', '.join(types) or 'none'}")
-        problem = check_value(types[k], ranges.get(k), v)
+                            f"{hint}its parameters: {', '.join(specs) or 'none'}")
+        problem = specs[k].check(v)
         if problem:
             raise loc.error(where, f"parameter '{k}': {problem}", "see `shadermatrix bricks` for types and ranges")

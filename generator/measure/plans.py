@@ -334,11 +334,11 @@ def load_cost_library(extra_dirs=()) -> Library:
 
     Stand-ins of slot kinds (ndf, fresnel, visibility) are generated from the
     kind's slot signature, so they follow it when it changes; the others are
-    files in generator/cost_bricks.
+    files in generator/measure/standins.
     """
     lib = load_library([*extra_dirs, COST_BRICKS])
     for kind, k in KINDS.items():
-        if k.interface is None or standin(lib, kind) is not None:
+        if not k.slot or standin(lib, kind) is not None:
             continue
         b = load_brick(COST_BRICKS / f"standin_{kind}.py", text=_slot_standin(kind), shown=f"<stand-in {kind}>")
         lib.bricks[(kind, b.id)] = b
@@ -347,10 +347,10 @@ def load_cost_library(extra_dirs=()) -> Library:
 
 def _slot_standin(kind: str) -> str:
     """Brick text of a slot kind's stand-in: it returns one of its inputs unchanged, so nothing folds."""
-    k = KINDS[kind]
-    params = ", ".join(f"{n}: {t}" for n, t in k.interface)
-    same = [n for n, t in k.interface if t == k.ret]
-    value = same[-1] if same else f"{k.ret}({k.interface[-1][0]})"
+    e = KINDS[kind].entries[0]
+    params = ", ".join(f"{a.name}: {a.ty}" for a in e.args)
+    same = [a.name for a in e.args if a.ty == e.ret]
+    value = same[-1] if same else f"{e.ret}({e.args[-1].name})"
     return (f'"""Cost stand-in {kind}: returns {value} (not a model; the baseline of `costs --bricks`)."""\n'
             f'BRICK = {{"kind": "{kind}", "cite": "{STANDIN_CITE}"}}\n\n\n'
-            f"def {k.entries[0]}({params}) -> {k.ret}:\n    return {value}\n")
+            f"def {e.name}({params}) -> {e.ret}:\n    return {value}\n")

@@ -145,13 +145,9 @@ def vis_smith_schlick(g: Geometry, alpha):
 # ------------------------------------------------------------------ whole BRDFs
 
 def brdf_parameters(nodes) -> dict:
-    """{name: (type, default, range)} of every parameter of a parsed BRDF spec (from the bricks' metadata)."""
-    out = {}
-    for top in nodes:
-        for node in top.walk():
-            for name, prm in node.brick.params.items():
-                out.setdefault(name, (prm.ty, prm.default, prm.range))
-    return out
+    """{name: (type, default, range)} of a parsed BRDF spec: the one parameter policy (library/params.py)."""
+    from ..library.params import spec_params
+    return {k: (p.ty, p.default, p.range) for k, p in spec_params(nodes).items()}
 
 
 def _param_values(declared: dict, given: dict | None, count: int) -> dict:

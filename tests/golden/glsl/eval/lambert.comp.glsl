@@ -19,21 +19,22 @@ vec3 lambert_diffuse(vec3 rho_d) {
     return (rho_d * 0.3183098861837907);
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d) {
     return lambert_diffuse(rho_d);
 }
 
+#line 3 "<glue>"
 vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d) {
     if (dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
-#line 11 "<glue>"
+#line 6 "<glue>"
     return brdf_lit(L, V, N, rho_d);
 }
 
 
-#line 37 "55679a70c070.comp.glsl"
+#line 38 "55679a70c070.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -25,7 +25,7 @@ vec3 blinn_phong_normalized_specular(float NdotH, float n, vec3 f0) {
     return (f0 * (((n + 4.0) / (8.0 * 3.141592653589793)) * pow(NdotH, n)));
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
     vec3 Hsum = (L + V);
     vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
@@ -33,16 +33,17 @@ vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
     return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
 }
 
+#line 6 "<glue>"
 vec3 brdf(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
     if (dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
-#line 14 "<glue>"
+#line 9 "<glue>"
     return brdf_lit(L, V, N, rho_d, n, f0);
 }
 
 
-#line 46 "4db92c6b384d.comp.glsl"
+#line 47 "4db92c6b384d.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -39,14 +39,14 @@ float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, f
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
+vec3 microfacet_91c806_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
 #line 27 "bricks/brdf/specular/microfacet.py"
     float D = beckmann_ndf(NdotH, NxH2, alpha);
     float Vis = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (none_fresnel(f0, VdotH) * (D * Vis));
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
@@ -56,19 +56,20 @@ vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     vec3 NxH = cross(N, H);
     float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
+    return microfacet_91c806_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
+#line 11 "<glue>"
 vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     if (dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
-#line 19 "<glue>"
+#line 14 "<glue>"
     return brdf_lit(L, V, N, alpha, f0);
 }
 
 
-#line 72 "5e84b038a5f7.comp.glsl"
+#line 73 "5e84b038a5f7.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -40,14 +40,14 @@ float implicit_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alp
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
+vec3 microfacet_5039d9_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
 #line 27 "bricks/brdf/specular/microfacet.py"
     float D = blinn_phong_ndf(NdotH, NxH2, alpha);
     float Vis = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
@@ -57,19 +57,20 @@ vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     vec3 NxH = cross(N, H);
     float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
+    return microfacet_5039d9_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
+#line 11 "<glue>"
 vec3 brdf(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
     if (dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
-#line 19 "<glue>"
+#line 14 "<glue>"
     return brdf_lit(L, V, N, alpha, f0);
 }
 
 
-#line 73 "990b9a56f7cb.comp.glsl"
+#line 74 "990b9a56f7cb.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

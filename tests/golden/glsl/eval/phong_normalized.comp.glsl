@@ -20,22 +20,23 @@ vec3 phong_normalized_specular(float RdotV, float n, vec3 f0) {
     return (f0 * (((n + 2.0) * 0.15915494309189535) * pow(RdotV, n)));
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float n, vec3 f0) {
     float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
     return phong_normalized_specular(RdotV, n, f0);
 }
 
+#line 4 "<glue>"
 vec3 brdf(vec3 L, vec3 V, vec3 N, float n, vec3 f0) {
     if (dot(N, L) <= 0.0) {
         return vec3(0.0);
     }
-#line 12 "<glue>"
+#line 7 "<glue>"
     return brdf_lit(L, V, N, n, f0);
 }
 
 
-#line 39 "bcf91138f6f2.comp.glsl"
+#line 40 "bcf91138f6f2.comp.glsl"
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= params.info.x) {

@@ -53,11 +53,24 @@ float smith_schlick_vis(float NdotL, float NdotV, float NdotH, float VdotH, floa
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
+vec3 microfacet_f43076_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
 #line 27 "bricks/brdf/specular/microfacet.py"
     float D = ggx_ndf(NdotH, NxH2, alpha);
     float Vis = smith_schlick_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
+}
+
+#line 1 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
+    float NdotL = min(dot(N, L), 1.0);
+    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
+    vec3 Hsum = (L + V);
+    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
+    float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    vec3 NxH = cross(N, H);
+    float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
+    float VdotH = clamp(dot(V, H), 0.0, 1.0);
+    return microfacet_f43076_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 #line 11 "bricks/packing/normal/vertex.py"
@@ -105,19 +118,7 @@ vec4 linear_output(vec3 color) {
     return vec4(color, 1.0);
 }
 
-#line 4 "<glue>"
-vec3 brdf_lit(vec3 L, vec3 V, vec3 N, float alpha, vec3 f0) {
-    float NdotL = min(dot(N, L), 1.0);
-    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
-    vec3 Hsum = (L + V);
-    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
-    float NdotH = clamp(dot(N, H), 0.0, 1.0);
-    vec3 NxH = cross(N, H);
-    float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
-    float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
-}
-
+#line 26 "<glue>"
 vec4 shade(vec3 P, vec3 Ng, vec3 V, float m_alpha, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D l0_shadow_map, sampler _smp_l0_shadow_map) {
     vec3 N = vertex_normal(Ng);
     vec3 Lo = vec3(0.0);
@@ -128,7 +129,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, float m_alpha, vec3 m_f0, vec3 l0_direction,
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 25 "<glue>"
+#line 35 "<glue>"
     vec3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -136,12 +137,12 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, float m_alpha, vec3 m_f0, vec3 l0_direction,
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 31 "<glue>"
+#line 41 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 145 "3595e5d140dc.frag.glsl"
+#line 146 "3595e5d140dc.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

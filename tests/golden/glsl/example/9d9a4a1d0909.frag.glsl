@@ -31,6 +31,14 @@ vec3 blinn_phong_normalized_specular(float NdotH, float n, vec3 f0) {
     return (f0 * (((n + 4.0) / (8.0 * 3.141592653589793)) * pow(NdotH, n)));
 }
 
+#line 1 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
+    vec3 Hsum = (L + V);
+    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
+    float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
+}
+
 #line 11 "bricks/packing/normal/vertex.py"
 vec3 vertex_normal(vec3 N) {
     return N;
@@ -57,14 +65,7 @@ vec4 linear_output(vec3 color) {
     return vec4(color, 1.0);
 }
 
-#line 4 "<glue>"
-vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
-    vec3 Hsum = (L + V);
-    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
-    float NdotH = clamp(dot(N, H), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
-}
-
+#line 21 "<glue>"
 vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_n, vec3 m_f0, vec3 l0_position, vec3 l0_color, vec3 l1_position, vec3 l1_color) {
     vec3 N = vertex_normal(Ng);
     vec3 Lo = vec3(0.0);
@@ -75,7 +76,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_n, vec3 m_f0, vec3 l0_
         float s0 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 20 "<glue>"
+#line 30 "<glue>"
     vec3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -83,12 +84,12 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_n, vec3 m_f0, vec3 l0_
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 26 "<glue>"
+#line 36 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 92 "9d9a4a1d0909.frag.glsl"
+#line 93 "9d9a4a1d0909.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

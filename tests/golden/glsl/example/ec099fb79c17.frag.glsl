@@ -64,11 +64,24 @@ float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, f
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-vec3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
+vec3 microfacet_209db6_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, vec3 f0) {
 #line 27 "bricks/brdf/specular/microfacet.py"
     float D = beckmann_ndf(NdotH, NxH2, alpha);
     float Vis = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
+}
+
+#line 1 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
+    float NdotL = min(dot(N, L), 1.0);
+    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
+    vec3 Hsum = (L + V);
+    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
+    float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    vec3 NxH = cross(N, H);
+    float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
+    float VdotH = clamp(dot(V, H), 0.0, 1.0);
+    return (lambert_diffuse(rho_d) + microfacet_209db6_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 #line 12 "bricks/packing/normal/normal_map.py"
@@ -78,7 +91,7 @@ vec3 normal_map_normal(vec3 N, vec3 T, vec3 B, vec2 uv, texture2D normal_map, sa
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
-vec3 albedo_texture_get_rho_d(vec2 uv, texture2D albedo_map, sampler _smp_albedo_map, vec3 rho_d) {
+vec3 albedo_texture_512f91_get_rho_d(vec2 uv, texture2D albedo_map, sampler _smp_albedo_map, vec3 rho_d) {
     return (rho_d * texture(sampler2D(albedo_map, _smp_albedo_map), uv).xyz);
 }
 
@@ -122,21 +135,9 @@ vec4 linear_output(vec3 color) {
     return vec4(color, 1.0);
 }
 
-#line 4 "<glue>"
-vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
-    float NdotL = min(dot(N, L), 1.0);
-    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
-    vec3 Hsum = (L + V);
-    vec3 H = (Hsum * inversesqrt(max(dot(Hsum, Hsum), 1e-30)));
-    float NdotH = clamp(dot(N, H), 0.0, 1.0);
-    vec3 NxH = cross(N, H);
-    float NxH2 = mix(1.0, dot(NxH, NxH), (NdotH > 0.0));
-    float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
-}
-
+#line 27 "<glue>"
 vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, vec3 m_rho_d, float m_alpha, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D t_albedo_map, sampler _smp_t_albedo_map, texture2D t_normal_map, sampler _smp_t_normal_map, texture2D l0_shadow_map, sampler _smp_l0_shadow_map) {
-    vec3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    vec3 p_rho_d = albedo_texture_512f91_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     vec3 N = normal_map_normal(Ng, T, B, uv, t_normal_map, _smp_t_normal_map);
     vec3 Lo = vec3(0.0);
     vec3 L0 = directional_light_dir(P, l0_direction);
@@ -146,7 +147,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, vec3 m_rho_d, float
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 26 "<glue>"
+#line 37 "<glue>"
     vec3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -154,12 +155,12 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, vec3 m_rho_d, float
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, p_rho_d, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 32 "<glue>"
+#line 43 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 163 "ec099fb79c17.frag.glsl"
+#line 164 "ec099fb79c17.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

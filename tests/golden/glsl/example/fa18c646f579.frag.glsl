@@ -39,13 +39,19 @@ vec3 phong_normalized_specular(float RdotV, float n, vec3 f0) {
     return (f0 * (((n + 2.0) * 0.15915494309189535) * pow(RdotV, n)));
 }
 
+#line 1 "<glue>"
+vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
+    float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
+    return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
+}
+
 #line 11 "bricks/packing/normal/vertex.py"
 vec3 vertex_normal(vec3 N) {
     return N;
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
-vec3 albedo_texture_get_rho_d(vec2 uv, texture2D albedo_map, sampler _smp_albedo_map, vec3 rho_d) {
+vec3 albedo_texture_588c14_get_rho_d(vec2 uv, texture2D albedo_map, sampler _smp_albedo_map, vec3 rho_d) {
     return (rho_d * texture(sampler2D(albedo_map, _smp_albedo_map), uv).xyz);
 }
 
@@ -89,14 +95,9 @@ vec4 linear_output(vec3 color) {
     return vec4(color, 1.0);
 }
 
-#line 4 "<glue>"
-vec3 brdf_lit(vec3 L, vec3 V, vec3 N, vec3 rho_d, float n, vec3 f0) {
-    float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
-}
-
+#line 20 "<glue>"
 vec4 shade(vec3 P, vec3 Ng, vec3 V, vec2 uv, vec3 m_rho_d, float m_n, vec3 m_f0, vec3 l0_direction, vec3 l0_color, mat4 l0_shadow_matrix, float l0_shadow_bias, vec3 l1_position, vec3 l1_color, texture2D t_albedo_map, sampler _smp_t_albedo_map, texture2D l0_shadow_map, sampler _smp_l0_shadow_map) {
-    vec3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    vec3 p_rho_d = albedo_texture_588c14_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     vec3 N = vertex_normal(Ng);
     vec3 Lo = vec3(0.0);
     vec3 L0 = directional_light_dir(P, l0_direction);
@@ -106,7 +107,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec2 uv, vec3 m_rho_d, float m_n, vec3 m_f0,
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 19 "<glue>"
+#line 30 "<glue>"
     vec3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -114,12 +115,12 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec2 uv, vec3 m_rho_d, float m_n, vec3 m_f0,
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 25 "<glue>"
+#line 36 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 123 "fa18c646f579.frag.glsl"
+#line 124 "fa18c646f579.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

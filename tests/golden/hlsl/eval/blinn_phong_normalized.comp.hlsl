@@ -16,7 +16,7 @@ float3 blinn_phong_normalized_specular(float NdotH, float n, float3 f0) {
     return (f0 * (((n + 4.0) / (8.0 * 3.141592653589793)) * pow(NdotH, n)));
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 float3 brdf_lit(float3 L, float3 V, float3 N, float n, float3 f0) {
     float3 Hsum = (L + V);
     float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
@@ -24,16 +24,17 @@ float3 brdf_lit(float3 L, float3 V, float3 N, float n, float3 f0) {
     return blinn_phong_normalized_specular(NdotH, n, f0);
 }
 
+#line 6 "<glue>"
 float3 brdf(float3 L, float3 V, float3 N, float n, float3 f0) {
     if (dot(N, L) <= 0.0) {
         return ((float3)(0.0));
     }
-#line 14 "<glue>"
+#line 9 "<glue>"
     return brdf_lit(L, V, N, n, f0);
 }
 
 
-#line 37 "9a8398637d4c.comp.hlsl"
+#line 38 "9a8398637d4c.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

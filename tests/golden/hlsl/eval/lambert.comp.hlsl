@@ -16,21 +16,22 @@ float3 lambert_diffuse(float3 rho_d) {
     return (rho_d * 0.3183098861837907);
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d) {
     return lambert_diffuse(rho_d);
 }
 
+#line 3 "<glue>"
 float3 brdf(float3 L, float3 V, float3 N, float3 rho_d) {
     if (dot(N, L) <= 0.0) {
         return ((float3)(0.0));
     }
-#line 11 "<glue>"
+#line 6 "<glue>"
     return brdf_lit(L, V, N, rho_d);
 }
 
 
-#line 34 "55679a70c070.comp.hlsl"
+#line 35 "55679a70c070.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

@@ -37,14 +37,14 @@ float implicit_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alp
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+float3 microfacet_5039d9_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
 #line 27 "bricks/brdf/specular/microfacet.py"
     float D = blinn_phong_ndf(NdotH, NxH2, alpha);
     float Vis = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 float3 brdf_lit(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     float NdotL = min(dot(N, L), 1.0);
     float NdotV = clamp(dot(N, V), 0.0001, 1.0);
@@ -54,19 +54,20 @@ float3 brdf_lit(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     float3 NxH = cross(N, H);
     float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
     float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
+    return microfacet_5039d9_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
+#line 11 "<glue>"
 float3 brdf(float3 L, float3 V, float3 N, float alpha, float3 f0) {
     if (dot(N, L) <= 0.0) {
         return ((float3)(0.0));
     }
-#line 19 "<glue>"
+#line 14 "<glue>"
     return brdf_lit(L, V, N, alpha, f0);
 }
 
 
-#line 70 "990b9a56f7cb.comp.hlsl"
+#line 71 "990b9a56f7cb.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

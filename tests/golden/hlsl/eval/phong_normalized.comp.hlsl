@@ -17,22 +17,23 @@ float3 phong_normalized_specular(float RdotV, float n, float3 f0) {
     return (f0 * (((n + 2.0) * 0.15915494309189535) * pow(RdotV, n)));
 }
 
-#line 4 "<glue>"
+#line 1 "<glue>"
 float3 brdf_lit(float3 L, float3 V, float3 N, float n, float3 f0) {
     float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
     return phong_normalized_specular(RdotV, n, f0);
 }
 
+#line 4 "<glue>"
 float3 brdf(float3 L, float3 V, float3 N, float n, float3 f0) {
     if (dot(N, L) <= 0.0) {
         return ((float3)(0.0));
     }
-#line 12 "<glue>"
+#line 7 "<glue>"
     return brdf_lit(L, V, N, n, f0);
 }
 
 
-#line 36 "bcf91138f6f2.comp.hlsl"
+#line 37 "bcf91138f6f2.comp.hlsl"
 [numthreads(64, 1, 1)]
 void main(uint3 gid : SV_DispatchThreadID) {
     uint i = gid.x;

@@ -49,11 +49,24 @@ float implicit_vis(float NdotL, float NdotV, float NdotH, float VdotH, float alp
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+float3 microfacet_f7e29a_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
 #line 27 "bricks/brdf/specular/microfacet.py"
     float D = blinn_phong_ndf(NdotH, NxH2, alpha);
     float Vis = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (none_fresnel(f0, VdotH) * (D * Vis));
+}
+
+#line 1 "<glue>"
+float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float alpha, float3 f0) {
+    float NdotL = min(dot(N, L), 1.0);
+    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
+    float3 Hsum = (L + V);
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
+    float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    float3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
+    float VdotH = clamp(dot(V, H), 0.0, 1.0);
+    return (lambert_diffuse(rho_d) + microfacet_f7e29a_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 #line 11 "bricks/packing/normal/vertex.py"
@@ -82,19 +95,7 @@ float4 linear_output(float3 color) {
     return float4(color, 1.0);
 }
 
-#line 4 "<glue>"
-float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float alpha, float3 f0) {
-    float NdotL = min(dot(N, L), 1.0);
-    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
-    float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
-    float NdotH = clamp(dot(N, H), 0.0, 1.0);
-    float3 NxH = cross(N, H);
-    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
-    float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
-}
-
+#line 26 "<glue>"
 float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_alpha, float3 m_f0, float3 l0_position, float3 l0_color, float3 l1_position, float3 l1_color) {
     float3 N = vertex_normal(Ng);
     float3 Lo = ((float3)(0.0));
@@ -105,7 +106,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_alpha, float
         float s0 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 25 "<glue>"
+#line 35 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -113,12 +114,12 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_alpha, float
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 31 "<glue>"
+#line 41 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 122 "3492f48173ec.frag.hlsl"
+#line 123 "3492f48173ec.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

@@ -31,6 +31,14 @@ float3 blinn_phong_normalized_specular(float NdotH, float n, float3 f0) {
     return (f0 * (((n + 4.0) / (8.0 * 3.141592653589793)) * pow(NdotH, n)));
 }
 
+#line 1 "<glue>"
+float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
+    float3 Hsum = (L + V);
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
+    float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
+}
+
 #line 11 "bricks/packing/normal/vertex.py"
 float3 vertex_normal(float3 N) {
     return N;
@@ -57,14 +65,7 @@ float4 linear_output(float3 color) {
     return float4(color, 1.0);
 }
 
-#line 4 "<glue>"
-float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
-    float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
-    float NdotH = clamp(dot(N, H), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
-}
-
+#line 21 "<glue>"
 float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_n, float3 m_f0, float3 l0_position, float3 l0_color, float3 l1_position, float3 l1_color) {
     float3 N = vertex_normal(Ng);
     float3 Lo = ((float3)(0.0));
@@ -75,7 +76,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_n, float3 m_
         float s0 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 20 "<glue>"
+#line 30 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -83,12 +84,12 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_n, float3 m_
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 26 "<glue>"
+#line 36 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 92 "9d9a4a1d0909.frag.hlsl"
+#line 93 "9d9a4a1d0909.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

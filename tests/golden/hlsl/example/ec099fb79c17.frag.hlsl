@@ -64,11 +64,24 @@ float torrance_sparrow_vis(float NdotL, float NdotV, float NdotH, float VdotH, f
 }
 
 #line 25 "bricks/brdf/specular/microfacet.py"
-float3 microfacet_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
+float3 microfacet_209db6_specular(float NdotL, float NdotV, float NdotH, float NxH2, float VdotH, float alpha, float3 f0) {
 #line 27 "bricks/brdf/specular/microfacet.py"
     float D = beckmann_ndf(NdotH, NxH2, alpha);
     float Vis = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
+}
+
+#line 1 "<glue>"
+float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float alpha, float3 f0) {
+    float NdotL = min(dot(N, L), 1.0);
+    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
+    float3 Hsum = (L + V);
+    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
+    float NdotH = clamp(dot(N, H), 0.0, 1.0);
+    float3 NxH = cross(N, H);
+    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
+    float VdotH = clamp(dot(V, H), 0.0, 1.0);
+    return (lambert_diffuse(rho_d) + microfacet_209db6_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 #line 12 "bricks/packing/normal/normal_map.py"
@@ -78,7 +91,7 @@ float3 normal_map_normal(float3 N, float3 T, float3 B, float2 uv, Texture2D norm
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
-float3 albedo_texture_get_rho_d(float2 uv, Texture2D albedo_map, SamplerState _smp_albedo_map, float3 rho_d) {
+float3 albedo_texture_512f91_get_rho_d(float2 uv, Texture2D albedo_map, SamplerState _smp_albedo_map, float3 rho_d) {
     return (rho_d * albedo_map.Sample(_smp_albedo_map, uv).xyz);
 }
 
@@ -122,21 +135,9 @@ float4 linear_output(float3 color) {
     return float4(color, 1.0);
 }
 
-#line 4 "<glue>"
-float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float alpha, float3 f0) {
-    float NdotL = min(dot(N, L), 1.0);
-    float NdotV = clamp(dot(N, V), 0.0001, 1.0);
-    float3 Hsum = (L + V);
-    float3 H = (Hsum * rsqrt(max(dot(Hsum, Hsum), 1e-30)));
-    float NdotH = clamp(dot(N, H), 0.0, 1.0);
-    float3 NxH = cross(N, H);
-    float NxH2 = ((NdotH > 0.0) ? dot(NxH, NxH) : 1.0);
-    float VdotH = clamp(dot(V, H), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
-}
-
+#line 27 "<glue>"
 float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float3 m_rho_d, float m_alpha, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D t_albedo_map, SamplerState _smp_t_albedo_map, Texture2D t_normal_map, SamplerState _smp_t_normal_map, Texture2D l0_shadow_map, SamplerState _smp_l0_shadow_map) {
-    float3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    float3 p_rho_d = albedo_texture_512f91_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     float3 N = normal_map_normal(Ng, T, B, uv, t_normal_map, _smp_t_normal_map);
     float3 Lo = ((float3)(0.0));
     float3 L0 = directional_light_dir(P, l0_direction);
@@ -146,7 +147,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_alpha, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 26 "<glue>"
+#line 37 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -154,12 +155,12 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, p_rho_d, m_alpha, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 32 "<glue>"
+#line 43 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 163 "ec099fb79c17.frag.hlsl"
+#line 164 "ec099fb79c17.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

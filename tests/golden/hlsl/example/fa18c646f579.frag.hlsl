@@ -39,13 +39,19 @@ float3 phong_normalized_specular(float RdotV, float n, float3 f0) {
     return (f0 * (((n + 2.0) * 0.15915494309189535) * pow(RdotV, n)));
 }
 
+#line 1 "<glue>"
+float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
+    float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
+    return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
+}
+
 #line 11 "bricks/packing/normal/vertex.py"
 float3 vertex_normal(float3 N) {
     return N;
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
-float3 albedo_texture_get_rho_d(float2 uv, Texture2D albedo_map, SamplerState _smp_albedo_map, float3 rho_d) {
+float3 albedo_texture_588c14_get_rho_d(float2 uv, Texture2D albedo_map, SamplerState _smp_albedo_map, float3 rho_d) {
     return (rho_d * albedo_map.Sample(_smp_albedo_map, uv).xyz);
 }
 
@@ -89,14 +95,9 @@ float4 linear_output(float3 color) {
     return float4(color, 1.0);
 }
 
-#line 4 "<glue>"
-float3 brdf_lit(float3 L, float3 V, float3 N, float3 rho_d, float n, float3 f0) {
-    float RdotV = clamp(dot(reflect((-L), N), V), 0.0, 1.0);
-    return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
-}
-
+#line 20 "<glue>"
 float4 shade(float3 P, float3 Ng, float3 V, float2 uv, float3 m_rho_d, float m_n, float3 m_f0, float3 l0_direction, float3 l0_color, float4x4 l0_shadow_matrix, float l0_shadow_bias, float3 l1_position, float3 l1_color, Texture2D t_albedo_map, SamplerState _smp_t_albedo_map, Texture2D l0_shadow_map, SamplerState _smp_l0_shadow_map) {
-    float3 p_rho_d = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    float3 p_rho_d = albedo_texture_588c14_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     float3 N = vertex_normal(Ng);
     float3 Lo = ((float3)(0.0));
     float3 L0 = directional_light_dir(P, l0_direction);
@@ -106,7 +107,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float2 uv, float3 m_rho_d, float m_n
         float s0 = shadow_map_shadow(P, l0_shadow_matrix, l0_shadow_bias, l0_shadow_map, _smp_l0_shadow_map);
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, p_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
-#line 19 "<glue>"
+#line 30 "<glue>"
     float3 L1 = point_light_dir(P, l1_position);
     float NdotL1 = dot(N, L1);
     if (NdotL1 > 0.0) {
@@ -114,12 +115,12 @@ float4 shade(float3 P, float3 Ng, float3 V, float2 uv, float3 m_rho_d, float m_n
         float s1 = none_shadow(P);
         Lo += (((3.141592653589793 * brdf_lit(L1, V, N, p_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
     }
-#line 25 "<glue>"
+#line 36 "<glue>"
     return linear_output(Lo);
 }
 
 
-#line 123 "fa18c646f579.frag.hlsl"
+#line 124 "fa18c646f579.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

@@ -35,7 +35,7 @@ fn smith_schlick_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32)
     return (1.0f / max(((4.0f * gl) * gv), 1e-08f));
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+fn microfacet_f43076_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
     var D: f32 = ggx_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = smith_schlick_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
@@ -50,7 +50,7 @@ fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>)
     var NxH: vec3<f32> = cross(N, H);
     var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
     var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
+    return microfacet_f43076_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 fn brdf(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {

@@ -42,10 +42,22 @@ fn implicit_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32) -> f
     return 0.25f;
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+fn microfacet_f7e29a_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
     var D: f32 = blinn_phong_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = implicit_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (none_fresnel(f0, VdotH) * (D * Vis));
+}
+
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    var NdotL: f32 = min(dot(N, L), 1.0f);
+    var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
+    var Hsum: vec3<f32> = (L + V);
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
+    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    var NxH: vec3<f32> = cross(N, H);
+    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
+    var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
+    return (lambert_diffuse(rho_d) + microfacet_f7e29a_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 fn vertex_normal(N: vec3<f32>) -> vec3<f32> {
@@ -67,18 +79,6 @@ fn none_shadow(P: vec3<f32>) -> f32 {
 
 fn linear_output(color: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(color, 1.0f);
-}
-
-fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    var NdotL: f32 = min(dot(N, L), 1.0f);
-    var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
-    var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
-    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
-    var NxH: vec3<f32> = cross(N, H);
-    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
-    var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, m_rho_d: vec3<f32>, m_alpha: f32, m_f0: vec3<f32>, l0_position: vec3<f32>, l0_color: vec3<f32>, l1_position: vec3<f32>, l1_color: vec3<f32>) -> vec4<f32> {

@@ -45,10 +45,22 @@ fn smith_schlick_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f32)
     return (1.0f / max(((4.0f * gl) * gv), 1e-08f));
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+fn microfacet_f43076_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
     var D: f32 = ggx_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = smith_schlick_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
+}
+
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    var NdotL: f32 = min(dot(N, L), 1.0f);
+    var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
+    var Hsum: vec3<f32> = (L + V);
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
+    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    var NxH: vec3<f32> = cross(N, H);
+    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
+    var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
+    return microfacet_f43076_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 fn vertex_normal(N: vec3<f32>) -> vec3<f32> {
@@ -86,18 +98,6 @@ fn none_shadow(P: vec3<f32>) -> f32 {
 
 fn linear_output(color: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(color, 1.0f);
-}
-
-fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    var NdotL: f32 = min(dot(N, L), 1.0f);
-    var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
-    var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
-    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
-    var NxH: vec3<f32> = cross(N, H);
-    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
-    var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0);
 }
 
 fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, m_alpha: f32, m_f0: vec3<f32>, l0_direction: vec3<f32>, l0_color: vec3<f32>, l0_shadow_matrix: mat4x4<f32>, l0_shadow_bias: f32, l1_position: vec3<f32>, l1_color: vec3<f32>, l0_shadow_map: texture_2d<f32>, _smp_l0_shadow_map: sampler) -> vec4<f32> {

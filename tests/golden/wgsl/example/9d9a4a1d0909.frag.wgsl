@@ -27,6 +27,13 @@ fn blinn_phong_normalized_specular(NdotH: f32, n: f32, f0: vec3<f32>) -> vec3<f3
     return (f0 * (((n + 4.0f) / (8.0f * 3.141592653589793f)) * pow(NdotH, n)));
 }
 
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
+    var Hsum: vec3<f32> = (L + V);
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
+    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
+}
+
 fn vertex_normal(N: vec3<f32>) -> vec3<f32> {
     return N;
 }
@@ -46,13 +53,6 @@ fn none_shadow(P: vec3<f32>) -> f32 {
 
 fn linear_output(color: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(color, 1.0f);
-}
-
-fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
-    var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
-    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
-    return (lambert_diffuse(rho_d) + blinn_phong_normalized_specular(NdotH, n, f0));
 }
 
 fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, m_rho_d: vec3<f32>, m_n: f32, m_f0: vec3<f32>, l0_position: vec3<f32>, l0_color: vec3<f32>, l1_position: vec3<f32>, l1_color: vec3<f32>) -> vec4<f32> {

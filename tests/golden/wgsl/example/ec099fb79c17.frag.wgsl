@@ -53,10 +53,22 @@ fn torrance_sparrow_vis(NdotL: f32, NdotV: f32, NdotH: f32, VdotH: f32, alpha: f
     return (G / ((4.0f * nl) * NdotV));
 }
 
-fn microfacet_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+fn microfacet_209db6_specular(NdotL: f32, NdotV: f32, NdotH: f32, NxH2: f32, VdotH: f32, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
     var D: f32 = beckmann_ndf(NdotH, NxH2, alpha);
     var Vis: f32 = torrance_sparrow_vis(NdotL, NdotV, NdotH, VdotH, alpha);
     return (schlick_fresnel(f0, VdotH) * (D * Vis));
+}
+
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
+    var NdotL: f32 = min(dot(N, L), 1.0f);
+    var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
+    var Hsum: vec3<f32> = (L + V);
+    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
+    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
+    var NxH: vec3<f32> = cross(N, H);
+    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
+    var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
+    return (lambert_diffuse(rho_d) + microfacet_209db6_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
 }
 
 fn normal_map_normal(N: vec3<f32>, T: vec3<f32>, B: vec3<f32>, uv: vec2<f32>, normal_map: texture_2d<f32>, _smp_normal_map: sampler) -> vec3<f32> {
@@ -64,7 +76,7 @@ fn normal_map_normal(N: vec3<f32>, T: vec3<f32>, B: vec3<f32>, uv: vec2<f32>, no
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
 }
 
-fn albedo_texture_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, rho_d: vec3<f32>) -> vec3<f32> {
+fn albedo_texture_512f91_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, rho_d: vec3<f32>) -> vec3<f32> {
     return (rho_d * textureSample(albedo_map, _smp_albedo_map, uv).xyz);
 }
 
@@ -101,20 +113,8 @@ fn linear_output(color: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(color, 1.0f);
 }
 
-fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, alpha: f32, f0: vec3<f32>) -> vec3<f32> {
-    var NdotL: f32 = min(dot(N, L), 1.0f);
-    var NdotV: f32 = clamp(dot(N, V), 0.0001f, 1.0f);
-    var Hsum: vec3<f32> = (L + V);
-    var H: vec3<f32> = (Hsum * inverseSqrt(max(dot(Hsum, Hsum), 1e-30f)));
-    var NdotH: f32 = clamp(dot(N, H), 0.0f, 1.0f);
-    var NxH: vec3<f32> = cross(N, H);
-    var NxH2: f32 = select(1.0f, dot(NxH, NxH), (NdotH > 0.0f));
-    var VdotH: f32 = clamp(dot(V, H), 0.0f, 1.0f);
-    return (lambert_diffuse(rho_d) + microfacet_specular(NdotL, NdotV, NdotH, NxH2, VdotH, alpha, f0));
-}
-
 fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, T: vec3<f32>, B: vec3<f32>, uv: vec2<f32>, m_rho_d: vec3<f32>, m_alpha: f32, m_f0: vec3<f32>, l0_direction: vec3<f32>, l0_color: vec3<f32>, l0_shadow_matrix: mat4x4<f32>, l0_shadow_bias: f32, l1_position: vec3<f32>, l1_color: vec3<f32>, t_albedo_map: texture_2d<f32>, _smp_t_albedo_map: sampler, t_normal_map: texture_2d<f32>, _smp_t_normal_map: sampler, l0_shadow_map: texture_2d<f32>, _smp_l0_shadow_map: sampler) -> vec4<f32> {
-    var p_rho_d: vec3<f32> = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    var p_rho_d: vec3<f32> = albedo_texture_512f91_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     var N: vec3<f32> = normal_map_normal(Ng, T, B, uv, t_normal_map, _smp_t_normal_map);
     var Lo: vec3<f32> = vec3<f32>(0.0f);
     var L0: vec3<f32> = directional_light_dir(P, l0_direction);

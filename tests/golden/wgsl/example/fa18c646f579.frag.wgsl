@@ -33,11 +33,16 @@ fn phong_normalized_specular(RdotV: f32, n: f32, f0: vec3<f32>) -> vec3<f32> {
     return (f0 * (((n + 2.0f) * 0.15915494309189535f) * pow(RdotV, n)));
 }
 
+fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
+    var RdotV: f32 = clamp(dot(reflect((-L), N), V), 0.0f, 1.0f);
+    return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
+}
+
 fn vertex_normal(N: vec3<f32>) -> vec3<f32> {
     return N;
 }
 
-fn albedo_texture_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, rho_d: vec3<f32>) -> vec3<f32> {
+fn albedo_texture_588c14_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, rho_d: vec3<f32>) -> vec3<f32> {
     return (rho_d * textureSample(albedo_map, _smp_albedo_map, uv).xyz);
 }
 
@@ -74,13 +79,8 @@ fn linear_output(color: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(color, 1.0f);
 }
 
-fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, n: f32, f0: vec3<f32>) -> vec3<f32> {
-    var RdotV: f32 = clamp(dot(reflect((-L), N), V), 0.0f, 1.0f);
-    return (lambert_diffuse(rho_d) + phong_normalized_specular(RdotV, n, f0));
-}
-
 fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, uv: vec2<f32>, m_rho_d: vec3<f32>, m_n: f32, m_f0: vec3<f32>, l0_direction: vec3<f32>, l0_color: vec3<f32>, l0_shadow_matrix: mat4x4<f32>, l0_shadow_bias: f32, l1_position: vec3<f32>, l1_color: vec3<f32>, t_albedo_map: texture_2d<f32>, _smp_t_albedo_map: sampler, l0_shadow_map: texture_2d<f32>, _smp_l0_shadow_map: sampler) -> vec4<f32> {
-    var p_rho_d: vec3<f32> = albedo_texture_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
+    var p_rho_d: vec3<f32> = albedo_texture_588c14_get_rho_d(uv, t_albedo_map, _smp_t_albedo_map, m_rho_d);
     var N: vec3<f32> = vertex_normal(Ng);
     var Lo: vec3<f32> = vec3<f32>(0.0f);
     var L0: vec3<f32> = directional_light_dir(P, l0_direction);

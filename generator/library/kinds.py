@@ -1,0 +1,84 @@
+"""Kind contracts as data: what each kind of brick's entries take and return.
+
+An entry's parameters are bound by name. A name is one of
+- an argument of the contract (`args`): what the caller passes, positionally, in
+  the contract's order (a slot's host, or the glue: `output(color)`);
+- a shading input (`reads` = "shading": the inputs table of library/inputs.py) or a
+  surface input (`reads` = "surface": P, N, T, B, uv);
+- a parameter or texture the brick declares in BRICK.
+An optional argument may be left out of an entry; a required one must be declared.
+The loader (library/bricks.py) checks entries against these contracts; the linker
+(link/) binds them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..lang.types import FLOAT, VEC3, VEC4, Type
+
+
+@dataclass(frozen=True)
+class Arg:
+    """A value the caller of an entry passes."""
+
+    name: str
+    ty: Type
+    required: bool = False  # the entry must declare it
+
+
+@dataclass(frozen=True)
+class Entry:
+    name: str
+    ret: Type
+    args: tuple[Arg, ...] = ()
+
+
+@dataclass(frozen=True)
+class Kind:
+    """One kind of brick.
+
+    entries: the functions the generator calls; a packing's entries are every
+      function named `get_<material input>` (prefix_entries), returning that input.
+    reads: "shading" (the inputs table) or "surface" (P, N, T, B, uv).
+    slot: a kind that fills a slot of a host brick (called from the host, not the glue).
+    """
+
+    name: str
+    entries: tuple[Entry, ...]
+    reads: str
+    slot: bool = False
+    prefix_entries: str = ""
+    doc: str = ""
+
+    def entry(self, name: str) -> Entry | None:
+        for e in self.entries:
+            if e.name == name:
+                return e
+        if self.prefix_entries and name.startswith(self.prefix_entries):
+            return Entry(name, VEC3)
+        return None
+
+    def signature(self, entry: str) -> tuple[tuple[str, Type], ...]:
+        """The positional signature a caller of `entry` is type-checked against (its args)."""
+        return tuple((a.name, a.ty) for a in self.entry(entry).args)
+
+
+KINDS: dict[str, Kind] = {k.name: k for k in (
+    Kind("diffuse", (Entry("diffuse", VEC3),), "shading", doc="a diffuse BRDF term f_r (1/sr)"),
+    Kind("specular", (Entry("specular", VEC3),), "shading", doc="a specular BRDF term f_r (1/sr)"),
+    Kind("ndf", (Entry("ndf", FLOAT, (Arg("NdotH", FLOAT), Arg("NxH2", FLOAT), Arg("alpha", FLOAT))),),
+         "shading", slot=True, doc="a normal distribution D(h), normalized: ∫ D cosθ_h dω = 1"),
+    Kind("fresnel", (Entry("fresnel", VEC3, (Arg("f0", VEC3), Arg("VdotH", FLOAT))),), "shading", slot=True,
+         doc="a Fresnel reflectance F"),
+    Kind("visibility", (Entry("vis", FLOAT, (Arg("NdotL", FLOAT), Arg("NdotV", FLOAT), Arg("NdotH", FLOAT),
+                                             Arg("VdotH", FLOAT), Arg("alpha", FLOAT))),),
+         "shading", slot=True, doc="a visibility term V = G / (4 n·l n·v)"),
+    Kind("light", (Entry("light_dir", VEC3), Entry("light_radiance", VEC3)), "surface",
+         doc="a light: the unit direction to it and c_light, the game intensity"),
+    Kind("shadow", (Entry("shadow", FLOAT),), "surface", doc="a shadow filter: visibility of the light in [0, 1]"),
+    Kind("packing", (), "surface", prefix_entries="get_", doc="a texture packing: get_<param> supplies a material input"),
+    Kind("normal", (Entry("normal", VEC3),), "surface", doc="the shading normal"),
+    Kind("output", (Entry("output", VEC4, (Arg("color", VEC3, required=True),)),), "surface",
+         doc="the output transform of the outgoing radiance"),
+)}
+BRDF_KINDS = ("diffuse", "specular")

@@ -1,0 +1,221 @@
+"""The typed Interface of a linked program: what a shader reads and where each value lives.
+
+Everything downstream reads it: compose (templates declare it), build (the manifest's
+reflection), the runtime (what to bind), measure (stand-ins). Layout (NOTES.md,
+"Uniform layout"): material and light parameters live in arrays of vec4, one vec4
+per scalar or vector and four per mat4 (column-major), identical in std140, HLSL
+cbuffers and WGSL uniforms, so one byte block serves all three languages. Set 0:
+frame (b0), lights (b1), light textures (b2+); set 1: material (b0), material
+textures (b1+); a texture takes two bindings, the image at B and its sampler at B+1.
+"""
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass, field
+
+from ..lang.types import Type
+from ..library.params import ParamSpec
+
+VEC4_BYTES = 16
+
+
+@dataclass
+class Slot:
+    """One parameter in a vec4-array block: shader name, engine name, type, vec4 index."""
+
+    name: str  # the glue's name (m_alpha, l0_color)
+    param: str  # the engine's name (alpha, color)
+    ty: Type
+    index: int
+    spec: ParamSpec | None = None
+    light: int | None = None  # the light it belongs to
+    base: int = 0  # byte offset of the vec4 array in its block
+
+    @property
+    def width(self) -> int:
+        """vec4s it occupies."""
+        return 4 if self.ty.kind == "matrix" else 1
+
+    @property
+    def offset(self) -> int:
+        """Byte offset in the block."""
+        return self.base + self.index * VEC4_BYTES
+
+    def as_dict(self) -> dict:
+        d = {"name": self.param, "type": str(self.ty), "offset": self.offset, "size": self.ty.components * 4}
+        if self.spec is not None:
+            d["default"] = self.spec.default
+            d["range"] = list(self.spec.range) if self.spec.range else None
+        return d
+
+
+def layout(values: list[tuple[str, str, Type, ParamSpec | None, int | None]]) -> tuple[list[Slot], int]:
+    """(name, param, type, spec, light) in order → slots, one vec4 each (four per mat4), and the vec4 count."""
+    slots, i = [], 0
+    for name, param, ty, spec, light in values:
+        s = Slot(name, param, ty, i, spec, light)
+        slots.append(s)
+        i += s.width
+    return slots, i
+
+
+def pack(slots: list[Slot], values: dict[str, object], count: int) -> bytes:
+    """A ready-to-upload block: `values` ({slot name: number or list}) at their slots, zeros elsewhere."""
+    words = [0.0] * (4 * max(count, 1))
+    for s in slots:
+        v = values.get(s.name)
+        if v is None:
+            continue
+        flat = list(v) if isinstance(v, (list, tuple)) else [v]
+        if s.ty.kind == "vector" and len(flat) == 1:
+            flat = flat * s.ty.size
+        if s.ty.kind == "matrix":  # column-major, one column per vec4
+            for c in range(4):
+                words[4 * (s.index + c):4 * (s.index + c) + 4] = [float(x) for x in flat[4 * c:4 * c + 4]]
+        else:
+            words[4 * s.index:4 * s.index + len(flat)] = [float(x) for x in flat]
+    return struct.pack(f"<{len(words)}f", *words)
+
+
+@dataclass
+class Block:
+    """A uniform or storage block: its declared members and the parameters inside them."""
+
+    name: str
+    set: int
+    binding: int
+    kind: str  # "uniform" | "storage"
+    members: list[dict]  # [{"name", "type", "offset", "size", "array_stride"?}] as declared
+    slots: list[Slot] = field(default_factory=list)
+    readonly: bool = True
+
+    @property
+    def size(self) -> int:
+        last = self.members[-1]
+        return last["offset"] + last["size"]
+
+    def as_dict(self) -> dict:
+        d = {"name": self.name, "set": self.set, "binding": self.binding, "kind": self.kind, "size": self.size,
+             "members": self.members}
+        if self.slots:
+            d["parameters"] = [s.as_dict() for s in self.slots]
+        return d
+
+
+def vec4_array_block(name: str, set_: int, binding: int, slots: list[Slot], count: int,
+                     header: list[dict] | None = None) -> Block:
+    """A block holding `header` members then `data: vec4[count]`."""
+    members = list(header or [])
+    base = members[-1]["offset"] + members[-1]["size"] if members else 0
+    members.append({"name": "data", "type": f"vec4[{count}]", "offset": base, "size": count * VEC4_BYTES,
+                    "array_stride": VEC4_BYTES})
+    for s in slots:
+        s.base = base
+    return Block(name, set_, binding, "uniform", members, slots)
+
+
+FRAME_BLOCK = [{"name": "view_proj", "type": "mat4", "offset": 0, "size": 64, "matrix_stride": 16},
+               {"name": "model", "type": "mat4", "offset": 64, "size": 64, "matrix_stride": 16},
+               {"name": "camera_pos", "type": "vec4", "offset": 128, "size": 16}]
+
+
+@dataclass
+class Texture:
+    """A texture and its sampler: the image at `binding`, the sampler at `binding + 1`."""
+
+    name: str  # the glue's name (t_albedo_map)
+    param: str  # the brick's texture name
+    group: str  # "material" | "light"
+    srgb: bool
+    dim: str = "2d"  # "2d" | "cube"
+    light: int | None = None
+    set: int = 0
+    binding: int = 0
+
+    def as_dict(self) -> dict:
+        d = {"name": self.param, "set": self.set, "binding": self.binding, "sampler_binding": self.binding + 1,
+             "dimension": self.dim, "color_space": "srgb" if self.srgb else "linear"}
+        if self.light is not None:
+            d["light"] = self.light
+        return d
+
+
+def assign_bindings(textures: list[Texture], first: dict[str, int]) -> None:
+    """Two bindings per texture (image, sampler), numbered per group from `first`."""
+    nxt = dict(first)
+    for t in textures:
+        t.set = 0 if t.group == "light" else 1
+        t.binding = nxt[t.group]
+        nxt[t.group] += 2
+
+
+@dataclass(frozen=True)
+class Location:
+    """A vertex input, an interpolant or an output: location, name, type, and the vertex format."""
+
+    location: int
+    name: str
+    ty: str
+    format: str = ""
+
+    def as_dict(self) -> dict:
+        d = {"location": self.location, "name": self.name, "type": self.ty}
+        if self.format:
+            d["format"] = self.format
+        return d
+
+
+# The mesh attributes and interpolants of the fragment shaders (templates/*/vertex and fragment).
+VERTEX_INPUTS = {"P": Location(0, "a_position", "vec3", "R32G32B32_SFLOAT"),
+                 "N": Location(1, "a_normal", "vec3", "R32G32B32_SFLOAT"),
+                 "T": Location(2, "a_tangent", "vec4", "R32G32B32A32_SFLOAT"),
+                 "uv": Location(3, "a_uv", "vec2", "R32G32_SFLOAT")}
+INTERPOLANTS = {"P": Location(0, "v_position", "vec3"), "N": Location(1, "v_normal", "vec3"),
+                "T": Location(2, "v_tangent", "vec4"), "uv": Location(3, "v_uv", "vec2")}
+
+
+@dataclass
+class Interface:
+    """What one linked program reads, and where every value lives."""
+
+    stage_entries: dict[str, str]  # stage -> entry point name
+    shading_inputs: list[str]  # rows of the inputs table the BRDF reads (frame rows included)
+    surface: list[str]  # P, N, then T, B, uv where read
+    blocks: list[Block]
+    textures: list[Texture]
+    outputs: list[Location]
+    params: dict[str, dict[str, ParamSpec]] = field(default_factory=dict)  # group -> name -> spec
+
+    @property
+    def tangent(self) -> bool:
+        return "T" in self.surface or "T" in self.shading_inputs
+
+    @property
+    def vertex_inputs(self) -> list[Location]:
+        return [VERTEX_INPUTS[k] for k in ("P", "N", "T", "uv") if k in self.surface or (k == "T" and self.tangent)]
+
+    @property
+    def interpolants(self) -> list[Location]:
+        return [INTERPOLANTS[k] for k in ("P", "N", "T", "uv") if k in self.surface or (k == "T" and self.tangent)]
+
+    def block(self, name: str) -> Block | None:
+        for b in self.blocks:
+            if b.name == name:
+                return b
+        return None
+
+    def as_dict(self) -> dict:
+        """The reflection written to manifest.json (per stage: what the engine binds)."""
+        frag = {"entry_point": self.stage_entries.get("frag", "main"),
+                "uniform_blocks": [b.as_dict() for b in self.blocks if b.kind == "uniform"],
+                "storage_blocks": [b.as_dict() for b in self.blocks if b.kind == "storage"],
+                "textures": [t.as_dict() for t in self.textures],
+                "inputs": [x.as_dict() for x in self.interpolants],
+                "outputs": [x.as_dict() for x in self.outputs]}
+        out = {"shading_inputs": self.shading_inputs, "frag": frag}
+        if "vert" in self.stage_entries:
+            out["vert"] = {"entry_point": self.stage_entries["vert"],
+                           "uniform_blocks": [self.block("Frame").as_dict()],
+                           "inputs": [x.as_dict() for x in self.vertex_inputs],
+                           "outputs": [x.as_dict() for x in self.interpolants]}
+        return out
