@@ -1,4 +1,4 @@
-"""Atomic, change-only file writes (the start of the content-addressed store).
+"""Atomic, change-only file writes (the start of the content-addressed store), and progress policy.
 
 Every artifact is written to a temporary name in its directory and renamed, so
 an interrupted or failed build never leaves a half-written file and never
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import sys
 import tempfile
 from pathlib import Path
 
@@ -39,3 +40,8 @@ def atomic_write(path: Path, data: bytes) -> bool:
             pass
         raise
     return True
+
+
+def show_progress() -> bool:
+    """Progress bars on a terminal, quiet in CI and in pipes."""
+    return sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")

@@ -8,20 +8,17 @@ fails (brick error, compiler error) is reported and the others still build.
 from __future__ import annotations
 
 import json
-import os
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
 from ..library.bricks import Library
 from ..io import atomic_write, sha256
-from ..compose import Composed, compose_permutation
 from ..analysis import entry_cost
-from ..lang import SourceError
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
-from ..toolchain import CompileJob, CompileResult, compile_many, tool_versions
+from ..toolchain import tool_versions
+from ..toolchain.scenes import compile_scene, job_key
 
 
 @dataclass
@@ -34,35 +31,6 @@ class BuildResult:
     @property
     def ok(self) -> bool:
         return not self.failures
-
-
-def show_progress() -> bool:
-    """Progress bars on a terminal, quiet in CI and in pipes."""
-    return sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")
-
-
-def job_key(h: str, stage: str, lang: str) -> str:
-    return f"{h}.{stage}.{lang}"
-
-
-def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES
-                  ) -> tuple[dict[str, Composed], dict[str, list[str]], dict[str, CompileResult]]:
-    """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key)."""
-    composed: dict[str, Composed] = {}
-    errors: dict[str, list[str]] = {}
-    jobs: list[CompileJob] = []
-    for h, perm in sorted(scene.permutations.items()):
-        try:
-            c = compose_permutation(perm, lib, languages)
-        except SourceError as e:
-            errors[h] = [str(e)]
-            continue
-        composed[h] = c
-        for src in c.sources:
-            jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
-                                   line_map=tuple(src.line_map)))
-    results = compile_many(jobs, optimize=True, validate=True, progress=show_progress())
-    return composed, errors, results
 
 
 def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> BuildResult:

@@ -15,7 +15,7 @@ from ..lang.errors import read_text
 from ..lang import ir
 from ..lang.types import BUILTIN_TYPES, Type
 from .inputs import SHADING, SURFACE
-from .kinds import BRDF_KINDS, KINDS, Kind
+from .kinds import KINDS
 
 REPO = Path(__file__).resolve().parents[2]
 BUILTIN_BRICKS = REPO / "bricks"

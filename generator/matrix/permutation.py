@@ -13,7 +13,8 @@ import hashlib
 import re
 from dataclasses import dataclass
 
-from ..library.bricks import BRDF_KINDS, Brick, Library
+from ..library.bricks import Brick, Library
+from ..library.kinds import BRDF_KINDS
 from ..lang import SourceError
 from ..lang.errors import UserError
 

@@ -34,8 +34,10 @@ import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from ..library.bricks import BRDF_KINDS, KINDS, Brick, Library, load_brick, load_library
-from ..build import compile_scene, job_key, show_progress
+from ..library.bricks import Brick, Library, load_brick, load_library
+from ..library.kinds import BRDF_KINDS, KINDS
+from ..io import show_progress
+from ..toolchain.scenes import compile_scene, job_key
 from ..compose import Composed, compose_eval, compose_permutation
 from ..analysis import Cost, entry_cost
 from ..lang import SourceError
