@@ -217,6 +217,7 @@ def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, to
     assert after["manifest.json"] == before["manifest.json"], "the manifest is written last"
 
 
+@pytest.mark.toolchain
 def test_output_path_that_is_a_file_is_a_clear_error(tmp_path):
     blocker = tmp_path / "out"
     blocker.write_text("not a directory")
@@ -245,6 +246,7 @@ def test_cli_start_loads_neither_vulkan_nor_numpy():
 @pytest.mark.parametrize("command", [["build", str(EXAMPLE), "--out", "{tmp}"],
                                      ["eval", "lambert", "--input", "{tmp}/s.npy", "--output", "{tmp}/f.npy",
                                       "--target", "glsl"]], ids=["build", "eval"])
+@pytest.mark.lavapipe  # the eval case opens the device before it looks for a compiler
 def test_missing_tool_is_one_line_error(tmp_path, monkeypatch, capsys, command):
     import numpy as np
 

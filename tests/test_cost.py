@@ -52,6 +52,7 @@ def block_liveness(data: bytes):
 
 # ------------------------------------------------------------------ SPIR-V fixtures
 
+@pytest.mark.toolchain
 def test_counts_fixture_classes_and_scalar_rules(tmp_path):
     from generator.analysis import entry_cost
     c = entry_cost(assemble("counts", tmp_path))
@@ -69,6 +70,7 @@ def test_counts_fixture_classes_and_scalar_rules(tmp_path):
     assert c.calls == 0
 
 
+@pytest.mark.toolchain
 def test_branch_liveness_carries_a_value_through_both_arms(tmp_path):
     live, peak = block_liveness(assemble("branch", tmp_path))
     assert live == {
@@ -80,6 +82,7 @@ def test_branch_liveness_carries_a_value_through_both_arms(tmp_path):
     assert peak == 6
 
 
+@pytest.mark.toolchain
 def test_loop_liveness_reaches_a_fixpoint(tmp_path):
     live, peak = block_liveness(assemble("loop", tmp_path))
     assert live == {
@@ -92,6 +95,7 @@ def test_loop_liveness_reaches_a_fixpoint(tmp_path):
     assert peak == 9  # i 1 + n 1 + acc 2 + k 4 + cond 1 at the loop test
 
 
+@pytest.mark.toolchain
 def test_calls_count_the_callee_per_call_site(tmp_path):
     from generator.analysis import entry_cost
     c = entry_cost(assemble("call", tmp_path))
@@ -99,6 +103,7 @@ def test_calls_count_the_callee_per_call_site(tmp_path):
     assert c.registers == 3  # y and the first result live across the second call, plus its peak
 
 
+@pytest.mark.toolchain
 def test_big_endian_module_reads_the_same(tmp_path):
     from generator.analysis import entry_cost
     data = assemble("counts", tmp_path)
@@ -106,6 +111,7 @@ def test_big_endian_module_reads_the_same(tmp_path):
     assert entry_cost(struct.pack(f">{len(words)}I", *words)) == entry_cost(data)
 
 
+@pytest.mark.toolchain
 def test_malformed_modules_are_errors(tmp_path):
     from generator.analysis import SpirvError, entry_cost
     data = assemble("branch", tmp_path)
@@ -135,6 +141,7 @@ def _dis_ops(spirv_dis: str, data: bytes, tmp_path: Path) -> list[tuple[str, str
     return out
 
 
+@pytest.mark.toolchain
 def test_opcode_table_agrees_with_spirv_dis(tmp_path):
     """Every instruction of the fixtures and of real compiled shaders decodes to spirv-dis's name."""
     for t in COMPILERS:

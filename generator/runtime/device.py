@@ -113,6 +113,8 @@ class Device:
     """Instance + lavapipe logical device + one queue and command pool; collects validation messages."""
 
     def __init__(self, validation: bool = False, prefer: str = "llvmpipe"):
+        if os.environ.get("SHADERMATRIX_FORBID_DEVICE"):  # the test tiers: only lavapipe tests open a device
+            raise RuntimeError(f"a Vulkan device opened where none may ({os.environ['SHADERMATRIX_FORBID_DEVICE']})")
         vk = self.vk = _vk()
         self.validation = validation
         self.messages: list[ValidationMessage] = []

@@ -133,6 +133,8 @@ class ToolMissing(UserError):
 
 def find_tool(name: str) -> str | None:
     """Path of an executable: ``<repo>/.tools/bin`` first, then ``PATH``."""
+    if os.environ.get("SHADERMATRIX_FORBID_TOOLS"):  # the test tiers: a unit test runs no external tool
+        raise RuntimeError(f"external tool '{name}' used where none may run ({os.environ['SHADERMATRIX_FORBID_TOOLS']})")
     local = TOOLS_BIN / name
     if local.is_file() and os.access(local, os.X_OK):
         return str(local)
