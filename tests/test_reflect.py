@@ -466,3 +466,49 @@ def test_not_spirv_is_an_error():
         reflect(b"\x00" * 24)
     with pytest.raises(SpirvError):
         reflect(b"abc")
+
+
+DEPTH_GLSL = """#version 450
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(set = 0, binding = 0) uniform texture2D shadow;
+layout(set = 0, binding = 1) uniform samplerShadow cmp;
+layout(set = 0, binding = 2, rgba8) uniform writeonly image2D img;
+void main() {
+    vec2 uv = vec2(gl_GlobalInvocationID.xy) / 64.0;
+    imageStore(img, ivec2(gl_GlobalInvocationID.xy), vec4(textureLod(sampler2DShadow(shadow, cmp), vec3(uv, 0.5), 0.0)));
+}
+"""
+DEPTH_HLSL = """Texture2D shadow : register(t0, space0);
+SamplerComparisonState cmp : register(s1, space0);
+{fmt}RWTexture2D<float4> img : register(u2, space0);
+[numthreads(8, 8, 1)]
+void main(uint3 id : SV_DispatchThreadID) {{
+    img[id.xy] = (float4)shadow.SampleCmpLevelZero(cmp, float2(id.xy) / 64.0, 0.5);
+}}
+"""
+DEPTH_WGSL = """@group(0) @binding(0) var shadow: texture_depth_2d;
+@group(0) @binding(1) var cmp: sampler_comparison;
+@group(0) @binding(2) var img: texture_storage_2d<rgba8unorm, write>;
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let d = textureSampleCompareLevel(shadow, cmp, vec2<f32>(id.xy) / 64.0, 0.5);
+    textureStore(img, id.xy, vec4<f32>(d));
+}
+"""
+
+
+@pytest.mark.toolchain
+def test_depth_images_and_storage_image_formats_across_languages(tools):
+    """The docstring's "equal only when the sources say the same thing": depth and format."""
+    srcs = {"glsl": DEPTH_GLSL, "wgsl": DEPTH_WGSL, "hlsl": DEPTH_HLSL.format(fmt=""),
+            "hlsl+format": DEPTH_HLSL.format(fmt="[[spv::format_rgba8]] ")}  # glslang's spelling (not DXC's)
+    res = {k: by_binding(reflect(compile_one(src, k.split("+")[0], "comp")[0]).entry().resources)
+           for k, src in srcs.items()}
+    for k, r in res.items():
+        assert (r[0, 0].kind, r[0, 0].dim, r[0, 0].depth) == ("sampled_image", "2d", True), k
+        assert r[0, 1].kind == "sampler", k  # a comparison sampler is a plain OpTypeSampler
+        assert r[0, 2].kind == "storage_image", k
+    assert {k: r[0, 2].format for k, r in res.items()} == \
+        {"glsl": "rgba8", "wgsl": "rgba8", "hlsl": "rgba32f", "hlsl+format": "rgba8"}
+    assert {k: r[0, 2].writeonly for k, r in res.items()} == \
+        {"glsl": True, "wgsl": True, "hlsl": False, "hlsl+format": False}

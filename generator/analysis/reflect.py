@@ -66,8 +66,8 @@ the example scene's shaders (see tests/test_reflect.py):
 - Equal only when the sources say the same thing, so ``comparable()`` keeps them
   (a difference is a template bug): ``readonly`` (GLSL ``readonly``, HLSL
   ``StructuredBuffer``, WGSL ``read``), a storage image's ``format`` (an HLSL
-  ``RWTexture2D<float4>`` gets ``rgba32f`` from its element type unless
-  ``[[vk::image_format]]`` says otherwise), ``depth`` (WGSL ``texture_depth_2d``,
+  ``RWTexture2D<float4>`` gets ``rgba32f`` from its element type unless glslang's
+  ``[[spv::format_rgba8]]`` says otherwise; it ignores DXC's ``[[vk::image_format]]``), ``depth`` (WGSL ``texture_depth_2d``,
   an HLSL texture used with ``SampleCmp`` and a GLSL ``texture2D`` used with a
   ``samplerShadow`` are depth images; the same textures sampled plainly are not).
 - Built-in blocks: GLSL writes gl_Position through the gl_PerVertex block (only
