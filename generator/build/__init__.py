@@ -19,6 +19,7 @@ from ..matrix.scene import Scene
 from ..targets import LANGUAGES
 from ..toolchain import tool_versions
 from ..toolchain.scenes import compile_scene, job_key
+from .reflection import scene_tables, uploads
 
 
 @dataclass
@@ -46,6 +47,8 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> B
         c = composed.get(h)
         if c is not None:
             entry["bricks"] = dict(sorted(c.bricks.items()))
+            entry["interface"] = c.interface.as_dict()
+            entry["uploads"] = uploads(scene, h, c)
             for src in c.sources:
                 r = results[job_key(h, src.stage, src.language)]
                 data = src.text.encode()
@@ -75,6 +78,7 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> B
         "tools": tool_versions(),
         "languages": list(languages),
         "permutations": entries,
+        **scene_tables(scene, composed),
     }
     text = json.dumps(res.manifest, indent=2, sort_keys=False) + "\n"
     _count(res, atomic_write(out / "manifest.json", text.encode()))

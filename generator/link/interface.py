@@ -43,6 +43,8 @@ class Slot:
 
     def as_dict(self) -> dict:
         d = {"name": self.param, "type": str(self.ty), "offset": self.offset, "size": self.ty.components * 4}
+        if self.light is not None:
+            d["light"] = self.light
         if self.spec is not None:
             d["default"] = self.spec.default
             d["range"] = list(self.spec.range) if self.spec.range else None

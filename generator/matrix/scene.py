@@ -194,7 +194,8 @@ def load_scene(path, lib: Library) -> Scene:
         perm = Permutation(m.brdf, keys, m.packing, output, precision)
         scene.permutations.setdefault(perm.hash, perm)
         scene.users.setdefault(perm.hash, []).append(oname)
-        scene.objects.append({"name": oname, "material": mat, "lights": names, "permutation": perm.hash})
+        scene.objects.append({"name": oname, "material": mat, "light_set": lset, "lights": names,
+                              "permutation": perm.hash})
     return scene
 
 
