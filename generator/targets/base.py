@@ -40,5 +40,7 @@ class Target(ABC):
         """The spelling of a brick-language type (struct names pass through ident())."""
 
     @abstractmethod
-    def emit(self, structs: list[Type], functions: list[ir.Function]) -> Emitted:
-        """Struct declarations then functions, callees before callers (the caller orders them)."""
+    def emit(self, structs: list[Type], functions: list[ir.Function], globals: list[ir.Global] = ()) -> Emitted:
+        """Struct declarations, then global resources (buffers, textures; C-like targets
+        declare them, the NumPy target receives them at load()), then functions, callees
+        before callers (the caller orders them)."""

@@ -3,6 +3,7 @@
 A subclass supplies tables (type spellings, intrinsic spellings, literal
 suffixes) and overrides the few hooks where a language's structure differs
 (declarations, signatures, matrix products in HLSL, `select` in WGSL).
+Buffers, global declarations and arrays are in clike_resources.py (a mixin).
 Every binary and unary expression is parenthesized, so no precedence table
 is needed and every target reads the same.
 """
@@ -11,10 +12,12 @@ from __future__ import annotations
 import math
 
 from ..lang import ir
+from ..lang.control import always_returns
 from ..lang.intrinsics import CONSTANTS
 from ..lang.types import Type
 from . import reserved
-from .base import Emitted, Target
+from .base import Emitted
+from .clike_resources import ResourceMixin
 
 INDENT = "    "
 
@@ -62,7 +65,7 @@ def float_literal(v: float) -> str:
     return s
 
 
-class CLikeTarget(Target):
+class CLikeTarget(ResourceMixin):
     """GLSL, HLSL and WGSL: one walk over the IR, spelled by the tables below."""
 
     reserved = reserved.ALL
@@ -73,6 +76,7 @@ class CLikeTarget(Target):
     VECTORS: dict[str, str] = {}    # brick scalar -> format with {n}
     MATRIX = ""                     # format with {n}
     TEXTURE = ""                    # texture2d parameter type
+    TEXTURE_CUBE = ""               # texturecube parameter type
     SAMPLER = ""                    # separate sampler parameter type ("" = combined)
     FLOAT_SUFFIX = ""
     INT_SUFFIX = ""
@@ -80,7 +84,8 @@ class CLikeTarget(Target):
     BINARY_OPS = {"and": "&&", "or": "||"}
     SIGNED_MOD_BY_DIVISION = True   # write signed int % as a - b*(a/b) (see expr_binary)
     UNARY_OPS = {"-": "-", "not": "!"}
-    # intrinsic -> format over {0}, {1}, ... (texture args also give {smp}); missing = same name
+    # intrinsic -> format over {0}, {1}, ... (texture args also give {smp}); missing = same name;
+    # "name@cube" overrides "name" when the first argument is a cube texture
     INTRINSICS: dict[str, str] = {}
 
     # ------------------------------------------------------------ public interface
@@ -104,8 +109,8 @@ class CLikeTarget(Target):
             return ""
         return f'#line {int(line)} "{directive_path(path)}"'
 
-    def declare_texture(self, name: str, set: int, binding: int) -> str:
-        """A global texture2d resource NAME (and its sampler) at bindings B and B+1 of set S."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
+        """A global texture resource NAME ("2d" or "cube") and its sampler at bindings B and B+1 of set S."""
         raise NotImplementedError
 
     def type_name(self, t: Type) -> str:
@@ -116,15 +121,22 @@ class CLikeTarget(Target):
         if t.kind == "matrix":
             return self.MATRIX.format(n=t.size)
         if t.kind == "texture":
-            return self.TEXTURE
+            return self.TEXTURE_CUBE if t.dim == "cube" else self.TEXTURE
         if t.kind == "struct":
             return self.ident(t.name)
+        if t.kind == "array":
+            return self.array_type(t)
         raise AssertionError(f"no {self.name} spelling for type {t}")
 
-    def emit(self, structs: list[Type], functions: list[ir.Function]) -> Emitted:
+    def emit(self, structs: list[Type], functions: list[ir.Function], globals: list[ir.Global] = ()) -> Emitted:
+        """Structs, then the declarations of `globals` (buffers, textures), then functions."""
         w = Writer(self.line_directives)
         for s in structs:
             self.struct_decl(w, s)
+            w.line("")
+        for g in globals:
+            for text in self.declare_global(g).splitlines():
+                w.line(text)
             w.line("")
         for f in functions:
             self.function(w, f)
@@ -141,7 +153,7 @@ class CLikeTarget(Target):
         w.line("};")
 
     def field_decl(self, name: str, t: Type) -> str:
-        return f"{self.type_name(t)} {self.ident(name)};"
+        return f"{self.var_decl(self.ident(name), t)};"
 
     def params(self, p: ir.Param) -> list[str]:
         """Parameter declarations for one brick parameter (a texture brings its sampler)."""
@@ -151,7 +163,9 @@ class CLikeTarget(Target):
         return out
 
     def var_decl(self, name: str, t: Type | None) -> str:
-        """`T name` (None = the sampler type)."""
+        """`T name` (None = the sampler type); `T name[N]` for arrays."""
+        if t is not None and t.kind == "array":
+            return f"{self.type_name(t.elem)} {name}[{t.size}]"
         return f"{self.type_name(t) if t is not None else self.SAMPLER} {name}"
 
     def param_list(self, f: ir.Function) -> list[str]:
@@ -183,8 +197,13 @@ class CLikeTarget(Target):
             self.assign(w, s)
         elif isinstance(s, ir.If):
             self.if_stmt(w, s, "")
+        elif isinstance(s, ir.Switch):
+            self.switch(w, s)
         elif isinstance(s, ir.For):
-            w.line(self.for_head(self.ident(s.var), s.count), s.loc)
+            if s.bound is not None:
+                w.line(self.for_bound_head(self.ident(s.var), s.var_type, self.expr(s.bound)), s.loc)
+            else:
+                w.line(self.for_head(self.ident(s.var), s.count), s.loc)
             w.depth += 1
             self.block(w, s.body)
             w.depth -= 1
@@ -202,6 +221,48 @@ class CLikeTarget(Target):
 
     def for_head(self, var: str, count: int) -> str:
         return f"for (int {var} = 0; {var} < {self.int_literal(count)}; {var}++) {{"
+
+    def for_bound_head(self, var: str, t: Type, bound: str) -> str:
+        """A loop head for a runtime int/uint bound (the loop variable has the bound's type)."""
+        zero = self.literal(t, 0)
+        return f"for ({self.type_name(t)} {var} = {zero}; {var} < {bound}; {var}++) {{"
+
+    def switch(self, w: Writer, s: ir.Switch) -> None:
+        """switch (x) { case 1: case 2: { ...; break; } default: { ... } } — no fallthrough."""
+        w.line(self.switch_head(self.expr(s.selector)), s.loc)
+        w.depth += 1
+        arms = [(tuple(values), body) for values, body in s.cases]
+        if s.default or self.DEFAULT_REQUIRED:
+            arms.append((None, s.default))
+        for values, body in arms:
+            for label in self.case_labels(s.selector.ty, values):
+                w.line(label)
+            w.depth += 1
+            self.block(w, body)
+            if self.CASE_BREAK and not always_returns(body):
+                w.line("break;")
+            w.depth -= 1
+            w.line("}")
+        w.depth -= 1
+        w.line("}")
+
+    DEFAULT_REQUIRED = False  # WGSL: every switch has a default clause
+    CASE_BREAK = True         # GLSL/HLSL: a case body ends with break; (WGSL never falls through)
+
+    def switch_head(self, selector: str) -> str:
+        return f"switch {wrap(selector)} {{"
+
+    def case_label_value(self, t: Type, v: int) -> str:
+        """A case value without parentheses (a negative int reads -3, not (-3))."""
+        return f"{int(v)}{self.UINT_SUFFIX}" if t.scalar == "uint" else self.int_literal(int(v))
+
+    def case_labels(self, t: Type, values: tuple[int, ...] | None) -> list[str]:
+        """The lines opening one arm: `case 1:` per value, the last opening the body's brace."""
+        if values is None:
+            return ["default: {"]
+        labels = [f"case {self.case_label_value(t, v)}:" for v in values]
+        labels[-1] += " {"
+        return labels
 
     def if_head(self, cond: str) -> str:
         return f"if {wrap(cond)} {{"
@@ -284,7 +345,12 @@ class CLikeTarget(Target):
         return f"{self.ident(e.func)}({', '.join(self.args(e.args))})"
 
     def expr_intrinsic(self, e: ir.Intrinsic) -> str:
-        fmt = self.INTRINSICS.get(e.name)
+        if e.name == "buffer_length":
+            return self.buffer_length(e.args[0])
+        fmt = None
+        if e.args and e.args[0].ty.dim == "cube":
+            fmt = self.INTRINSICS.get(e.name + "@cube")
+        fmt = fmt or self.INTRINSICS.get(e.name)
         if fmt is None:
             return f"{e.name}({', '.join(self.expr(a) for a in e.args)})"
         args = [self.expr(a) for a in e.args]
@@ -300,6 +366,8 @@ class CLikeTarget(Target):
             return self.matrix(t, args)
         if t.kind == "struct":
             return self.struct_value(t, args)
+        if t.kind == "array":
+            return self.array_value(t, args)
         return f"{self.type_name(t)}({', '.join(args)})"
 
     def splat(self, t: Type, x: str) -> str:
@@ -318,6 +386,8 @@ class CLikeTarget(Target):
         return f"{self.expr(e.base)}.{self.ident(e.field)}"
 
     def expr_index(self, e: ir.Index) -> str:
+        if e.base.ty.kind == "buffer":
+            return self.buffer_element(e.base, self.expr(e.index))
         return f"{self.expr(e.base)}[{self.expr(e.index)}]"
 
     def expr_select(self, e: ir.Select) -> str:

@@ -1,8 +1,9 @@
 """GLSL 4.50 for Vulkan (glslang): column-major matrices as in the IR; separate images and samplers.
 
-Textures are a `texture2D` and a `sampler` (Vulkan GLSL), joined at the call as
-`sampler2D(t, s)`, so the descriptor layout is the same as HLSL's and WGSL's:
-image at binding B, sampler at B+1.
+Textures are a `texture2D` (or `textureCube`) and a `sampler` (Vulkan GLSL), joined
+at the call as `sampler2D(t, s)` (`samplerCube(t, s)`), so the descriptor layout is the
+same as HLSL's and WGSL's: image at binding B, sampler at B+1. Buffers are interface
+blocks with one member `data` (clike_resources.py).
 """
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ class GlslTarget(CLikeTarget):
     VECTORS = {"float": "vec{n}", "int": "ivec{n}", "uint": "uvec{n}", "bool": "bvec{n}"}
     MATRIX = "mat{n}"
     TEXTURE = "texture2D"
+    TEXTURE_CUBE = "textureCube"
     SAMPLER = "sampler"
     INTRINSICS = {
         "rsqrt": "inversesqrt({0})",
@@ -26,17 +28,33 @@ class GlslTarget(CLikeTarget):
         "atan2": "atan({0}, {1})",
         "sample": "texture(sampler2D({0}, {smp}), {1})",
         "sample_level": "textureLod(sampler2D({0}, {smp}), {1}, {2})",
+        "sample@cube": "texture(samplerCube({0}, {smp}), {1})",
+        "sample_level@cube": "textureLod(samplerCube({0}, {smp}), {1}, {2})",
     }
 
     def header(self) -> str:
         """`#line N "path"` with a file name needs this extension in glslang."""
         return "#extension GL_GOOGLE_cpp_style_line_directive : require"
 
-    def declare_texture(self, name: str, set: int, binding: int) -> str:
-        """texture2D NAME at binding B and sampler NAME_smp at B+1 of set S (as HLSL and WGSL)."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
+        """texture2D (textureCube) NAME at binding B and sampler _smp_NAME at B+1 of set S (as HLSL and WGSL)."""
         s, b = int(set), int(binding)
-        return (f"layout(set = {s}, binding = {b}) uniform texture2D {self.ident(name)};\n"
+        image = {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
+        return (f"layout(set = {s}, binding = {b}) uniform {image} {self.ident(name)};\n"
                 f"layout(set = {s}, binding = {b + 1}) uniform sampler {self.sampler_name(name)};")
+
+    def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
+        if kind == "storage":
+            return (f"layout(set = {set}, binding = {binding}, std430) readonly buffer {self.block_name(name)} "
+                    f"{{ {elem} data[]; }} {name};")
+        return (f"layout(set = {set}, binding = {binding}, std140) uniform {self.block_name(name)} "
+                f"{{ {elem} data[{capacity}]; }} {name};")
+
+    def buffer_element(self, buf: ir.Var, index: str) -> str:
+        return f"{self.ident(buf.name)}.data[{index}]"
+
+    def storage_length(self, name: str) -> str:
+        return f"uint({name}.data.length())"
 
     def expr_select(self, e: ir.Select) -> str:
         return self.typed_select(e.ty, self.expr(e.cond), self.expr(e.if_true), self.expr(e.if_false))

@@ -4,12 +4,15 @@ IR matrices are column-major like GLSL and their HLSL values are the same
 mathematical matrices: a column list becomes transpose(floatNxN(rows...)),
 products become mul(), and column i of m is read as transpose(m)[i] (written
 component by component, m[r][i]). Structs get a `_make_S(...)` constructor
-function, since HLSL has no struct constructor expression.
+function, since HLSL has no struct constructor expression; an array value is an
+initializer list `{a, b, c}`, valid only where the IR puts it (a declaration).
+Buffers: StructuredBuffer (t register) and cbuffer (b register), clike_resources.py.
 """
 from __future__ import annotations
 
 from ..lang import ir
 from ..lang.types import Type
+from . import reserved
 from .clike import CLikeTarget, Writer
 
 _COMPONENT = {"x": 0, "y": 1, "z": 2, "w": 3}
@@ -23,6 +26,7 @@ class HlslTarget(CLikeTarget):
     VECTORS = {"float": "float{n}", "int": "int{n}", "uint": "uint{n}", "bool": "bool{n}"}
     MATRIX = "float{n}x{n}"
     TEXTURE = "Texture2D"
+    TEXTURE_CUBE = "TextureCube"
     SAMPLER = "SamplerState"
     INTRINSICS = {
         "fract": "frac({0})",
@@ -32,12 +36,28 @@ class HlslTarget(CLikeTarget):
         "sample_level": "{0}.SampleLevel({smp}, {1}, {2})",
     }
 
-    def declare_texture(self, name: str, set: int, binding: int) -> str:
-        """Texture2D NAME at binding B and SamplerState NAME_smp at B+1 of set S (t/s registers alike)."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
+        """Texture2D (TextureCube) NAME at binding B and SamplerState _smp_NAME at B+1 of set S (t/s registers alike)."""
         s, b = int(set), int(binding)
-        return (f"[[vk::binding({b}, {s})]] Texture2D {self.ident(name)} : register(t{b}, space{s});\n"
+        image = {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
+        return (f"[[vk::binding({b}, {s})]] {image} {self.ident(name)} : register(t{b}, space{s});\n"
                 f"[[vk::binding({b + 1}, {s})]] SamplerState {self.sampler_name(name)} : "
                 f"register(s{b + 1}, space{s});")
+
+    def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
+        head = f"[[vk::binding({binding}, {set})]]"
+        if kind == "storage":
+            length = reserved.LENGTH_PREFIX + name
+            return (f"{head} StructuredBuffer<{elem}> {name} : register(t{binding}, space{set});\n"
+                    f"uint {length}() {{ uint n, stride; {name}.GetDimensions(n, stride); return n; }}")
+        return (f"{head} cbuffer {self.block_name(name)} : register(b{binding}, space{set}) "
+                f"{{ {elem} {name}[{capacity}]; }};")
+
+    def storage_length(self, name: str) -> str:
+        return f"{reserved.LENGTH_PREFIX}{name}()"
+
+    def array_value(self, t: Type, elems: list[str]) -> str:
+        return f"{{{', '.join(elems)}}}"
 
     # ------------------------------------------------------------ structs
     def struct_decl(self, w: Writer, s: Type) -> None:

@@ -7,9 +7,16 @@ created as F(...), the working dtype, so float16 runs compute in float16.
 
 Control flow is vectorized: both branches of an `if` run under masks, assignments to variables
 declared outside the branch become `x = _sel(mask, new, x, rank)`, and a `return` inside a branch
-records its value for the masked lanes (`_ret`, `_done`). The generated code never mutates an
-array in place (component assignment builds a new array), so parameters keep copy semantics.
-The helpers the emitted code calls (_sel, _setc, _dot, ...) live in numpy_runtime.py.
+records its value for the masked lanes (`_ret`, `_done`). Switches and loops with a runtime bound
+run the same way (numpy_control.py). The generated code never mutates an array in place
+(component assignment builds a new array), so parameters keep copy semantics.
+The helpers the emitted code calls (_sel, _setc, _dot, ...) live in numpy_runtime.py; those for
+arrays, buffers and textures, and the representation of those values, in numpy_resources.py.
+
+Textures are passed as arguments (arrays of texel values, sampled bilinearly with clamp to
+edge at mip level 0); global resources (buffers, and textures a program reads as globals)
+are given to load(..., resources={name: value}); unpack_buffer() turns a GPU buffer's bytes
+into a buffer value.
 """
 from __future__ import annotations
 
@@ -21,7 +28,9 @@ from ..lang import ir
 from ..lang.intrinsics import CONSTANTS
 from ..lang.types import Type
 from .base import Emitted, Target
-from .numpy_runtime import RUNTIME, _coerce
+from .numpy_control import ControlEmitter, returns_under_mask
+from .numpy_resources import RESOURCE_RUNTIME, unpack_buffer, value_rank
+from .numpy_runtime import RUNTIME, _coerce, _struct
 
 _SIMPLE = {"abs": "np.abs", "sign": "np.sign", "floor": "np.floor", "sqrt": "np.sqrt", "exp": "np.exp",
            "exp2": "np.exp2", "log": "np.log", "log2": "np.log2", "sin": "np.sin", "cos": "np.cos",
@@ -32,17 +41,15 @@ _SIMPLE = {"abs": "np.abs", "sign": "np.sign", "floor": "np.floor", "sqrt": "np.
 _DTYPES = {"float": "F", "int": "np.int32", "uint": "np.uint32", "bool": "np.bool_"}
 
 
-def _rank(t: Type):
-    """The runtime shape descriptor of a type: 0, 1, 2 trailing dims, or ((field, desc), ...)."""
-    if t.kind == "struct":
-        return tuple((f, _rank(ft)) for f, ft in t.fields)
-    return {"vector": 1, "matrix": 2}.get(t.kind, 0)
+_rank = value_rank  # the runtime shape descriptor of a type: trailing dims, or ((field, desc), ...)
 
 
 def _spec(t: Type):
     """How a caller's argument of type t is converted on entry (see _coerce)."""
     if t.kind == "struct":
         return tuple((f, _spec(ft)) for f, ft in t.fields)
+    if t.kind in ("array", "buffer"):
+        return _spec(t.elem)
     return t.scalar if t.kind in ("scalar", "vector", "matrix") else None
 
 
@@ -59,18 +66,7 @@ def _float_lit(v: float) -> str:
     return f"F({float(v)!r})"
 
 
-def _returns_under_if(stmts, inside=False) -> bool:
-    for s in stmts:
-        if isinstance(s, ir.Return) and inside:
-            return True
-        if isinstance(s, ir.If) and (_returns_under_if(s.then, True) or _returns_under_if(s.orelse, True)):
-            return True
-        if isinstance(s, ir.For) and _returns_under_if(s.body, inside):
-            return True
-    return False
-
-
-class _FunctionEmitter:
+class _FunctionEmitter(ControlEmitter):
     def __init__(self, target: "NumpyTarget", fn: ir.Function):
         self.t, self.fn = target, fn
         self.lines: list[tuple[str, ir.Loc | None]] = []
@@ -79,7 +75,8 @@ class _FunctionEmitter:
         self.mask: str | None = None
         self.tmp = 0
         self.scopes: list[dict[str, int]] = [{p.name: 0 for p in fn.params}]
-        self.ret_state = _returns_under_if(fn.body)
+        self.ret_state = returns_under_mask(fn.body)
+        self.resources: dict[str, Type] = {}  # global resources read: name -> type
 
     def line(self, text: str, loc: ir.Loc | None) -> None:
         self.lines.append(("    " * self.depth + text, loc))
@@ -134,6 +131,10 @@ class _FunctionEmitter:
                 self.line(f"{name} = _sel({self.mask}, {new}, {name}, {_rank(root.ty)!r})", s.loc)
         elif isinstance(s, ir.If):
             self.if_stmt(s)
+        elif isinstance(s, ir.Switch):
+            self.switch_stmt(s)
+        elif isinstance(s, ir.For) and s.bound is not None:
+            self.runtime_for(s)
         elif isinstance(s, ir.For):
             self.line(f"for {self.t.ident(s.var)} in _range({int(s.count)}):", s.loc)
             self.depth += 1
@@ -181,6 +182,9 @@ class _FunctionEmitter:
             return self.store(target.base, f"_setc({self.expr(target.base)}, {'xyzw'.index(target.components)}, {value})")
         if isinstance(target, ir.Member):
             return self.store(target.base, f"_setf({self.expr(target.base)}, {target.field!r}, {value})")
+        if isinstance(target, ir.Index) and target.base.ty.kind == "array":
+            k = _rank(target.base.ty.elem)
+            return self.store(target.base, f"_aset({self.expr(target.base)}, {self.expr(target.index)}, {value}, {k!r})")
         if isinstance(target, ir.Index):
             fn = "_setcol" if target.base.ty.kind == "matrix" else "_setc"
             return self.store(target.base, f"{fn}({self.expr(target.base)}, {self.expr(target.index)}, {value})")
@@ -194,7 +198,8 @@ class _FunctionEmitter:
             if e.scope == "const":
                 return _float_lit(CONSTANTS[e.name])
             if e.scope == "global":
-                raise NotImplementedError(f"{e.loc}: the numpy target has no global resources ('{e.name}')")
+                self.resources[e.name] = e.ty
+                return f"_res({e.name!r})"
             return self.t.ident(e.name)
         if isinstance(e, ir.Unary):
             return f"(~{self.expr(e.operand)})" if e.op == "not" else f"(-{self.expr(e.operand)})"
@@ -211,6 +216,8 @@ class _FunctionEmitter:
             return f"{self.expr(e.base)}[..., {idx[0] if len(idx) == 1 else idx}]"
         if isinstance(e, ir.Member):
             return f"{self.expr(e.base)}.{e.field}"
+        if isinstance(e, ir.Index) and e.base.ty.kind in ("array", "buffer"):
+            return f"_aidx({self.expr(e.base)}, {self.expr(e.index)}, {_rank(e.base.ty.elem)!r})"
         if isinstance(e, ir.Index):
             base, matrix = self.expr(e.base), e.base.ty.kind == "matrix"
             if isinstance(e.index, ir.Const):
@@ -251,9 +258,11 @@ class _FunctionEmitter:
     def intrinsic(self, e: ir.Intrinsic) -> str:
         args = [self.expr(a) for a in e.args]
         n = e.name
-        if n in ("sample", "sample_level"):
-            raise NotImplementedError(f"{e.loc}: the numpy target does not sample textures "
-                                      f"({n} in function '{self.fn.name}')")
+        if n in ("sample", "sample_level"):  # level 0 only: the lod of sample_level is not read
+            return f"{'_texcube' if e.args[0].ty.dim == 'cube' else '_tex2d'}({args[0]}, {args[1]})"
+        if n == "buffer_length":
+            buf = e.args[0].ty
+            return f"np.uint32({buf.size})" if buf.space == "uniform" else f"_blen({args[0]})"
         if n in _SIMPLE:
             return f"{_SIMPLE[n]}({', '.join(args)})"
         if n == "fract":
@@ -274,6 +283,8 @@ class _FunctionEmitter:
         t, args = e.ty, [self.expr(a) for a in e.args]
         if t.kind == "struct":
             return f"_S_{t.name}({', '.join(args)})"
+        if t.kind == "array":
+            return f"_arr({_rank(t.elem)!r}, {', '.join(args)})"
         if t.kind == "scalar":
             return f"_cvt({args[0]}, {_DTYPES[t.scalar]})"
         if t.kind == "matrix":
@@ -297,35 +308,79 @@ class NumpyTarget(Target):
     def type_name(self, t: Type) -> str:
         return t.name
 
-    def emit(self, structs: list[Type], functions: list[ir.Function]) -> Emitted:
+    def emit(self, structs: list[Type], functions: list[ir.Function], globals: list[ir.Global] = ()) -> Emitted:
+        """Structs, functions, and a table of the global resources read (given to load())."""
         rows: list[tuple[str, ir.Loc | None]] = [
             ("# Generated by shadermatrix (numpy target). Run through NumpyTarget.load(): needs np, F (float dtype).", None)]
         for st in structs:
             fields = tuple(f for f, _ in st.fields)
             rows.append((f"_S_{st.name} = _STRUCTS[{st.name!r}] = _struct({st.name!r}, {fields!r})", None))
+        resources = {g.name: g.ty for g in globals}
         for fn in functions:
             rows.append(("", None))
-            rows.extend(_FunctionEmitter(self, fn).emit())
+            fe = _FunctionEmitter(self, fn)
+            rows.extend(fe.emit())
+            resources.update(fe.resources)
+        if resources:
+            rows.append(("", None))
+        for name, ty in resources.items():
+            rows.append((f"_RESOURCES[{name!r}] = ({ty.name!r}, {_spec(ty)!r})", None))
         text = "\n".join(r for r, _ in rows) + "\n"
         line_map = [(i + 1, loc.path, loc.line) for i, (_, loc) in enumerate(rows) if loc is not None]
         return Emitted(text, line_map)
 
-    def load(self, emitted: Emitted | str, dtype) -> dict:
+    def load(self, emitted: Emitted | str, dtype, resources: dict | None = None) -> dict:
         """Execute emitted code with np and F = dtype; returns {brick name: function or struct class}.
 
         A loaded function takes arrays (or anything np.asarray accepts: floats, lists), converts
         them to the brick's types (floats to `dtype`, ints to int32, ...) and runs under
-        np.errstate(all="ignore"), since masked-out lanes may divide by zero.
+        np.errstate(all="ignore"), since masked-out lanes may divide by zero. Texture arguments
+        are arrays of texel values (numpy_resources.py).
+
+        resources: the global resources the functions read, by name: a buffer is an object (or
+        dict) with the element struct's fields, each an array whose first axis is the element
+        index (unpack_buffer() makes one from GPU bytes); a texture is an array as for texture
+        arguments. They are converted like arguments, once, here.
         """
         text = emitted.text if isinstance(emitted, Emitted) else str(emitted)
         f = np.dtype(dtype).type
-        ns = {"__builtins__": {}, "np": np, "F": f, "_FUNCTIONS": {}, "_STRUCTS": {}}
+        ns = {"__builtins__": {}, "np": np, "F": f, "_FUNCTIONS": {}, "_STRUCTS": {}, "_RESOURCES": {}}
         ns.update(RUNTIME)
+        ns.update(RESOURCE_RUNTIME)
         exec(compile(text, "<shadermatrix numpy target>", "exec"), ns)
+        bound = {}
+        for name, value in (resources or {}).items():
+            ty, spec = ns["_RESOURCES"].get(name, ("", None))
+            bound[name] = _coerce(_as_struct(value), spec, f) if spec is not None else value
+        ns["_res"] = _reader(bound, ns["_RESOURCES"])
         out: dict = dict(ns["_STRUCTS"])
         for name, (fn, specs) in ns["_FUNCTIONS"].items():
             out[name] = _entry(fn, specs, f)
         return out
+
+
+    @staticmethod
+    def unpack_buffer(elem: Type, data):
+        """A buffer value of `elem` structs from the bytes of its GPU buffer (numpy_resources.py)."""
+        return unpack_buffer(elem, data, _struct)
+
+
+def _as_struct(value):
+    """Dicts (as buffers may be given) become attribute holders, recursively."""
+    if isinstance(value, dict):
+        return _struct("buffer", tuple(value))(*(_as_struct(v) for v in value.values()))
+    return value
+
+
+def _reader(bound: dict, declared: dict):
+    def _res(name):
+        try:
+            return bound[name]
+        except KeyError:
+            ty = declared.get(name, ("resource",))[0]
+            raise LookupError(f"the program reads global {ty} '{name}': pass it to "
+                              f"NumpyTarget.load(..., resources={{'{name}': ...}})") from None
+    return _res
 
 
 def _entry(fn, specs, f):

@@ -9,8 +9,14 @@ import copy
 
 import numpy as np
 
-def _range(n):
-    return (np.int32(i) for i in range(n))
+def _range(n, dtype=np.int32):
+    return (dtype(i) for i in range(n))
+
+
+def _bmax(b):
+    """The iteration count of a loop with per-lane bound b: its largest value (0 if none is positive)."""
+    b = np.asarray(b)
+    return max(int(b.max()), 0) if b.size else 0
 
 
 def _expand(x, k):

@@ -195,3 +195,7 @@ RESERVED_PREFIXES: tuple[str, ...] = ("gl_",)
 # cannot meet a brick's own name; the same holds for SAMPLER_PREFIX.
 PREFIX = "_r_"
 SAMPLER_PREFIX = "_smp_"
+# Generated names for buffers: the GLSL block / HLSL cbuffer of buffer NAME, and
+# HLSL's length helper of a storage buffer (see clike_resources.py).
+BLOCK_PREFIX = "_blk_"
+LENGTH_PREFIX = "_len_"

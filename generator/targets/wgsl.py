@@ -1,4 +1,9 @@
-"""WGSL as naga accepts it: typed literals, immutable parameters, select() for conditionals."""
+"""WGSL as naga accepts it: typed literals, immutable parameters, select() for conditionals.
+
+Switches always carry a default clause (WGSL requires one) and never fall through;
+arrays are array<T, N> values; buffers are var<storage, read> / var<uniform> arrays
+(clike_resources.py).
+"""
 from __future__ import annotations
 
 from ..lang import ir
@@ -17,7 +22,10 @@ class WgslTarget(CLikeTarget):
     VECTORS = {"float": "vec{n}<f32>", "int": "vec{n}<i32>", "uint": "vec{n}<u32>", "bool": "vec{n}<bool>"}
     MATRIX = "mat{n}x{n}<f32>"
     TEXTURE = "texture_2d<f32>"
+    TEXTURE_CUBE = "texture_cube<f32>"
     SAMPLER = "sampler"
+    DEFAULT_REQUIRED = True
+    CASE_BREAK = False
     # Typed literals keep constant folding in f32/i32, as GLSL and HLSL do (abstract numbers fold in f64).
     SIGNED_MOD_BY_DIVISION = False  # WGSL's % on i32 already truncates
     FLOAT_SUFFIX = "f"
@@ -29,14 +37,37 @@ class WgslTarget(CLikeTarget):
         "sample_level": "textureSampleLevel({0}, {smp}, {1}, {2})",
     }
 
-    def declare_texture(self, name: str, set: int, binding: int) -> str:
-        """texture_2d<f32> NAME at binding B and sampler NAME_smp at B+1 of group S."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
+        """texture_2d<f32> (texture_cube<f32>) NAME at binding B and sampler _smp_NAME at B+1 of group S."""
         s, b = int(set), int(binding)
-        return (f"@group({s}) @binding({b}) var {self.ident(name)}: texture_2d<f32>;\n"
+        image = {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
+        return (f"@group({s}) @binding({b}) var {self.ident(name)}: {image};\n"
                 f"@group({s}) @binding({b + 1}) var {self.sampler_name(name)}: sampler;")
+
+    def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
+        if kind == "storage":
+            return f"@group({set}) @binding({binding}) var<storage, read> {name}: array<{elem}>;"
+        return f"@group({set}) @binding({binding}) var<uniform> {name}: array<{elem}, {capacity}>;"
+
+    def storage_length(self, name: str) -> str:
+        return f"arrayLength(&{name})"
+
+    def array_type(self, t: Type) -> str:
+        return f"array<{self.type_name(t.elem)}, {t.size}>"
 
     def var_decl(self, name: str, t: Type | None) -> str:
         return f"{name}: {self.type_name(t) if t is not None else self.SAMPLER}"
+
+    def switch_head(self, selector: str) -> str:
+        return f"switch {selector} {{"
+
+    def case_labels(self, t: Type, values: tuple[int, ...] | None) -> list[str]:
+        if values is None:
+            return ["default: {"]
+        return [f"case {', '.join(self.case_label_value(t, v) for v in values)}: {{"]
+
+    def for_bound_head(self, var: str, t: Type, bound: str) -> str:
+        return f"for (var {var}: {self.type_name(t)} = {self.literal(t, 0)}; {var} < {bound}; {var}++) {{"
 
     def struct_decl(self, w: Writer, s: Type) -> None:
         w.line(f"struct {self.ident(s.name)} {{")
