@@ -118,9 +118,9 @@ class LinkedPermutation:
 def link_permutation(perm: Permutation, lib: Library) -> LinkedPermutation:
     """Link the bricks of a permutation and lay out what its fragment shader reads."""
     r = resolve(perm, lib)
-    problem = check_packing(r)
+    problem, todo = check_packing(r)
     if problem:
-        raise SourceError("<key>", 1, 1, problem, "use the constants packing for this BRDF")
+        raise SourceError("<key>", 1, 1, problem, todo)
     prog = Program()
     g = shade_glue(prog, r)
     assign_bindings(g.textures, {"light": 2, "material": 1})

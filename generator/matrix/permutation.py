@@ -209,14 +209,23 @@ def resolve(perm: Permutation, lib: Library) -> Resolved:
     return Resolved(brdf, packing[0], lights, out)
 
 
-def check_packing(r: Resolved) -> str:
-    """'' when the packing fits the BRDF, else why not (a provided input the BRDF does not read)."""
+def check_packing(r: Resolved) -> tuple[str, str]:
+    """('', '') when the packing fits the BRDF, else (what is wrong, what to do)."""
+    from ..library.inputs import BY_NAME, SHADING
     from ..library.params import spec_params
 
     params = spec_params(r.brdf)
+    brdf = "+".join(n.canonical() for n in r.brdf)
     for f in r.packing.brick.entries:
         name = f.name[len("get_"):]
         if name not in params:
-            return (f"packing '{r.packing.brick.id}' provides {name}, which BRDF "
-                    f"'{'+'.join(n.canonical() for n in r.brdf)}' does not read")
-    return ""
+            return (f"packing '{r.packing.brick.id}' provides {name}, which BRDF '{brdf}' does not read",
+                    "use the constants packing for this BRDF")
+    tangent = sorted({p.name for n in r.brdf for x in n.walk() for f in x.brick.entries for p in f.params
+                      if p.name in SHADING and BY_NAME[p.name].tangent})
+    frame = any(p.name in ("T", "B") for x in r.packing.walk() for f in x.brick.entries for p in f.params)
+    if tangent and not frame:
+        return (f"BRDF '{brdf}' reads {', '.join(tangent)} (the tangent frame), but packing "
+                f"'{r.packing.canonical()}' supplies no tangent",
+                f"fill its normal slot with vertex_tangent or normal_map, e.g. {r.packing.brick.id}(normal=vertex_tangent)")
+    return "", ""

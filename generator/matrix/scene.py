@@ -136,9 +136,9 @@ def load_scene(path, lib: Library) -> Scene:
             raise loc.error(where, e.message, e.hint) from None
         params = m.get("params", {})
         _check_params(loc, f"materials.{name}", params, specs, f"BRDF '{brdf}'")
-        problem = check_packing(resolve(Permutation(brdf, (), packing, output), lib))
+        problem, todo = check_packing(resolve(Permutation(brdf, (), packing, output), lib))
         if problem:
-            raise loc.error(loc.find(f"materials.{name}", "packing"), problem, "use the constants packing for this BRDF")
+            raise loc.error(loc.find(f"materials.{name}", "packing"), problem, todo)
         scene.materials[name] = Material(name, brdf, packing, params)
 
     for name, li in _table(loc, data, "lights").items():

@@ -7,7 +7,7 @@
 // brick bricks/brdf/microfacet/ndf/ggx.py sha256:8bab662c825b
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:706385e0b16a
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
-// template glsl/eval.glsl.j2 sha256:184a01d74c8a
+// template glsl/eval.glsl.j2 sha256:9df531e080fc
 // template glsl/macros.glsl.j2 sha256:b444f57a7364
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

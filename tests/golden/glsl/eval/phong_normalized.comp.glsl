@@ -4,7 +4,7 @@
 // eval: phong_normalized
 // hash: bcf91138f6f2
 // brick bricks/brdf/specular/phong_normalized.py sha256:81d46719a0f0
-// template glsl/eval.glsl.j2 sha256:184a01d74c8a
+// template glsl/eval.glsl.j2 sha256:9df531e080fc
 // template glsl/macros.glsl.j2 sha256:b444f57a7364
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -2,7 +2,7 @@
 // eval: lambert
 // hash: 55679a70c070
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
-// template hlsl/eval.hlsl.j2 sha256:2c2924df8739
+// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
 // template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

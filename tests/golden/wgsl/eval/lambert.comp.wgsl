@@ -2,7 +2,7 @@
 // eval: lambert
 // hash: 55679a70c070
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
-// template wgsl/eval.wgsl.j2 sha256:076e0c552233
+// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
 // template wgsl/macros.wgsl.j2 sha256:80e35411c40a
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -5,7 +5,7 @@
 // brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
 // brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
-// template wgsl/eval.wgsl.j2 sha256:076e0c552233
+// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
 // template wgsl/macros.wgsl.j2 sha256:80e35411c40a
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

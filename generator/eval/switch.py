@@ -1,0 +1,66 @@
+"""Several BRDFs in one program behind a switch on a per-sample id: the ubershader's BRDF core.
+
+`evaluate_switch(specs, ids, L, V, N, ...)` runs `brdf_switch` (link.switch_program):
+sample i is evaluated with BRDF `specs[ids[i]]`. On GPU targets the id travels in the
+w component of the sample's L (templates/*/eval.*.j2), so the switch is on a value read
+from a storage buffer, divergent within a workgroup. Parameters are the union of the
+BRDFs' (one parameter policy across them all).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import GPU_TARGETS
+from ..library.bricks import library_or_builtin
+from ..link import EvalProgram, switch_program
+from .evaluate import EvalError, _numpy_arg, _param_block, _vectors, resolve_params
+
+
+def switch_kernel_program(specs: list[str], lib=None) -> EvalProgram:
+    """The linked switch program of `specs` (kept in the library's memo)."""
+    lib = library_or_builtin(lib)
+    key = ("switch_program", tuple(specs))
+    if key not in lib.memo:
+        lib.memo[key] = switch_program(list(specs), lib)
+    return lib.memo[key]
+
+
+def evaluate_switch(specs: list[str], ids, L, V, N, T=None, params: dict | None = None, target: str = "numpy",
+                    dtype: str | None = None, lib=None) -> np.ndarray:
+    """f_r (N, 3) float64: sample i evaluated with BRDF specs[ids[i]] through one switch program."""
+    lib = library_or_builtin(lib)
+    ep = switch_kernel_program(specs, lib)
+    values = resolve_params(ep, params)
+    vecs = _vectors(L, V, N, T, ep.tangent, ep.spec)
+    ids = np.asarray(ids)
+    if ids.shape != (len(vecs[0]),) or ids.dtype.kind not in "iu":
+        raise EvalError(f"ids has shape {ids.shape} and dtype {ids.dtype}", f"pass one int per sample ({len(vecs[0])})")
+    if target in GPU_TARGETS:
+        return _run_gpu(ep, lib, target, vecs, values, ids)
+    if target != "numpy":
+        raise EvalError(f"target {target!r} has no switch program", "use numpy, glsl, hlsl or wgsl")
+    f = np.dtype(dtype or "float64").type
+    args = [ids.astype(np.int32)] + [v.astype(f) for v in vecs[:3]]
+    if ep.tangent:
+        args += [vecs[3].astype(f), np.cross(args[3], vecs[3].astype(f)).astype(f)]
+    args += [_numpy_arg(ep.params[k], values[k], f) for k in ep.params]
+    key = ("numpy_switch", ep.spec, np.dtype(f).name)
+    if key not in lib.memo:
+        from ..targets.numpy import NumpyTarget
+        t = NumpyTarget()
+        lib.memo[key] = t.load(t.emit(ep.program.structs, ep.program.functions), np.dtype(f))["brdf_switch"]
+    out = lib.memo[key](*args)
+    return np.broadcast_to(np.asarray(out, np.float64), (len(ids), 3)).copy()
+
+
+def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, ids) -> np.ndarray:
+    from ..compose import compose_eval
+    from ..runtime.eval_kernel import compile_kernel, shared_device
+
+    device = shared_device()
+    key = ("switch", lib.serial, ep.spec, language)
+    if key not in device.cache:
+        src = compose_eval(ep.spec, lib, (language,), ep=ep).sources[0]
+        device.cache[key] = compile_kernel(src, device, ep.tangent, ep.param_vec4s)
+    f32 = [v.astype(np.float32) for v in vecs]
+    return device.cache[key].run(f32, _param_block(ep, values), ids=ids).astype(np.float64)

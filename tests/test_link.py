@@ -1,0 +1,237 @@
+"""The link stage: any set of nodes in one program, slot fillers bound by name, kind contracts, one parameter policy.
+
+Proofs by construction (issue: the link-stage redesign): three fillers of one host behind a
+switch; an anisotropic NDF filler reading HdotT/HdotB against a float64 formula; an output
+brick with a parameter; the errors that name both bricks or the missing tangent frame.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from generator.lang import SourceError
+from generator.library.bricks import load_brick, load_library
+
+REPO = Path(__file__).resolve().parent.parent
+LINK_BRICKS = REPO / "tests" / "link_bricks"
+NDFS = ["microfacet(ndf=ggx)", "microfacet(ndf=beckmann)", "microfacet(ndf=blinn_phong)"]
+LANGS = ("glsl", "hlsl", "wgsl")
+
+
+@pytest.fixture(scope="module")
+def lib():
+    return load_library([LINK_BRICKS])
+
+
+def _unit(rng, n, upper=True):
+    v = rng.normal(size=(n, 3))
+    if upper:
+        v[:, 2] = np.abs(v[:, 2])
+    return v / np.linalg.norm(v, axis=1)[:, None]
+
+
+@pytest.fixture(scope="module")
+def frame():
+    rng = np.random.default_rng(7)
+    n = 512
+    L, V = _unit(rng, n), _unit(rng, n)
+    N = np.tile([0.0, 0.0, 1.0], (n, 1))
+    phi = rng.uniform(0, 2 * np.pi, n)
+    T = np.stack([np.cos(phi), np.sin(phi), np.zeros(n)], 1)
+    return L, V, N, T, rng.integers(0, 3, n)
+
+
+# ------------------------------------------------------------------ one program, many fillers
+
+def test_fillers_of_one_host_link_into_one_program_deterministically(lib):
+    from generator.link import switch_program
+    from generator.targets import get_target
+
+    ep = switch_program(NDFS, lib)
+    names = [f.name for f in ep.program.functions]
+    hosts = [n for n in names if n.startswith("microfacet_") and n.endswith("_specular")]
+    assert len(hosts) == 3 and len(set(names)) == len(names)
+    assert {"ggx_ndf", "beckmann_ndf", "blinn_phong_ndf", "brdf_switch"} <= set(names)
+    again = switch_program(NDFS, load_library([LINK_BRICKS]))
+    glsl = get_target("glsl")
+    assert glsl.emit(ep.program.structs, ep.program.functions).text == \
+        glsl.emit(again.program.structs, again.program.functions).text
+
+
+def test_switch_program_equals_the_specialized_programs_in_numpy(lib, frame):
+    from generator.eval.evaluate import evaluate
+    from generator.eval.switch import evaluate_switch
+
+    L, V, N, _, ids = frame
+    got = evaluate_switch(NDFS, ids, L, V, N, params={"alpha": 0.3}, lib=lib)
+    each = np.stack([evaluate(s, L, V, N, params={"alpha": 0.3}, target="numpy", lib=lib) for s in NDFS])
+    assert np.array_equal(got, each[ids, np.arange(len(ids))])
+    assert len(set(ids.tolist())) == 3
+
+
+@pytest.mark.toolchain
+def test_switch_kernel_compiles_and_validates_in_every_language(lib):
+    from generator.compose import compose_eval
+    from generator.link import switch_program
+    from generator.toolchain import CompileJob, compile_many
+
+    ep = switch_program(NDFS, lib)
+    c = compose_eval(ep.spec, lib, ep=ep)
+    jobs = [CompileJob(f"switch.comp.{s.language}", s.language, "comp", s.text, line_map=tuple(s.line_map))
+            for s in c.sources]
+    results = compile_many(jobs)
+    assert all(r.ok for r in results.values()), {k: r.errors() for k, r in results.items()}
+    assert "switch" in c.sources[0].text
+
+
+# ------------------------------------------------------------------ a filler reading the tangent frame
+
+def _aniso_expected(L, V, N, T, alpha, alpha_u, alpha_v, f0):
+    """float64: microfacet(ndf=aniso_ggx) = reference microfacet(ndf=ggx) · D_aniso / D_ggx (same F, Vis)."""
+    from generator.library.inputs import float64_geometry
+    from generator.reference import d_ggx, reference_brdf
+
+    g = float64_geometry(L, V, N, T)
+    x, y = g["HdotT"] / alpha_u, g["HdotB"] / alpha_v
+    d_aniso = 1.0 / (np.pi * alpha_u * alpha_v * (x * x + y * y + g["NdotH"] ** 2) ** 2)
+    ref = reference_brdf("microfacet(ndf=ggx)", L, V, N, params={"alpha": alpha, "f0": f0})
+    with np.errstate(all="ignore"):
+        ratio = np.where(ref[:, 0] > 0, d_aniso / d_ggx(g["NdotH"], g["NxH2"], alpha), 0.0)
+    return ref * ratio[:, None]
+
+
+def test_anisotropic_filler_reads_HdotT_HdotB_threaded_through_its_host(lib, frame):
+    from generator.eval.evaluate import evaluate, program
+
+    L, V, N, T, _ = frame
+    ep = program("microfacet(ndf=aniso_ggx)", lib)
+    host = next(f for f in ep.program.functions if f.name.startswith("microfacet_"))
+    assert {"HdotT", "HdotB", "alpha_u", "alpha_v"} <= {p.name for p in host.params}
+    assert ep.tangent and list(ep.params) == ["alpha", "f0", "alpha_u", "alpha_v"]
+    p = {"alpha": 0.3, "f0": [0.9, 0.6, 0.3], "alpha_u": 0.15, "alpha_v": 0.45}
+    got = evaluate("microfacet(ndf=aniso_ggx)", L, V, N, T, params=p, target="numpy", lib=lib)
+    want = _aniso_expected(L, V, N, T, 0.3, 0.15, 0.45, p["f0"])
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+    iso = evaluate("microfacet(ndf=aniso_ggx)", L, V, N, T, params={**p, "alpha_u": 0.3, "alpha_v": 0.3},
+                   target="numpy", lib=lib)
+    ggx = evaluate("microfacet(ndf=ggx)", L, V, N, params={"alpha": 0.3, "f0": p["f0"]}, target="numpy", lib=lib)
+    np.testing.assert_allclose(iso, ggx, rtol=1e-12)  # α_u = α_v: Walter's isotropic GGX
+
+
+@pytest.mark.lavapipe
+@pytest.mark.toolchain
+@pytest.mark.parametrize("language", LANGS)
+def test_anisotropic_filler_on_lavapipe_against_float64(lib, frame, language):
+    from generator.eval.evaluate import evaluate
+    from generator.runtime.probe import lavapipe_present
+    from tests.conftest import require
+
+    require(lavapipe_present(), "no lavapipe Vulkan device")
+    L, V, N, T, _ = frame
+    p = {"alpha": 0.3, "f0": [0.9, 0.6, 0.3], "alpha_u": 0.15, "alpha_v": 0.45}
+    got = evaluate("microfacet(ndf=aniso_ggx)", L, V, N, T, params=p, target=language, lib=lib)
+    want = _aniso_expected(*(x.astype(np.float32).astype(np.float64) for x in (L, V, N, T)), 0.3, 0.15, 0.45,
+                           p["f0"])
+    # float32 arithmetic on f up to ~1/(π α_u α_v): relative 1e-4, absolute 2^-20 of the peak
+    np.testing.assert_allclose(got, want, rtol=1e-4, atol=2.0 ** -20 * np.abs(want).max())
+
+
+def test_tangent_brdf_needs_a_packing_with_a_tangent_frame(lib, tmp_path):
+    from generator.matrix.scene import load_scene
+
+    scene = tmp_path / "s.toml"
+    body = ('[scene]\nname = "t"\n[materials.brushed]\nbrdf = "microfacet(ndf=aniso_ggx)"\npacking = "{p}"\n'
+            '[lights.sun]\ntype = "directional"\n[light_sets]\nall = ["sun"]\n'
+            '[[objects]]\nname = "pan"\nmaterial = "brushed"\nlights = "all"\n')
+    scene.write_text(body.format(p="constants"))
+    with pytest.raises(SourceError) as e:
+        load_scene(scene, lib)
+    msg = str(e.value)
+    assert f"{scene}:5:" in msg and "HdotB, HdotT (the tangent frame)" in msg and "normal=vertex_tangent" in msg
+    scene.write_text(body.format(p="constants(normal=vertex_tangent)"))
+    s = load_scene(scene, lib)
+    assert len(s.permutations) == 1
+
+
+# ------------------------------------------------------------------ parameterized output brick
+
+def test_output_brick_parameter_reaches_the_material_block_and_scales_the_output(lib):
+    from generator.link import link_permutation
+    from generator.matrix.permutation import LightKey, Permutation
+    from generator.targets.numpy import NumpyTarget
+
+    perm = Permutation("lambert", (LightKey("directional", "none"),), "constants(normal=vertex)", "exposure")
+    lp = link_permutation(perm, lib)
+    ev = next(s for s in lp.material if s.param == "ev")
+    assert ev.name == "o_ev" and lp.interface.block("Material").as_dict()["parameters"][-1]["name"] == "ev"
+    t = NumpyTarget()
+    shade = t.load(t.emit(lp.program.structs, lp.program.functions), np.dtype("float64"))["shade"]
+    args = {"P": np.zeros((1, 3)), "Ng": np.array([[0.0, 0.0, 1.0]]), "V": np.array([[0.0, 0.0, 1.0]]),
+            "m_rho_d": [0.5, 0.5, 0.5], "l0_direction": [0.0, 0.0, 1.0], "l0_color": [1.0, 1.0, 1.0]}
+    names = [n for n, _ in lp.glue.signature]
+    base = np.asarray(shade(*[args.get(n, 0.0) for n in names]))
+    two = np.asarray(shade(*[args.get(n, 1.0 if n == "o_ev" else 0.0) for n in names]))
+    np.testing.assert_allclose(base[..., :3], 0.5, rtol=1e-12)  # π · (ρ/π) · 1 · cos 0
+    np.testing.assert_allclose(two[..., :3], 2.0 * base[..., :3], rtol=1e-12)
+
+
+@pytest.mark.toolchain
+def test_output_brick_with_a_parameter_compiles_in_every_language(lib):
+    from generator.compose import compose_permutation
+    from generator.matrix.permutation import LightKey, Permutation
+    from generator.toolchain import CompileJob, compile_many
+
+    perm = Permutation("lambert", (LightKey("point", "none"),), "constants(normal=vertex)", "exposure")
+    c = compose_permutation(perm, lib)
+    jobs = [CompileJob(f"x.{s.stage}.{s.language}", s.language, s.stage, s.text, line_map=tuple(s.line_map))
+            for s in c.sources]
+    results = compile_many(jobs)
+    assert all(r.ok for r in results.values()), {k: r.errors() for k, r in results.items()}
+
+
+# ------------------------------------------------------------------ contracts and the parameter policy
+
+def _brick(tmp_path, rel, text):
+    path = tmp_path / rel
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return path
+
+
+def test_filler_reading_an_unknown_input_is_located_with_the_closest_name(tmp_path):
+    p = _brick(tmp_path, "ndf/bad.py", '"""Bad."""\nBRICK = {"kind": "ndf", "cite": "x"}\n\n\n'
+               'def ndf(NdotH: float, HdotTT: float) -> float:\n    return NdotH\n')
+    with pytest.raises(SourceError) as e:
+        load_brick(p)
+    assert ":5:" in str(e.value) and "HdotTT" in str(e.value) and "did you mean 'HdotT'" in str(e.value)
+
+
+def test_output_brick_must_take_color(tmp_path):
+    p = _brick(tmp_path, "output/bad.py", '"""Bad."""\nBRICK = {"kind": "output", "cite": "x"}\n\n\n'
+               'def output(c: vec3) -> vec4:\n    return vec4(c, 1.0)\n')
+    with pytest.raises(SourceError, match=r"must take 'color: vec3'"):
+        load_brick(p)
+
+
+def test_one_name_two_types_or_disjoint_ranges_is_an_error_naming_both_bricks(tmp_path):
+    from generator.matrix.permutation import parse_brdf
+    from generator.library.params import spec_params
+
+    base = load_library()
+    d = tmp_path / "b"
+    _brick(d, "diffuse/odd.py", '"""Odd."""\nBRICK = {"kind": "diffuse", "cite": "x", "params": '
+           '{"alpha": {"type": "vec3", "default": [0.1, 0.1, 0.1]}}}\n\n\ndef diffuse(alpha: vec3) -> vec3:\n'
+           '    return alpha\n')
+    _brick(d, "diffuse/far.py", '"""Far."""\nBRICK = {"kind": "diffuse", "cite": "x", "params": '
+           '{"alpha": {"type": "float", "range": [2.0, 3.0], "default": 2.5}}}\n\n\ndef diffuse(alpha: float) -> vec3:\n'
+           '    return vec3(alpha)\n')
+    lib = load_library([d])
+    for spec, what in [("odd+microfacet", "is float here but vec3 in"), ("far+microfacet", "disjoint from [2.0, 3.0]")]:
+        with pytest.raises(SourceError) as e:
+            spec_params(parse_brdf(spec, lib))
+        msg = str(e.value)
+        assert what in msg, msg
+        assert "microfacet.py" in msg and ("odd.py" in msg or "far.py" in msg), msg
+    assert spec_params(parse_brdf("lambert+microfacet", base))["alpha"].range == (0.0, 1.0)
