@@ -97,15 +97,15 @@ class Checker(ControlChecker, ExprChecker):
             if isinstance(t, ast.Name) and self.lookup(t.id) is None:
                 return self.declare(n, t, None, n.value)
             target = self.lvalue(t)
+            if isinstance(n.value, ast.List):
+                raise self.err(n.value, "an array literal only initializes a declaration (HLSL has no array expression)",
+                               "declare a new array: w: array[float, 3] = [a, b, c], or assign element by element")
             value = self.expr(n.value)
             if value.ty != target.ty:
                 raise self.err(n.value, f"cannot assign {value.ty} to {target.ty}",
                                "types never convert implicitly; use float(...), vec3(...) or another name")
             if target.ty.kind == "texture":
                 raise self.err(t, "textures cannot be reassigned", "pass the texture you want directly")
-            if isinstance(n.value, ast.List):
-                raise self.err(n.value, "an array literal only initializes a declaration (HLSL has no array expression)",
-                               "declare a new array: w: array[float, 3] = [a, b, c], or assign element by element")
             return ir.Assign(loc, target, None, value)
         if isinstance(n, ast.AugAssign):
             op = ARITH.get(type(n.op))

@@ -3,7 +3,8 @@
 A subclass supplies tables (type spellings, intrinsic spellings, literal
 suffixes) and overrides the few hooks where a language's structure differs
 (declarations, signatures, matrix products in HLSL, `select` in WGSL).
-Buffers, global declarations and arrays are in clike_resources.py (a mixin).
+Switches and runtime-bounded loops are in clike_control.py, buffers, global
+declarations and arrays in clike_resources.py (mixins).
 Every binary and unary expression is parenthesized, so no precedence table
 is needed and every target reads the same.
 """
@@ -12,11 +13,11 @@ from __future__ import annotations
 import math
 
 from ..lang import ir
-from ..lang.control import always_returns
 from ..lang.intrinsics import CONSTANTS
 from ..lang.types import Type
 from . import reserved
 from .base import Emitted
+from .clike_control import ControlMixin, wrap  # noqa: F401  (wrap: re-exported)
 from .clike_resources import ResourceMixin
 
 INDENT = "    "
@@ -65,7 +66,7 @@ def float_literal(v: float) -> str:
     return s
 
 
-class CLikeTarget(ResourceMixin):
+class CLikeTarget(ControlMixin, ResourceMixin):
     """GLSL, HLSL and WGSL: one walk over the IR, spelled by the tables below."""
 
     reserved = reserved.ALL
@@ -222,48 +223,6 @@ class CLikeTarget(ResourceMixin):
     def for_head(self, var: str, count: int) -> str:
         return f"for (int {var} = 0; {var} < {self.int_literal(count)}; {var}++) {{"
 
-    def for_bound_head(self, var: str, t: Type, bound: str) -> str:
-        """A loop head for a runtime int/uint bound (the loop variable has the bound's type)."""
-        zero = self.literal(t, 0)
-        return f"for ({self.type_name(t)} {var} = {zero}; {var} < {bound}; {var}++) {{"
-
-    def switch(self, w: Writer, s: ir.Switch) -> None:
-        """switch (x) { case 1: case 2: { ...; break; } default: { ... } } — no fallthrough."""
-        w.line(self.switch_head(self.expr(s.selector)), s.loc)
-        w.depth += 1
-        arms = [(tuple(values), body) for values, body in s.cases]
-        if s.default or self.DEFAULT_REQUIRED:
-            arms.append((None, s.default))
-        for values, body in arms:
-            for label in self.case_labels(s.selector.ty, values):
-                w.line(label)
-            w.depth += 1
-            self.block(w, body)
-            if self.CASE_BREAK and not always_returns(body):
-                w.line("break;")
-            w.depth -= 1
-            w.line("}")
-        w.depth -= 1
-        w.line("}")
-
-    DEFAULT_REQUIRED = False  # WGSL: every switch has a default clause
-    CASE_BREAK = True         # GLSL/HLSL: a case body ends with break; (WGSL never falls through)
-
-    def switch_head(self, selector: str) -> str:
-        return f"switch {wrap(selector)} {{"
-
-    def case_label_value(self, t: Type, v: int) -> str:
-        """A case value without parentheses (a negative int reads -3, not (-3))."""
-        return f"{int(v)}{self.UINT_SUFFIX}" if t.scalar == "uint" else self.int_literal(int(v))
-
-    def case_labels(self, t: Type, values: tuple[int, ...] | None) -> list[str]:
-        """The lines opening one arm: `case 1:` per value, the last opening the body's brace."""
-        if values is None:
-            return ["default: {"]
-        labels = [f"case {self.case_label_value(t, v)}:" for v in values]
-        labels[-1] += " {"
-        return labels
-
     def if_head(self, cond: str) -> str:
         return f"if {wrap(cond)} {{"
 
@@ -395,17 +354,3 @@ class CLikeTarget(ResourceMixin):
 
     def select(self, cond: str, if_true: str, if_false: str) -> str:
         return f"({cond} ? {if_true} : {if_false})"
-
-
-def wrap(s: str) -> str:
-    """`s` in parentheses unless one pair already encloses all of it."""
-    if s.startswith("(") and s.endswith(")"):
-        depth = 0
-        for i, c in enumerate(s):
-            depth += c == "("
-            depth -= c == ")"
-            if depth == 0 and i < len(s) - 1:
-                break
-        else:
-            return s
-    return f"({s})"
