@@ -235,3 +235,64 @@ def test_one_name_two_types_or_disjoint_ranges_is_an_error_naming_both_bricks(tm
         assert what in msg, msg
         assert "microfacet.py" in msg and ("odd.py" in msg or "far.py" in msg), msg
     assert spec_params(parse_brdf("lambert+microfacet", base))["alpha"].range == (0.0, 1.0)
+
+
+# ------------------------------------------------------------------ a light loop over a storage buffer
+
+DYNAMIC = ("lambert+blinn_phong_normalized", "constants(normal=vertex)")
+
+
+def test_fragment_loops_over_a_storage_buffer_of_lights_with_a_runtime_count(lib):
+    """shade() with *point lights read from a buffer of 3 = shade() with 3 static point lights (NumPy)."""
+    from generator.link import link_permutation
+    from generator.matrix.permutation import LightKey, Permutation
+    from generator.targets.numpy import NumpyTarget
+
+    brdf, packing = DYNAMIC
+    dyn = link_permutation(Permutation(brdf, (LightKey("point", "none", dynamic=True),), packing), lib)
+    static = link_permutation(Permutation(brdf, (LightKey("point", "none"),) * 3, packing), lib)
+    assert dyn.perm.canonical().startswith("brdf=lambert+blinn_phong_normalized;lights=*point/none;")
+    blocks = {b.name: b for b in dyn.interface.blocks}
+    assert blocks["LightBuffer0"].kind == "storage" and (blocks["LightBuffer0"].set, blocks["LightBuffer0"].binding) == (0, 2)
+    assert "Lights" not in blocks  # no static light parameters left
+    rng = np.random.default_rng(3)
+    pos, col = rng.uniform(-3, 3, (3, 3)), rng.uniform(0, 2, (3, 3))
+    P, Ng = np.array([[0.1, 0.0, -0.2]]), np.array([[0.0, 0.6, 0.8]])
+    V = np.array([[0.0, 0.0, 1.0]])
+    mat = {"m_rho_d": [0.6, 0.5, 0.4], "m_n": 32.0, "m_f0": [0.04, 0.04, 0.04]}
+    t = NumpyTarget()
+    res = {"light_buffer0": {"position": np.c_[pos, np.zeros(3)], "color": np.c_[col, np.zeros(3)]}}
+    f_dyn = t.load(t.emit(dyn.program.structs, dyn.program.functions, dyn.program.globals),
+                   np.dtype("float64"), resources=res)["shade"]
+    f_static = t.load(t.emit(static.program.structs, static.program.functions), np.dtype("float64"))["shade"]
+    args = {"P": P, "Ng": Ng, "V": V, **mat}
+    for i in range(3):
+        args[f"l{i}_position"], args[f"l{i}_color"] = pos[i], col[i]
+    got = np.asarray(f_dyn(*[args[n] for n, _ in dyn.glue.signature]))
+    want = np.asarray(f_static(*[args[n] for n, _ in static.glue.signature]))
+    np.testing.assert_allclose(got, want, rtol=1e-12)
+    assert want[..., :3].max() > 0.0
+
+
+@pytest.mark.toolchain
+def test_buffer_light_loop_compiles_and_its_spirv_declares_the_storage_block(lib):
+    from generator.analysis.reflect import flatten_layout, reflect
+    from generator.compose import compose_permutation
+    from generator.matrix.permutation import LightKey, Permutation
+    from generator.toolchain import CompileJob, compile_many
+
+    brdf, packing = DYNAMIC
+    perm = Permutation(brdf, (LightKey("directional", "shadow_map"), LightKey("point", "none", dynamic=True)), packing)
+    c = compose_permutation(perm, lib)
+    jobs = [CompileJob(f"d.{s.stage}.{s.language}", s.language, s.stage, s.text, line_map=tuple(s.line_map))
+            for s in c.sources]
+    results = compile_many(jobs)
+    want = c.interface.block("LightBuffer1")
+    assert (want.set, want.binding) == (0, 4)  # after the shadow map's image and sampler (2, 3)
+    for key, r in results.items():
+        assert r.ok, r.errors()
+        if ".frag." in key:
+            res = {(x.set, x.binding): x for x in reflect(r.spirv).entry("frag").resources}
+            buf = res[(0, 4)]
+            assert buf.kind == "storage_buffer" and buf.readonly, key
+            assert flatten_layout(buf.members) == ["0:{0:vec4,16:vec4}[] s32"], key

@@ -35,7 +35,10 @@ def built(tmp_path_factory):
 def _flat(members: list[dict]) -> list[str]:
     out = []
     for m in members:
-        leaf = f"{m['offset']}:{m['type']}"
+        ty = m["type"]
+        if "members" in m:  # an array of structs: its element's layout, as flatten_layout spells it
+            ty = "{" + ",".join(_flat(m["members"])) + "}" + ty[ty.index("["):]
+        leaf = f"{m['offset']}:{ty}"
         if "array_stride" in m:
             leaf += f" s{m['array_stride']}"
         if "matrix_stride" in m:

@@ -147,7 +147,7 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
     mat, lights = iface.block("Material"), iface.block("Lights")
     for lang in languages:
         target = get_target(lang)
-        emitted = target.emit(prog.structs, prog.functions)
+        emitted = target.emit(prog.structs, prog.functions, prog.globals)
         for stage in ("vertex", "fragment"):
             tname = f"{lang}/{stage}.{lang}.j2"
             used = _templates_used(lang, tname)

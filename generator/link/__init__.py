@@ -131,6 +131,15 @@ def link_permutation(perm: Permutation, lib: Library) -> LinkedPermutation:
         blocks.append(vec4_array_block("Lights", 0, 1, light_slots, light_count))
     if mat_count:
         blocks.append(vec4_array_block("Material", 1, 0, mat_slots, mat_count))
+    binding = max([1] + [t.binding + 1 for t in g.textures if t.set == 0]) + 1
+    for gl in g.light_buffers:  # dynamic lights: read-only storage buffers after the light textures
+        gl.set, gl.binding = 0, binding
+        binding += 1
+        elem = gl.ty.elem
+        fields = [{"name": f, "type": str(ft), "offset": 16 * k, "size": 16} for k, (f, ft) in enumerate(elem.fields)]
+        blocks.append(Block(f"LightBuffer{elem.name[len('LightData'):]}", gl.set, gl.binding, "storage",
+                            [{"name": "data", "type": f"{elem.name}[]", "offset": 0, "size": 0,
+                              "array_stride": 16 * len(fields), "members": fields}]))
     from ..library.params import spec_params
     params = {"material": {p: s for _, p, _, s in g.material}}
     for i, (lb, sh) in enumerate(r.lights):

@@ -12,10 +12,10 @@ inputs, parameters and textures.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..lang import SourceError, ir
-from ..lang.types import FLOAT, INT, TEXTURE2D, VEC3, VEC4, Type
+from ..lang.types import FLOAT, INT, MAT4, TEXTURE2D, UINT, VEC3, VEC4, Type, storage_buffer, struct
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
 from ..library.params import ParamSpec, spec_params
 from ..matrix.permutation import Node, Resolved
@@ -120,6 +120,7 @@ class ShadeGlue:
     lights: list[list[tuple[str, str, Type, ParamSpec | None]]]  # per light
     textures: list[Texture]
     brdf: BrdfGlue
+    light_buffers: list[ir.Global] = field(default_factory=list)  # per dynamic light: its storage buffer
 
 
 class _Binder:
@@ -137,7 +138,7 @@ class _Binder:
         out = []
         for p in f.params:
             if args and p.name in args:
-                out.append(args[p.name])
+                out.append(self.b.copy(args[p.name]))
             elif p.ty.kind == "texture":
                 name = ("t_" if group == "material" else prefix) + p.name
                 if name not in {t.name for t in self.textures}:
@@ -171,6 +172,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     out_node = Node(r.output, ())
     prog.link(out_node)
     bind = _Binder(b)
+    dynamic_lights: list[ir.Global] = []
     provided: dict[str, ir.Expr] = {}
     packing_params = spec_params([r.packing])
     output_params = spec_params([out_node])
@@ -192,12 +194,14 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         for i, (lb, sh) in enumerate(r.lights):
             pre = f"l{i}_"
             ln = Node(lb, ())
+            dyn = i < len(r.dynamic) and r.dynamic[i]
+            values = _light_buffer(prog, b, i, lb, sh, dynamic_lights) if dyn else None
             Li = f"L{i}"
-            stmts.append(b.decl(Li, bind.call(prog, ln, "light_dir", pre, "light", i, locals_)))
+            body_i = [b.decl(Li, bind.call(prog, ln, "light_dir", pre, "light", i, locals_, values))]
             cos = b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var(Li, VEC3))
-            stmts.append(b.decl(f"NdotL{i}", cos))
-            c = b.decl(f"c{i}", bind.call(prog, ln, "light_radiance", pre, "light", i, locals_))
-            s = b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_))
+            body_i.append(b.decl(f"NdotL{i}", cos))
+            c = b.decl(f"c{i}", bind.call(prog, ln, "light_radiance", pre, "light", i, locals_, values))
+            s = b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_, values))
             brdf_args = []
             for n, t in bg.signature:
                 if n == "L":
@@ -216,7 +220,13 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             term = b.arith("*", b.arith("*", b.arith("*", b.named_const("PI"), f_r), b.var(f"c{i}", VEC3)),
                            b.arith("*", b.var(f"NdotL{i}", FLOAT), b.var(f"s{i}", FLOAT)))
             add = b.assign(b.var("Lo", VEC3), term, "+")
-            stmts.append(b.if_(b.compare(">", b.var(f"NdotL{i}", FLOAT), b.const(0.0)), [c, s, add]))
+            body_i.append(b.if_(b.compare(">", b.var(f"NdotL{i}", FLOAT), b.const(0.0)), [c, s, add]))
+            if dyn:
+                g = dynamic_lights[-1]
+                bound = b.intrinsic("buffer_length", UINT, ir.Var(g.ty, b.here(), g.name, "global"))
+                stmts.append(ir.For(b.loc(), f"k{i}", 0, body_i, bound))
+            else:
+                stmts.extend(body_i)
             lights.append(pre)
         stmts.append(b.ret(bind.call(prog, out_node, "output", "o_", "material", None, {},
                                      args={"color": b.var("Lo", VEC3)})))
@@ -233,7 +243,8 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     light_values = []
     for i, (lb, sh) in enumerate(r.lights):
         lp = spec_params([Node(lb, ()), sh])
-        light_values.append([(f"l{i}_{k}", k, p.ty, p) for k, p in lp.items()])
+        dyn = i < len(r.dynamic) and r.dynamic[i]
+        light_values.append([] if dyn else [(f"l{i}_{k}", k, p.ty, p) for k, p in lp.items()])
     values = [(n, t) for n, _, t, _ in material] + [(n, t) for vals in light_values for n, _, t, _ in vals]
     missing = [n for n in bind.params if n not in dict(values)]
     assert not missing, f"shade() binds {missing}, which no brick declares"
@@ -242,7 +253,43 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     def shade_body():
         return stmts
     prog.add(b.function("shade", sig, VEC4, shade_body))
-    return ShadeGlue(sig, surface, material, light_values, bind.textures, bg)
+    prog.globals.extend(dynamic_lights)
+    return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights)
+
+
+def _light_buffer(prog: Program, b: Builder, i: int, lb, sh, out: list) -> dict[str, ir.Expr]:
+    """The storage buffer of dynamic light i and, per parameter, the expression reading it for element k<i>.
+
+    The element struct LightData<i> holds one vec4 per parameter (a scalar in .x, a vec3 in .xyz)
+    and four per mat4 (its columns): the layout rule of types.buffer_layout_error, so GLSL std430,
+    HLSL structured buffers and WGSL storage agree byte for byte.
+    """
+    params = spec_params([Node(lb, ()), sh])
+    textures = [x for n in sh.walk() for x in n.brick.textures] + list(lb.textures)
+    if textures:
+        raise SourceError(lb.display_path, 1, 1, f"a loop over a buffer of '{lb.id}' lights cannot bind textures "
+                          f"({', '.join(textures)})", "use a shadow filter without a texture (shadow none) for buffer lights")
+    fields = []
+    for k, p in params.items():
+        fields += [(f"{k}_c{c}", VEC4) for c in range(4)] if p.ty == MAT4 else [(k, VEC4)]
+    elem = struct(f"LightData{i}", fields)
+    g = ir.Global(f"light_buffer{i}", storage_buffer(elem))
+    prog.structs.append(elem)
+    out.append(g)
+    item = ir.Index(elem, b.here(), ir.Var(g.ty, b.here(), g.name, "global"), ir.Var(UINT, b.here(), f"k{i}"))
+
+    def member(name):
+        return ir.Member(VEC4, b.here(), b.copy(item), name)
+
+    values = {}
+    for k, p in params.items():
+        if p.ty == MAT4:
+            values[k] = b.construct(MAT4, *(member(f"{k}_c{c}") for c in range(4)))
+        elif p.ty.components == 4:
+            values[k] = member(k)
+        else:
+            values[k] = ir.Swizzle(p.ty, b.here(), member(k), "xyzw"[:p.ty.components])
+    return values
 
 
 def _texture_type(t: Texture) -> Type:

@@ -54,6 +54,7 @@ class Program:
 
     functions: list[ir.Function] = field(default_factory=list)
     structs: list[Type] = field(default_factory=list)
+    globals: list[ir.Global] = field(default_factory=list)  # buffers the glue reads (bindings set by link)
     bricks: dict[str, Brick] = field(default_factory=dict)  # display path -> brick
     by_name: dict[str, ir.Function] = field(default_factory=dict)
     _linked: dict = field(default_factory=dict)  # (kind, canonical) -> {function: linked name}

@@ -151,11 +151,14 @@ def canonical(nodes: list[Node]) -> str:
 
 @dataclass(frozen=True)
 class LightKey:
+    """One light of a permutation, or (dynamic) any number of lights of one type read from a storage buffer."""
+
     light: str  # light brick id
     shadow: str  # canonical shadow spec
+    dynamic: bool = False  # a loop over a storage buffer of lights with a runtime count
 
     def canonical(self) -> str:
-        return f"{self.light}/{self.shadow}"
+        return f"{'*' if self.dynamic else ''}{self.light}/{self.shadow}"
 
 
 @dataclass(frozen=True)
@@ -187,6 +190,7 @@ class Resolved:
     packing: Node
     lights: list[tuple[Brick, Node]]  # (light brick, shadow spec) per light, in order
     output: Brick
+    dynamic: tuple[bool, ...] = ()  # per light: a loop over a storage buffer of such lights
 
 
 def resolve(perm: Permutation, lib: Library) -> Resolved:
@@ -206,7 +210,7 @@ def resolve(perm: Permutation, lib: Library) -> Resolved:
     if out is None:
         raise SourceError("<key>", 1, 1, f"unknown output brick '{perm.output}'",
                           f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
-    return Resolved(brdf, packing[0], lights, out)
+    return Resolved(brdf, packing[0], lights, out, tuple(lk.dynamic for lk in perm.lights))
 
 
 def check_packing(r: Resolved) -> tuple[str, str]:
