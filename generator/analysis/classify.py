@@ -37,8 +37,6 @@ from __future__ import annotations
 
 from .spirv import GLSL_STD_450, Instruction, Module
 
-CLASSES = ("alu", "transcendental", "texture", "branch", "load", "store", "other")
-
 ALU_OPS = {
     "SNegate", "FNegate", "IAdd", "FAdd", "ISub", "FSub", "IMul", "FMul", "UDiv", "SDiv", "FDiv", "UMod",
     "SRem", "SMod", "FRem", "FMod", "VectorTimesScalar", "MatrixTimesScalar", "OuterProduct",

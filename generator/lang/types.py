@@ -10,7 +10,7 @@ SCALARS = ("float", "int", "uint", "bool")
 class Type:
     """A brick-language type.
 
-    kind: "scalar" | "vector" | "matrix" | "texture" | "struct" | "array" | "buffer" | "void".
+    kind: "scalar" | "vector" | "matrix" | "texture" | "struct" | "array" | "buffer".
     scalar: element scalar for scalar/vector/matrix ("float", "int", "uint", "bool").
     size: vector width or matrix order (mat3 → 3); 1 for scalars; the element count N of
         array[T, N]; a buffer's capacity (0: a runtime-sized storage buffer).
@@ -118,7 +118,6 @@ VEC2, VEC3, VEC4 = vector("float", 2), vector("float", 3), vector("float", 4)
 MAT3, MAT4 = matrix(3), matrix(4)
 TEXTURE2D = Type("texture", "float", 1, "texture2d")
 TEXTURECUBE = Type("texture", "float", 1, "texturecube")
-VOID = Type("void", "", 0, "void")
 
 BUILTIN_TYPES: dict[str, Type] = {
     "float": FLOAT, "int": INT, "uint": UINT, "bool": BOOL,
@@ -127,11 +126,6 @@ BUILTIN_TYPES: dict[str, Type] = {
 for _s, _p in _VEC_PREFIX.items():
     for _n in (2, 3, 4):
         BUILTIN_TYPES[f"{_p}{_n}"] = vector(_s, _n)
-
-
-def with_scalar(t: Type, s: str) -> Type:
-    """The same shape with another element scalar (vec3 → bvec3)."""
-    return vector(s, t.size) if t.kind in ("scalar", "vector") else t
 
 
 # ---------------------------------------------------------------- arrays and buffers
