@@ -210,3 +210,20 @@ def test_a_switch_whose_every_arm_returns_ends_a_function():
     for lang in LANGS:  # nothing is appended after the switch
         text = get_target(lang).emit([], [f]).text
         assert text.count("return") == 2, text
+
+
+def test_hlsl_builds_arrays_only_in_declarations():
+    loc = ir.Loc("glue", 1, 1)
+    arr = array(FLOAT, 2)
+    x = ir.Var(FLOAT, loc, "x", "param")
+    value = ir.Construct(arr, loc, [x, x])
+    ok = ir.Function("f", [ir.Param("x", FLOAT, loc)], FLOAT,
+                     [ir.Decl(loc, "a", arr, value), ir.Return(loc, ir.Index(FLOAT, loc, ir.Var(arr, loc, "a", "local"),
+                                                                            ir.Const(INT, loc, 1)))], loc)
+    assert "float a[2] = {x, x};" in get_target("hlsl").emit([], [ok]).text
+    assert "float a[2] = float[2](x, x);" in get_target("glsl").emit([], [ok]).text
+    g = ir.Function("g", [ir.Param("x", FLOAT, loc)], FLOAT,
+                    [ir.Return(loc, ir.Index(FLOAT, loc, value, ir.Const(INT, loc, 0)))], loc)
+    with pytest.raises(ValueError, match="HLSL has no array expression"):
+        get_target("hlsl").emit([], [g])
+    assert "return array<f32, 2>(x, x)[0i];" in get_target("wgsl").emit([], [g]).text

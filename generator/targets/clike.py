@@ -193,7 +193,7 @@ class CLikeTarget(ControlMixin, ResourceMixin):
 
     def stmt(self, w: Writer, s: ir.Stmt) -> None:
         if isinstance(s, ir.Decl):
-            w.line(self.decl(self.ident(s.name), s.ty, self.expr(s.value)), s.loc)
+            w.line(self.decl(self.ident(s.name), s.ty, self.initializer(s.value)), s.loc)
         elif isinstance(s, ir.Assign):
             self.assign(w, s)
         elif isinstance(s, ir.If):
@@ -213,6 +213,10 @@ class CLikeTarget(ControlMixin, ResourceMixin):
             w.line(f"return {self.expr(s.value)};", s.loc)
         else:
             raise AssertionError(f"unknown statement {type(s).__name__}")
+
+    def initializer(self, e: ir.Expr) -> str:
+        """A declaration's value (HLSL spells an array value here, and only here, as {a, b})."""
+        return self.expr(e)
 
     def decl(self, name: str, t: Type, value: str) -> str:
         return f"{self.var_decl(name, t)} = {value};"

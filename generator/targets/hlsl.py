@@ -56,8 +56,14 @@ class HlslTarget(CLikeTarget):
     def storage_length(self, name: str) -> str:
         return f"{reserved.LENGTH_PREFIX}{name}()"
 
+    def initializer(self, e: ir.Expr) -> str:
+        if isinstance(e, ir.Construct) and e.ty.kind == "array":
+            return f"{{{', '.join(self.expr(a) for a in e.args)}}}"
+        return super().initializer(e)
+
     def array_value(self, t: Type, elems: list[str]) -> str:
-        return f"{{{', '.join(elems)}}}"
+        raise ValueError(f"HLSL has no array expression ({t}): build an array only as the value of a "
+                         "Decl (ir.Decl(loc, name, array_type, ir.Construct(array_type, loc, elements)))")
 
     # ------------------------------------------------------------ structs
     def struct_decl(self, w: Writer, s: Type) -> None:
