@@ -296,3 +296,61 @@ def test_buffer_light_loop_compiles_and_its_spirv_declares_the_storage_block(lib
             buf = res[(0, 4)]
             assert buf.kind == "storage_buffer" and buf.readonly, key
             assert flatten_layout(buf.members) == ["0:{0:vec4,16:vec4}[] s32"], key
+
+
+# ------------------------------------------------------------------ an array parameter whose count is in the key
+
+LOBES = [[-1.0, 1.0, 8.0, 0.5], [-1.0, 1.0, 64.0, 0.3], [0.5, 0.5, 2.0, 0.1], [-0.9, 0.9, 200.0, 0.05]]
+
+
+def _lobes_expected(L, V, N, lobes, count):
+    nl, nv, lv = (np.sum(a * b, 1) for a, b in ((N, L), (N, V), (L, V)))
+    f = np.zeros(len(L))
+    for cxy, cz, n, rho in lobes[:count]:
+        f += rho * np.maximum(cxy * (lv - np.minimum(nl, 1.0) * np.clip(nv, 1e-4, 1.0))
+                              + cz * np.minimum(nl, 1.0) * np.clip(nv, 1e-4, 1.0), 0.0) ** n
+    return np.where(nl[:, None] > 0.0, f[:, None], 0.0) * np.ones((1, 3))
+
+
+def test_array_parameter_count_is_part_of_the_key(lib):
+    from generator.matrix.permutation import LightKey, Permutation, SpecError, parse_brdf, canonical
+    from generator.link import link_permutation
+
+    assert canonical(parse_brdf("lobes", lib)) == "lobes(lobes=4)"
+    assert canonical(parse_brdf("lobes(lobes=2)", lib)) == "lobes(lobes=2)"
+    with pytest.raises(SpecError, match="takes a count from 1 to 4"):
+        parse_brdf("lobes(lobes=5)", lib)
+    keys = {Permutation(f"lobes(lobes={n})", (LightKey("point", "none"),), "constants(normal=vertex)").hash
+            for n in (1, 2, 3, 4)}
+    assert len(keys) == 4
+    lp = link_permutation(Permutation("lobes(lobes=2)", (LightKey("point", "none"),), "constants(normal=vertex)"), lib)
+    params = lp.interface.block("Material").as_dict()["parameters"]
+    assert [p["name"] for p in params] == ["lobes[0]", "lobes[1]", "lobes[2]", "lobes[3]"]
+    assert [p["offset"] for p in params] == [0, 16, 32, 48]
+
+
+@pytest.mark.parametrize("count", [1, 2, 4])
+def test_array_parameter_lobes_in_numpy(lib, frame, count):
+    from generator.eval.evaluate import evaluate
+
+    L, V, N, _, _ = frame
+    got = evaluate(f"lobes(lobes={count})", L, V, N, params={"lobes": LOBES}, target="numpy", lib=lib)
+    np.testing.assert_allclose(got, _lobes_expected(L, V, N, LOBES, count), rtol=1e-12, atol=1e-300)
+
+
+@pytest.mark.lavapipe
+@pytest.mark.toolchain
+@pytest.mark.parametrize("language", LANGS)
+def test_array_parameter_lobes_on_lavapipe(lib, frame, language):
+    from generator.eval.evaluate import evaluate
+    from generator.runtime.probe import lavapipe_present
+    from tests.conftest import require
+
+    require(lavapipe_present(), "no lavapipe Vulkan device")
+    L, V, N, _, _ = frame
+    for count in (1, 3):
+        got = evaluate(f"lobes(lobes={count})", L, V, N, params={"lobes": LOBES}, target=language, lib=lib)
+        want = evaluate(f"lobes(lobes={count})", L, V, N, params={"lobes": LOBES}, target="numpy",
+                        dtype="float32", lib=lib)
+        # pow with exponents up to 200 in float32: relative 1e-4 of each lobe's value
+        np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6)

@@ -59,7 +59,8 @@ def uploads(scene: Scene, h: str, c) -> list[dict]:
         specs = {s.param: s.spec for s in c.material if s.spec is not None}
         mvals = material_values(scene, obj["material"], {s.param: s.spec for s in c.material
                                                          if s.spec is not None and s.name.startswith("m_")})
-        values = {s.name: (mvals[s.param] if s.name.startswith("m_") else specs[s.param].default) for s in c.material}
+        values = {s.name: _element(mvals[s.param] if s.name.startswith("m_") else specs[s.param].default, s)
+                  for s in c.material}
         item = {"material": obj["material"], "light_set": obj["light_set"], "objects": []}
         mat = c.interface.block("Material")
         if mat is not None:
@@ -69,10 +70,15 @@ def uploads(scene: Scene, h: str, c) -> list[dict]:
             lvals = {}
             for i, (ln, slots) in enumerate(zip(obj["lights"], c.lights)):
                 v = light_values(scene, ln, c.interface.params.get(f"light{i}", {}))
-                lvals.update({s.name: v[s.param] for s in slots})
+                lvals.update({s.name: _element(v[s.param], s) for s in slots})
             item["Lights"] = pack([s for ls in c.lights for s in ls], lvals, lb.members[-1]["size"] // 16).hex()
         out.append(item)
     for item in out:
         item["objects"] = [o["name"] for o in scene.objects if o["permutation"] == h
                            and (o["material"], o["light_set"]) == (item["material"], item["light_set"])]
     return out
+
+
+def _element(value, slot):
+    """The value a slot holds: an array parameter's element, or the value itself."""
+    return value if slot.element is None else value[slot.element]

@@ -25,6 +25,7 @@ from ..library.bricks import library_or_builtin
 from ..compose import compose_eval
 from ..link import EvalProgram, eval_program
 from ..lang.errors import UserError
+from ..library.params import flat
 
 
 class EvalError(UserError, ValueError):
@@ -60,6 +61,15 @@ def resolve_params(ep: EvalProgram, params: dict | None) -> dict[str, list[float
     out = {}
     for name, ty in ep.params.items():
         raw = params.get(name, defaults[name])
+        if ty.kind == "array":  # one value per element, each flattened under the element's shader name
+            problem = ep.specs[name].check(raw)
+            if problem:
+                raise EvalError(f"parameter '{name}' of '{ep.spec}': {problem}",
+                                f"give a list of {ty.size} values of {ty.elem}")
+            for i, v in enumerate(raw):
+                v = list(v) if isinstance(v, (list, tuple)) else [v]
+                out[f"{name}_{i}"] = [float(x) for x in (v * ty.elem.components if len(v) == 1 else v)]
+            continue
         try:
             vals = np.asarray(raw, dtype=np.float64).reshape(-1).tolist()
         except (TypeError, ValueError):
@@ -126,7 +136,12 @@ def _numpy_arg(ty, vals: list[float], dtype) -> np.ndarray:
 def _run_reference(ep: EvalProgram, vecs, values, n: int) -> np.ndarray:
     from ..reference import reference_brdf
 
-    ref_params = {k: (v[0] if ep.params[k].kind == "scalar" else list(v)) for k, v in values.items()}
+    ref_params = {}
+    for k, ty in ep.params.items():
+        if ty.kind == "array":
+            ref_params[k] = [values[f"{k}_{i}"] for i in range(ty.size)]
+        else:
+            ref_params[k] = values[k][0] if ty.kind == "scalar" else list(values[k])
     T = vecs[3] if len(vecs) > 3 else None
     out = reference_brdf(ep.spec, vecs[0], vecs[1], vecs[2], T=T, params=ref_params)
     return np.asarray(out, np.float64).reshape(n, 3)
@@ -150,7 +165,7 @@ def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int) -> np.nda
         T = vecs[3].astype(f)
         with np.errstate(all="ignore"):
             args += [T, np.cross(args[2], T).astype(f)]  # B = cross(N, T), as in the eval kernels
-    args += [_numpy_arg(ep.params[k], values[k], f) for k in ep.params]
+    args += [_numpy_arg(ty, values[n], f) for n, _, _, ty, _ in flat(ep.specs)]
     out = _numpy_brdf(ep, lib, dtype)(*args)
     return np.broadcast_to(np.asarray(out, np.float64), (n, 3)).copy()
 

@@ -12,6 +12,7 @@ import numpy as np
 
 from .. import GPU_TARGETS
 from ..library.bricks import library_or_builtin
+from ..library.params import flat
 from ..link import EvalProgram, switch_program
 from .evaluate import EvalError, _numpy_arg, _param_block, _vectors, resolve_params
 
@@ -43,7 +44,7 @@ def evaluate_switch(specs: list[str], ids, L, V, N, T=None, params: dict | None 
     args = [ids.astype(np.int32)] + [v.astype(f) for v in vecs[:3]]
     if ep.tangent:
         args += [vecs[3].astype(f), np.cross(args[3], vecs[3].astype(f)).astype(f)]
-    args += [_numpy_arg(ep.params[k], values[k], f) for k in ep.params]
+    args += [_numpy_arg(ty, values[n], f) for n, _, _, ty, _ in flat(ep.specs)]
     key = ("numpy_switch", ep.spec, np.dtype(f).name)
     if key not in lib.memo:
         from ..targets.numpy import NumpyTarget

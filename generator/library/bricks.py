@@ -13,7 +13,7 @@ from pathlib import Path
 from ..lang import Signature, SourceError, parse_module, read_meta
 from ..lang.errors import read_text
 from ..lang import ir
-from ..lang.types import BUILTIN_TYPES, Type
+from ..lang.types import BUILTIN_TYPES, INT, Type, array
 from .inputs import SHADING, SURFACE
 from .kinds import KINDS
 
@@ -170,6 +170,10 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     return brick
 
 
+PARAM_KEYS = {"type", "range", "default", "doc", "count"}
+MAX_ARRAY = 16
+
+
 def _params(shown, loc, raw) -> dict[str, Param]:
     if not isinstance(raw, dict):
         raise _meta_error(shown, loc, "'params' must be a dict", 'write "params": {"n": {"type": "float", ...}}')
@@ -178,7 +182,18 @@ def _params(shown, loc, raw) -> dict[str, Param]:
         if not isinstance(spec, dict) or spec.get("type") not in PARAM_TYPES:
             raise _meta_error(shown, loc, f"parameter '{name}' needs a type",
                               f"give \"type\" one of {', '.join(PARAM_TYPES)}")
+        unknown = set(spec) - PARAM_KEYS
+        if unknown:
+            close = difflib.get_close_matches(sorted(unknown)[0], sorted(PARAM_KEYS), n=1)
+            raise _meta_error(shown, loc, f"parameter '{name}' has unknown key(s) {', '.join(sorted(unknown))}",
+                              (f"did you mean '{close[0]}'? " if close else "") + f"allowed: {', '.join(sorted(PARAM_KEYS))}")
         ty = BUILTIN_TYPES[spec["type"]]
+        count = spec.get("count")
+        if count is not None:
+            if type(count) is not int or not 1 <= count <= MAX_ARRAY or ty.kind == "matrix":
+                raise _meta_error(shown, loc, f"parameter '{name}' has a bad count {count!r}",
+                                  f"an array parameter holds 1 to {MAX_ARRAY} scalars or vectors")
+            ty = array(ty, count)
         rng = spec.get("range")
         if rng is not None and not (isinstance(rng, (list, tuple)) and len(rng) == 2 and rng[0] <= rng[1]):
             raise _meta_error(shown, loc, f"parameter '{name}' has a bad range {rng!r}", "write [low, high]")
@@ -203,7 +218,15 @@ def _slots(shown, loc, raw) -> dict[str, dict]:
 
 
 def check_value(ty: Type, rng, value) -> str:
-    """'' when value fits type and range, else what is wrong."""
+    """'' when value fits type and range, else what is wrong (an array: one value per element)."""
+    if ty.kind == "array":
+        if not isinstance(value, (list, tuple)) or len(value) != ty.size:
+            return f"expected a list of {ty.size} values for {ty}, got {value!r}"
+        for i, v in enumerate(value):
+            problem = check_value(ty.elem, rng, v)
+            if problem:
+                return f"element {i}: {problem}"
+        return ""
     n = ty.components
     vals = value if isinstance(value, (list, tuple)) else [value]
     if ty.kind == "scalar" and isinstance(value, (list, tuple)):
@@ -248,6 +271,9 @@ def _check_entries(b: Brick, loc) -> None:
                                       f'add "textures": {{"{p.name}": {{"srgb": False}}}} to BRICK')
                 continue
             want = args.get(p.name) or inputs.get(p.name) or (b.params[p.name].ty if p.name in b.params else None)
+            if want is None and p.name.endswith("_count") and p.name[:-6] in b.params \
+                    and b.params[p.name[:-6]].ty.kind == "array":
+                want = INT  # the element count of an array parameter: part of the permutation key
             if want is None and b.kind == "packing":
                 continue  # a material parameter of the BRDF, bound when composed
             if want is None:

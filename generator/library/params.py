@@ -68,3 +68,15 @@ def spec_params(nodes) -> dict[str, ParamSpec]:
                                  "move the default inside the range every brick of the spec allows")
                 out[name] = ParamSpec(name, old.ty, old.default, rng, old.doc or p.doc, old.owners + (b.display_path,))
     return out
+
+
+def flat(specs: dict[str, ParamSpec]) -> list[tuple[str, str, int | None, Type, ParamSpec]]:
+    """(shader name, parameter, element, type, spec) per value a shader receives: an array parameter
+    becomes one value per element (`lobes_0`, `lobes_1`, ...; the glue rebuilds the array)."""
+    out = []
+    for k, p in specs.items():
+        if p.ty.kind == "array":
+            out += [(f"{k}_{i}", k, i, p.ty.elem, p) for i in range(p.ty.size)]
+        else:
+            out.append((k, k, None, p.ty, p))
+    return out

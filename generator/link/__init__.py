@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from ..lang import SourceError
 from ..lang.types import Type
 from ..library.bricks import Library
-from ..library.params import ParamSpec
+from ..library.params import ParamSpec, flat
 from ..matrix.permutation import Node, Permutation, check_packing, parse_brdf, resolve
 from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue
 from .interface import (FRAME_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
@@ -60,7 +60,7 @@ class EvalProgram:
 
 
 def _eval_interface(specs: dict[str, ParamSpec], tangent: bool, reads: list[str], textures) -> tuple[list[Slot], int, Interface]:
-    slots, count = layout([(k, k, p.ty, p, None) for k, p in specs.items()])
+    slots, count = layout([(n, k, e, ty, p, None) for n, k, e, ty, p in flat(specs)])
     params = vec4_array_block("Params", 0, 2, slots, max(count, 1), header=[EVAL_INFO])
     samples = Block("Samples", 0, 0, "storage", [{"name": "data", "type": "vec4[]", "offset": 0, "size": 0,
                                                   "array_stride": 16}])
@@ -124,8 +124,8 @@ def link_permutation(perm: Permutation, lib: Library) -> LinkedPermutation:
     prog = Program()
     g = shade_glue(prog, r)
     assign_bindings(g.textures, {"light": 2, "material": 1})
-    mat_slots, mat_count = layout([(n, p, t, s, None) for n, p, t, s in g.material])
-    light_slots, light_count = layout([(n, p, t, s, i) for i, vals in enumerate(g.lights) for n, p, t, s in vals])
+    mat_slots, mat_count = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.material])
+    light_slots, light_count = layout([(n, p, e, t, s, i) for i, vals in enumerate(g.lights) for n, p, e, t, s in vals])
     blocks = [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK))]
     if light_count:
         blocks.append(vec4_array_block("Lights", 0, 1, light_slots, light_count))
@@ -141,7 +141,7 @@ def link_permutation(perm: Permutation, lib: Library) -> LinkedPermutation:
                             [{"name": "data", "type": f"{elem.name}[]", "offset": 0, "size": 0,
                               "array_stride": 16 * len(fields), "members": fields}]))
     from ..library.params import spec_params
-    params = {"material": {p: s for _, p, _, s in g.material}}
+    params = {"material": {p: s for _, p, _, _, s in g.material}}
     for i, (lb, sh) in enumerate(r.lights):
         params[f"light{i}"] = spec_params([Node(lb, ()), sh])
     iface = Interface({"vert": "main", "frag": "main"}, g.brdf.reads, g.surface, blocks, g.textures,

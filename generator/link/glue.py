@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from ..lang import SourceError, ir
 from ..lang.types import FLOAT, INT, MAT4, TEXTURE2D, UINT, VEC3, VEC4, Type, storage_buffer, struct
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
-from ..library.params import ParamSpec, spec_params
+from ..library.params import ParamSpec, flat, spec_params
 from ..matrix.permutation import Node, Resolved
 from .interface import Texture
 from .irgen import Builder
@@ -52,7 +52,7 @@ class BrdfGlue:
 
     @property
     def signature(self) -> list[tuple[str, Type]]:
-        return self.frame + [(k, p.ty) for k, p in self.params.items()] + [(n, t) for n, t, _ in self.textures]
+        return self.frame + [(n, t) for n, _, _, t, _ in flat(self.params)] + [(n, t) for n, t, _ in self.textures]
 
 
 def brdf_glue(prog: Program, nodes: list[Node], suffix: str = "", guarded: bool = True,
@@ -70,22 +70,32 @@ def brdf_glue(prog: Program, nodes: list[Node], suffix: str = "", guarded: bool 
         for p in f.params:
             if p.ty.kind == "texture" and p.name not in {t[0] for t in textures}:
                 textures.append((p.name, p.ty, _texture_decl(nodes, p.name)))
+    counts = {f"{a}_count": c for top in nodes for n in top.walk() for a, c in n.counts}
     unknown = [p for f in entries for p in f.params
-               if p.name not in SHADING and p.name not in params and p.ty.kind != "texture"]
+               if p.name not in SHADING and p.name not in params and p.ty.kind != "texture" and p.name not in counts]
     if unknown:
         p = unknown[0]
         raise SourceError(p.loc.path, p.loc.line, p.loc.col, f"'{p.name}' is bound by nothing in this BRDF",
                           "name a shading input, a declared parameter or a texture")
     tangent = any(BY_NAME[r].tangent for r in reads)
     frame = [(n, BY_NAME[n].ty) for n in FRAME + (TANGENT_FRAME if tangent else ())]
-    sig = frame + [(k, p.ty) for k, p in params.items()] + [(n, t) for n, t, _ in textures]
+    sig = frame + [(n, t) for n, _, _, t, _ in flat(params)] + [(n, t) for n, t, _ in textures]
+
+    def arg(p, env):
+        if p.name in counts:  # an array's element count: a constant of the permutation key
+            return ir.Const(INT, b.here(), counts[p.name])
+        return b.var(p.name, env[p.name])
 
     def lit_body():
         body = []
+        for k, spec in params.items():  # array parameters arrive as elements; the terms take the array
+            if spec.ty.kind == "array":
+                elems = [b.var(f"{k}_{i}", spec.ty.elem) for i in range(spec.ty.size)]
+                body.append(b.decl(k, b.construct(spec.ty, *elems)))
         for name in closure(reads):
             body.append(b.decl(name, b.copy(expression(name))))
-        env = dict(sig) | {name: BY_NAME[name].ty for name in closure(reads)}
-        terms = [b.call(f, [b.var(p.name, env[p.name]) for p in f.params]) for f in entries]
+        env = dict(sig) | {name: BY_NAME[name].ty for name in closure(reads)} | {k: s.ty for k, s in params.items()}
+        terms = [b.call(f, [arg(p, env) for p in f.params]) for f in entries]
         total = terms[0]
         for t in terms[1:]:
             total = b.arith("+", total, t)
@@ -116,8 +126,8 @@ class ShadeGlue:
 
     signature: list[tuple[str, Type]]  # shade()'s parameters, in order
     surface: list[str]  # interpolants read: P, N, then T, B and uv where needed
-    material: list[tuple[str, str, Type, ParamSpec | None]]  # (glue name, param, type, spec)
-    lights: list[list[tuple[str, str, Type, ParamSpec | None]]]  # per light
+    material: list[tuple]  # (glue name, param, element or None, type, spec)
+    lights: list[list[tuple]]  # per light, the same
     textures: list[Texture]
     brdf: BrdfGlue
     light_buffers: list[ir.Global] = field(default_factory=list)  # per dynamic light: its storage buffer
@@ -188,9 +198,9 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         stmts.append(b.decl("N", bind.call(prog, normal, normal.brick.entries[0].name, "m_", "material", None, {})))
         stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
         locals_ = {"N": VEC3}
-        for k, spec in bg.params.items():
+        for n, k, _, ty, _ in flat(bg.params):
             if k not in provided:
-                bind.params[f"m_{k}"] = spec.ty
+                bind.params[f"m_{n}"] = ty
         for i, (lb, sh) in enumerate(r.lights):
             pre = f"l{i}_"
             ln = Node(lb, ())
@@ -237,15 +247,16 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     surface = ["P", "N"] + (["T", "B"] if bg.tangent or bind.surface & {"T", "B"} else []) \
         + (["uv"] if "uv" in bind.surface else [])
     sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")]
-    material = [(f"m_{k}", k, p.ty, p) for k, p in bg.params.items() if k not in provided or f"m_{k}" in bind.params]
-    material += [(f"m_{k}", k, p.ty, p) for k, p in packing_params.items()]
-    material += [(f"o_{k}", k, p.ty, p) for k, p in output_params.items()]
+    material = [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in flat(bg.params)
+                if k not in provided or f"m_{n}" in bind.params]
+    material += [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in flat(packing_params)]
+    material += [(f"o_{n}", k, e, ty, p) for n, k, e, ty, p in flat(output_params)]
     light_values = []
     for i, (lb, sh) in enumerate(r.lights):
         lp = spec_params([Node(lb, ()), sh])
         dyn = i < len(r.dynamic) and r.dynamic[i]
-        light_values.append([] if dyn else [(f"l{i}_{k}", k, p.ty, p) for k, p in lp.items()])
-    values = [(n, t) for n, _, t, _ in material] + [(n, t) for vals in light_values for n, _, t, _ in vals]
+        light_values.append([] if dyn else [(f"l{i}_{n}", k, e, ty, p) for n, k, e, ty, p in flat(lp)])
+    values = [(n, t) for n, _, _, t, _ in material] + [(n, t) for vals in light_values for n, _, _, t, _ in vals]
     missing = [n for n in bind.params if n not in dict(values)]
     assert not missing, f"shade() binds {missing}, which no brick declares"
     sig += values + [(t.name, _texture_type(t)) for t in bind.textures]

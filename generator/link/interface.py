@@ -30,6 +30,7 @@ class Slot:
     spec: ParamSpec | None = None
     light: int | None = None  # the light it belongs to
     base: int = 0  # byte offset of the vec4 array in its block
+    element: int | None = None  # the element of an array parameter
 
     @property
     def width(self) -> int:
@@ -42,7 +43,8 @@ class Slot:
         return self.base + self.index * VEC4_BYTES
 
     def as_dict(self) -> dict:
-        d = {"name": self.param, "type": str(self.ty), "offset": self.offset, "size": self.ty.components * 4}
+        name = self.param if self.element is None else f"{self.param}[{self.element}]"
+        d = {"name": name, "type": str(self.ty), "offset": self.offset, "size": self.ty.components * 4}
         if self.light is not None:
             d["light"] = self.light
         if self.spec is not None:
@@ -51,11 +53,11 @@ class Slot:
         return d
 
 
-def layout(values: list[tuple[str, str, Type, ParamSpec | None, int | None]]) -> tuple[list[Slot], int]:
-    """(name, param, type, spec, light) in order → slots, one vec4 each (four per mat4), and the vec4 count."""
+def layout(values: list[tuple]) -> tuple[list[Slot], int]:
+    """(name, param, element, type, spec, light) in order → slots, one vec4 each (four per mat4), and the vec4 count."""
     slots, i = [], 0
-    for name, param, ty, spec, light in values:
-        s = Slot(name, param, ty, i, spec, light)
+    for name, param, element, ty, spec, light in values:
+        s = Slot(name, param, ty, i, spec, light, element=element)
         slots.append(s)
         i += s.width
     return slots, i

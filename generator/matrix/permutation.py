@@ -18,7 +18,7 @@ from ..library.kinds import BRDF_KINDS
 from ..lang import SourceError
 from ..lang.errors import UserError
 
-_TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[()+=,])")
+_TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[0-9]+|[()+=,])")
 PRECISIONS = ("fp32",)  # fp16 is on the roadmap (issue: accuracy); the key keeps the axis
 
 
@@ -36,11 +36,14 @@ class Node:
 
     brick: Brick
     fillers: tuple  # ((slot, Node), ...) in the brick's slot order
+    counts: tuple = ()  # ((array parameter, element count), ...) in the brick's parameter order
 
     def canonical(self) -> str:
-        if not self.fillers:
-            return self.brick.id
-        return f"{self.brick.id}({','.join(f'{s}={n.canonical()}' for s, n in self.fillers)})"
+        parts = [f"{s}={n.canonical()}" for s, n in self.fillers] + [f"{p}={c}" for p, c in self.counts]
+        return f"{self.brick.id}({','.join(parts)})" if parts else self.brick.id
+
+    def count(self, param: str) -> int | None:
+        return dict(self.counts).get(param)
 
     def walk(self):
         """This node and every filler below it, callers first."""
@@ -83,20 +86,36 @@ def parse_spec(spec: str, lib: Library, kinds) -> list[Node]:
                             f"known: {', '.join(known)}")
         brick = found[0]
         given: dict[str, Node] = {}
+        counts: dict[str, int] = {}
+        arrays = {k: p.ty.size for k, p in brick.params.items() if p.ty.kind == "array"}
         if toks[i][0] == "(":
             i += 1
             while True:
                 sname, scol = toks[i]
-                if sname not in brick.slots:
-                    slots = ", ".join(brick.slots) or "none"
-                    raise SpecError(spec, scol, f"'{brick.id}' has no slot {sname!r}", f"its slots: {slots}")
+                if sname not in brick.slots and sname not in arrays:
+                    if not arrays:
+                        slots = ", ".join(brick.slots) or "none"
+                        raise SpecError(spec, scol, f"'{brick.id}' has no slot {sname!r}", f"its slots: {slots}")
+                    slots = ", ".join(list(brick.slots) + [f"{a}=1..{n}" for a, n in arrays.items()])
+                    raise SpecError(spec, scol, f"'{brick.id}' has no slot or array parameter {sname!r}",
+                                    f"its slots and counts: {slots}")
                 if sname in given:
                     raise SpecError(spec, scol, f"slot '{sname}' is filled twice", "fill each slot once")
+                if sname in counts:
+                    raise SpecError(spec, scol, f"count '{sname}' is given twice", "give each count once")
                 i += 1
                 if toks[i][0] != "=":
                     raise SpecError(spec, toks[i][1], "expected '='", "write slot=filler")
                 i += 1
-                given[sname] = term((brick.slots[sname]["kind"],))
+                if sname in arrays:
+                    num, ncol = toks[i]
+                    if not num.isdigit() or not 1 <= int(num) <= arrays[sname]:
+                        raise SpecError(spec, ncol, f"'{sname}' takes a count from 1 to {arrays[sname]}",
+                                        f"write {sname}=1 … {sname}={arrays[sname]}")
+                    counts[sname] = int(num)
+                    i += 1
+                else:
+                    given[sname] = term((brick.slots[sname]["kind"],))
                 if toks[i][0] == ",":
                     i += 1
                     continue
@@ -112,9 +131,9 @@ def parse_spec(spec: str, lib: Library, kinds) -> list[Node]:
                 if dflt is None:
                     raise SpecError(spec, col, f"default filler '{s['default']}' of slot '{sname}' is missing",
                                     f"fill the slot explicitly: {brick.id}({sname}=...)")
-                node = Node(dflt, _default_fillers(dflt, lib, spec, col))
+                node = Node(dflt, _default_fillers(dflt, lib, spec, col), _default_counts(dflt))
             fillers.append((sname, node))
-        return Node(brick, tuple(fillers))
+        return Node(brick, tuple(fillers), tuple((a, counts.get(a, n)) for a, n in arrays.items()))
 
     nodes = [term(kinds)]
     while toks[i][0] == "+":
@@ -131,8 +150,13 @@ def _default_fillers(brick: Brick, lib: Library, spec: str, col: int) -> tuple:
         d = lib.get(s["kind"], s["default"])
         if d is None:
             raise SpecError(spec, col, f"default filler '{s['default']}' of slot '{sname}' is missing", "")
-        out.append((sname, Node(d, _default_fillers(d, lib, spec, col))))
+        out.append((sname, Node(d, _default_fillers(d, lib, spec, col), _default_counts(d))))
     return tuple(out)
+
+
+def _default_counts(brick: Brick) -> tuple:
+    """Every array parameter at its full capacity."""
+    return tuple((k, p.ty.size) for k, p in brick.params.items() if p.ty.kind == "array")
 
 
 def parse_brdf(spec: str, lib: Library) -> list[Node]:
