@@ -1,21 +1,31 @@
-"""Compute pipelines from SPIR-V: descriptor set 0 of buffers, dispatch, timestamp queries.
+"""Compute pipelines from SPIR-V: descriptor set 0 of buffers, images and samplers, dispatch, timestamps.
 
 One :class:`ComputePipeline` holds its shader module, set layout, pipeline
 layout, pipeline, a descriptor pool with one set, and a timestamp query pool.
-``bind`` points the set at buffers; ``dispatch`` records, submits and waits,
-and with ``timed=True`` returns the device time between a timestamp written
-before the dispatch (top of pipe) and one after it (bottom of pipe).
+Binding i of set 0 has the i-th kind of `bindings`: STORAGE or UNIFORM (a
+:class:`~.device.Buffer`), SAMPLED_IMAGE (an :class:`~.device.Image`: GLSL
+``texture2D`` / ``textureCube``, HLSL ``Texture2D`` / ``TextureCube``, WGSL
+``texture_2d<f32>`` / ``texture_cube<f32>``) or SAMPLER (a
+:class:`~.device.Sampler`: GLSL ``sampler``, HLSL ``SamplerState``, WGSL
+``sampler``), separate image and sampler as every target declares them.
+``bind`` points the set at those resources; ``dispatch`` records, submits and
+waits, and with ``timed=True`` returns the device time between a timestamp
+written before the dispatch (top of pipe) and one after it (bottom of pipe).
 """
 from __future__ import annotations
 
-from .device import Buffer, Device
+from .device import Buffer, Device, Image, Sampler
 
 STORAGE = "storage"
 UNIFORM = "uniform"
+SAMPLED_IMAGE = "sampled_image"
+SAMPLER = "sampler"
+
+_RESOURCE = {STORAGE: Buffer, UNIFORM: Buffer, SAMPLED_IMAGE: Image, SAMPLER: Sampler}
 
 
 class ComputePipeline:
-    """A compute pipeline whose set 0 holds `bindings` (STORAGE / UNIFORM buffers at 0, 1, ...)."""
+    """A compute pipeline whose set 0 holds `bindings` (STORAGE / UNIFORM / SAMPLED_IMAGE / SAMPLER at 0, 1, ...)."""
 
     def __init__(self, device: Device, spirv: bytes, bindings: tuple[str, ...], entry: str = "main"):
         vk = self.vk = device.vk
@@ -23,7 +33,11 @@ class ComputePipeline:
         self.handle = self.module = self.layout = self.set_layout = self.pool = self.queries = None
         dev = device.handle
         try:
-            kinds = {STORAGE: vk.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, UNIFORM: vk.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}
+            kinds = {STORAGE: vk.VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, UNIFORM: vk.VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+                     SAMPLED_IMAGE: vk.VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, SAMPLER: vk.VK_DESCRIPTOR_TYPE_SAMPLER}
+            unknown = [b for b in self.bindings if b not in kinds]
+            if unknown:
+                raise ValueError(f"unknown binding kinds {unknown}: use {', '.join(kinds)}")
             self._types = [kinds[b] for b in self.bindings]
             self.module = vk.vkCreateShaderModule(dev, vk.VkShaderModuleCreateInfo(
                 codeSize=len(spirv), pCode=spirv), None)
@@ -55,17 +69,47 @@ class ComputePipeline:
             raise
         device.own(self)
 
-    def bind(self, buffers: list[Buffer]) -> None:
-        """Point binding i of set 0 at buffers[i] (whole buffer)."""
+    def bind(self, resources) -> None:
+        """Point set 0 at resources: a list for every binding (resources[i] at binding i), or a dict
+        {binding: resource} that updates only those bindings.
+
+        Buffers are bound whole; an Image as its view in SHADER_READ_ONLY_OPTIMAL; a Sampler alone.
+        Every binding must have been written before :meth:`dispatch`.
+        """
         vk = self.vk
-        if len(buffers) != len(self.bindings):
-            raise ValueError(f"pipeline has {len(self.bindings)} bindings, got {len(buffers)} buffers")
-        # range = the byte size: VK_WHOLE_SIZE overflows the binding's conversion (TOOLCHAIN.md).
-        infos = [vk.VkDescriptorBufferInfo(buffer=b.handle, offset=0, range=b.size) for b in buffers]
-        writes = [vk.VkWriteDescriptorSet(dstSet=self.set, dstBinding=i, dstArrayElement=0, descriptorCount=1,
-                                          descriptorType=t, pBufferInfo=[info])
-                  for i, (t, info) in enumerate(zip(self._types, infos))]
-        vk.vkUpdateDescriptorSets(self.device.handle, len(writes), writes, 0, None)
+        if isinstance(resources, dict):
+            items = sorted(resources.items())
+        else:
+            resources = list(resources)
+            if len(resources) != len(self.bindings):
+                raise ValueError(f"pipeline has {len(self.bindings)} bindings, got {len(resources)} resources")
+            items = list(enumerate(resources))
+        infos, writes = [], []  # the infos must outlive vkUpdateDescriptorSets (cffi frees nested data)
+        for i, res in items:
+            if not 0 <= i < len(self.bindings):
+                raise ValueError(f"binding {i} is not one of the pipeline's 0..{len(self.bindings) - 1}")
+            kind = self.bindings[i]
+            if not isinstance(res, _RESOURCE[kind]) or res.handle is None:
+                dead = " (destroyed)" if getattr(res, "handle", 0) is None else ""
+                raise TypeError(f"binding {i} is {kind}: it takes a live {_RESOURCE[kind].__name__}, "
+                                f"got {type(res).__name__}{dead}")
+            t = self._types[i]
+            write = dict(dstSet=self.set, dstBinding=i, dstArrayElement=0, descriptorCount=1, descriptorType=t)
+            if kind in (STORAGE, UNIFORM):
+                # range = the byte size: VK_WHOLE_SIZE overflows the binding's conversion (TOOLCHAIN.md).
+                info = vk.VkDescriptorBufferInfo(buffer=res.handle, offset=0, range=res.size)
+                write["pBufferInfo"] = [info]
+            elif kind == SAMPLED_IMAGE:
+                info = vk.VkDescriptorImageInfo(sampler=None, imageView=res.view, imageLayout=res.layout)
+                write["pImageInfo"] = [info]
+            else:
+                info = vk.VkDescriptorImageInfo(sampler=res.handle, imageView=None,
+                                                imageLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED)
+                write["pImageInfo"] = [info]
+            infos.append(info)
+            writes.append(vk.VkWriteDescriptorSet(**write))
+        if writes:
+            vk.vkUpdateDescriptorSets(self.device.handle, len(writes), writes, 0, None)
 
     def dispatch(self, groups_x: int, groups_y: int = 1, groups_z: int = 1, timed: bool = False) -> float | None:
         """Run the pipeline over the given workgroup counts and wait; seconds of device time if `timed`."""
