@@ -302,7 +302,7 @@ def test_float_literals_are_created_in_the_working_dtype():
     assert "import" not in emitted.text and "np.pi" not in emitted.text
 
 
-def test_sampling_is_rejected_at_emit_time_only_when_used(tmp_path):
+def test_textures_are_arrays_of_texels_sampled_bilinearly(tmp_path):
     text = '''"""Samples."""
 BRICK = {"kind": "test"}
 
@@ -316,10 +316,10 @@ def samples(t: texture2d, uv: vec2) -> vec4:
 '''
     module = parse_module(text, "tex.py")
     target = NumpyTarget()
-    fns = target.load(target.emit([], [module.functions["passes"]]), np.float64)
+    fns = target.load(target.emit([], list(module.functions.values())), np.float64)
     assert fns["passes"](None, np.array([1.5])).tolist() == [3.0]
-    with pytest.raises(NotImplementedError, match="does not sample textures"):
-        target.emit([], list(module.functions.values()))
+    img = np.arange(16.0).reshape(2, 2, 4)
+    np.testing.assert_array_equal(fns["samples"](img, np.array([[0.25, 0.25]])), [img[0, 0]])
 
 
 # ---------------------------------------------------------------- corner cases

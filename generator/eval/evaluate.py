@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import DTYPES, GPU_TARGETS, TARGETS  # defined in the package, where the CLI reads them without numpy
+from .. import DTYPES, GPU_TARGETS, EVAL_TARGETS  # defined in the package, where the CLI reads them without numpy
 from ..library.bricks import library_or_builtin
 from ..compose import compose_eval
 from ..link import EvalProgram, eval_program
@@ -197,8 +197,8 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
     dtype: float64 (default) for reference and numpy; float32/float16 for numpy;
     GPU targets compute in float32 (the default for them; any other is an error).
     """
-    if target not in TARGETS:
-        raise EvalError(f"unknown target {target!r}", f"use one of {', '.join(TARGETS)}")
+    if target not in EVAL_TARGETS:
+        raise EvalError(f"unknown target {target!r}", f"use one of {', '.join(EVAL_TARGETS)}")
     if dtype is not None:
         dtype = np.dtype(dtype).name if isinstance(dtype, type) or hasattr(dtype, "name") else str(dtype)
     if target in GPU_TARGETS:

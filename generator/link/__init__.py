@@ -66,7 +66,7 @@ def _eval_interface(specs: dict[str, ParamSpec], tangent: bool, reads: list[str]
                                                   "array_stride": 16}])
     result = Block("Result", 0, 1, "storage", [{"name": "data", "type": "vec4[]", "offset": 0, "size": 0,
                                                 "array_stride": 16}], readonly=False)
-    texs = [Texture(n, n, "material", bool(d.get("srgb")), d.get("dim", "2d")) for n, _, d in textures]
+    texs = [Texture(n, n, "material", bool(d.get("srgb")), ty.dim) for n, ty, d in textures]
     assign_bindings(texs, {"material": 3})
     for t in texs:
         t.set = 0

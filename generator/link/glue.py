@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..lang import SourceError, ir
-from ..lang.types import FLOAT, INT, MAT4, TEXTURE2D, UINT, VEC3, VEC4, Type, storage_buffer, struct
+from ..lang.types import FLOAT, INT, MAT4, TEXTURE2D, TEXTURECUBE, UINT, VEC3, VEC4, Type, storage_buffer, struct
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
 from ..library.params import ParamSpec, flat, spec_params
 from ..matrix.permutation import Node, Resolved
@@ -153,8 +153,7 @@ class _Binder:
                 name = ("t_" if group == "material" else prefix) + p.name
                 if name not in {t.name for t in self.textures}:
                     decl = _texture_decl([node], p.name)
-                    self.textures.append(Texture(name, p.name, group, bool(decl.get("srgb")),
-                                                 decl.get("dim", "2d"), light))
+                    self.textures.append(Texture(name, p.name, group, bool(decl.get("srgb")), p.ty.dim, light))
                 out.append(self.b.var(name, p.ty, "param"))
             elif p.name == "N":
                 self.surface.add("N")
@@ -304,7 +303,7 @@ def _light_buffer(prog: Program, b: Builder, i: int, lb, sh, out: list) -> dict[
 
 
 def _texture_type(t: Texture) -> Type:
-    return TEXTURE2D
+    return TEXTURECUBE if t.dim == "cube" else TEXTURE2D
 
 
 def bind_texture(bind: _Binder, name: str, ty: Type, nodes) -> ir.Var:
@@ -312,7 +311,7 @@ def bind_texture(bind: _Binder, name: str, ty: Type, nodes) -> ir.Var:
     tname = f"t_{name}"
     if tname not in {t.name for t in bind.textures}:
         decl = _texture_decl(nodes, name)
-        bind.textures.append(Texture(tname, name, "material", bool(decl.get("srgb")), decl.get("dim", "2d")))
+        bind.textures.append(Texture(tname, name, "material", bool(decl.get("srgb")), ty.dim))
     return bind.b.var(tname, ty, "param")
 
 

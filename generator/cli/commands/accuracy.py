@@ -19,14 +19,14 @@ from pathlib import Path
 from ... import DTYPES, GPU_TARGETS
 
 HELP = "error of every target × dtype against the float64 references: hemisphere and stress set (Markdown/JSON)"
-TARGETS = ("numpy",) + GPU_TARGETS
+EVAL_TARGETS = ("numpy",) + GPU_TARGETS
 MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 s (K grows memory as K⁴)
 
 
 def add_arguments(p) -> None:
     p.add_argument("specs", nargs="*", metavar="SPEC", help="BRDF specs (default: every BRDF brick)")
     p.add_argument("--targets", metavar="LIST",
-                   help=f"comma-separated, from {', '.join(TARGETS)} (default: numpy, plus the GPU "
+                   help=f"comma-separated, from {', '.join(EVAL_TARGETS)} (default: numpy, plus the GPU "
                         "languages when lavapipe is present)")
     p.add_argument("--dtypes", default=",".join(DTYPES), metavar="LIST",
                    help="comma-separated, from float64, float32, float16 (GPU targets run float32 only)")
@@ -64,7 +64,7 @@ def run(args) -> int:
         dtypes = _list(args.dtypes, DTYPES, "dtype")
         notes = []
         if args.targets:
-            targets = _list(args.targets, TARGETS, "target")
+            targets = _list(args.targets, EVAL_TARGETS, "target")
         else:
             targets = accuracy.default_targets()
             if targets == ["numpy"]:

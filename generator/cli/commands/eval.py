@@ -13,7 +13,7 @@ import io
 import sys
 from pathlib import Path
 
-from ... import DTYPES, TARGETS
+from ... import DTYPES, EVAL_TARGETS
 
 HELP = "evaluate a BRDF spec on samples (.npy in, float64 f_r .npy out): reference, numpy or a GPU kernel"
 
@@ -22,7 +22,7 @@ def add_arguments(p) -> None:
     p.add_argument("spec", help="BRDF spec, e.g. 'lambert+microfacet(ndf=ggx)'")
     p.add_argument("--input", required=True, metavar="S.npy", help="samples: (N, 9) [L, V, N] or (N, 12) [L, V, N, T]")
     p.add_argument("--output", required=True, metavar="F.npy", help="f_r as float64 (N, 3)")
-    p.add_argument("--target", required=True, choices=TARGETS,
+    p.add_argument("--target", required=True, choices=EVAL_TARGETS,
                    help="reference (float64), numpy (IR at --dtype), or a language's eval kernel on lavapipe")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a parameter (canonical name); RGB as f0=0.9,0.6,0.3; a scalar splats (repeatable)")
