@@ -354,3 +354,71 @@ def test_array_parameter_lobes_on_lavapipe(lib, frame, language):
                         dtype="float32", lib=lib)
         # pow with exponents up to 200 in float32: relative 1e-4 of each lobe's value
         np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-6)
+
+
+# ------------------------------------------------------------------ on lavapipe: the switch and a lookup texture
+
+@pytest.mark.lavapipe
+@pytest.mark.toolchain
+@pytest.mark.parametrize("language", LANGS)
+def test_switch_kernel_equals_the_three_specialized_kernels_per_sample(lib, frame, language):
+    """One kernel, the BRDF chosen per sample by an id read from the samples buffer (L.w)."""
+    from generator.eval.evaluate import evaluate
+    from generator.eval.switch import evaluate_switch
+    from generator.runtime.probe import lavapipe_present
+    from tests.conftest import require
+
+    require(lavapipe_present(), "no lavapipe Vulkan device")
+    L, V, N, _, ids = frame
+    p = {"alpha": 0.3, "f0": [0.9, 0.6, 0.3]}
+    got = evaluate_switch(NDFS, ids, L, V, N, params=p, target=language, lib=lib)
+    each = np.stack([evaluate(s, L, V, N, params=p, target=language, lib=lib) for s in NDFS])
+    want = each[ids, np.arange(len(ids))]
+    assert np.array_equal(got, want)  # bit for bit: the same float32 code runs for each sample
+    assert np.any(got != evaluate_switch(NDFS, (ids + 1) % 3, L, V, N, params=p, target=language, lib=lib))
+
+
+@pytest.fixture(scope="module")
+def lut():
+    rng = np.random.default_rng(11)
+    return rng.uniform(0.0, 1.0, (16, 32, 4)).astype(np.float32)
+
+
+def test_lut_brdf_in_numpy_samples_bilinearly(lib, frame, lut):
+    from generator.eval.evaluate import EvalError, evaluate
+
+    L, V, N, _, _ = frame
+    got = evaluate("lut_diffuse", L, V, N, params={"rho_d": 0.8}, target="numpy", lib=lib, textures={"lut": lut})
+    # float64 bilinear, clamp-to-edge, texel centres at (i + 0.5)/W (written here, not from the target)
+    nl, nv = np.minimum(np.sum(N * L, 1), 1.0), np.clip(np.sum(N * V, 1), 1e-4, 1.0)
+    h, w = lut.shape[:2]
+    x, y = np.clip(nl * w - 0.5, 0, w - 1), np.clip(nv * h - 0.5, 0, h - 1)
+    x0, y0 = np.floor(x).astype(int), np.floor(y).astype(int)
+    x1, y1 = np.minimum(x0 + 1, w - 1), np.minimum(y0 + 1, h - 1)
+    fx, fy = (x - x0)[:, None], (y - y0)[:, None]
+    t = lut.astype(np.float64)[..., :3]
+    s = (t[y0, x0] * (1 - fx) + t[y0, x1] * fx) * (1 - fy) + (t[y1, x0] * (1 - fx) + t[y1, x1] * fx) * fy
+    want = np.where(np.sum(N * L, 1)[:, None] > 0, 0.8 * s / np.pi, 0.0)
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-15)
+    with pytest.raises(EvalError, match="samples texture lut"):
+        evaluate("lut_diffuse", L, V, N, target="numpy", lib=lib)
+
+
+@pytest.mark.lavapipe
+@pytest.mark.toolchain
+@pytest.mark.parametrize("language", LANGS)
+def test_lut_brdf_on_lavapipe_agrees_with_numpy(lib, frame, lut, language):
+    """The eval kernel binds the table at set 0, bindings 3 (image) and 4 (sampler)."""
+    from generator.eval.evaluate import evaluate, program
+    from generator.runtime.probe import lavapipe_present
+    from tests.conftest import require
+
+    require(lavapipe_present(), "no lavapipe Vulkan device")
+    tex = program("lut_diffuse", lib).interface.textures[0]
+    assert (tex.set, tex.binding, tex.dim) == (0, 3, "2d")
+    L, V, N, _, _ = frame
+    got = evaluate("lut_diffuse", L, V, N, target=language, lib=lib, textures={"lut": lut})
+    want = evaluate("lut_diffuse", L, V, N, target="numpy", dtype="float32", lib=lib, textures={"lut": lut})
+    # lavapipe filters float textures in float32 (runtime tests: 4e-7 on a small table, values in [0, 1]):
+    # stated tolerance 1e-6 of the largest value, relative
+    np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6 * np.abs(want).max())

@@ -158,7 +158,32 @@ def _numpy_brdf(ep: EvalProgram, lib, dtype: str):
     return lib.memo[key]
 
 
-def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int) -> np.ndarray:
+def resolve_textures(ep: EvalProgram, textures: dict | None) -> list:
+    """The texel arrays of the textures the BRDF samples, in kernel order (EvalError when one is missing)."""
+    textures = dict(textures or {})
+    names = [n for n, _, _ in ep.textures]
+    unknown = sorted(set(textures) - set(names))
+    if unknown:
+        raise EvalError(f"unknown texture{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
+                        f"for BRDF '{ep.spec}'", f"its textures: {', '.join(names) or 'none'}")
+    missing = [n for n in names if n not in textures]
+    if missing:
+        raise EvalError(f"BRDF '{ep.spec}' samples texture{'s' if len(missing) > 1 else ''} {', '.join(missing)}",
+                        "pass textures={name: array (H, W, 4)} (float32 texels, or uint8 for an 8-bit image)")
+    return [textures[n] for n in names]
+
+
+def _numpy_texels(data, srgb: bool):
+    """What the GPU samples, as floats: uint8 texels are normalized (and sRGB-decoded for an sRGB texture)."""
+    a = np.asarray(data)
+    if a.dtype == np.uint8:
+        a = a.astype(np.float64) / 255.0
+        if srgb:
+            a = np.where(a <= 0.04045, a / 12.92, ((a + 0.055) / 1.055) ** 2.4)
+    return a
+
+
+def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int, texels=()) -> np.ndarray:
     f = np.dtype(dtype).type
     args = [v.astype(f) for v in vecs[:3]]
     if ep.tangent:
@@ -166,6 +191,7 @@ def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int) -> np.nda
         with np.errstate(all="ignore"):
             args += [T, np.cross(args[2], T).astype(f)]  # B = cross(N, T), as in the eval kernels
     args += [_numpy_arg(ty, values[n], f) for n, _, _, ty, _ in flat(ep.specs)]
+    args += [_numpy_texels(x, bool(d.get("srgb"))).astype(f) for x, (_, _, d) in zip(texels, ep.textures)]
     out = _numpy_brdf(ep, lib, dtype)(*args)
     return np.broadcast_to(np.asarray(out, np.float64), (n, 3)).copy()
 
@@ -180,19 +206,26 @@ def gpu_kernel(spec: str, language: str, lib=None, device=None):
     key = ("eval", lib.serial, ep.spec, language)  # kernels live on their device
     if key not in device.cache:
         src = compose_eval(ep.spec, lib, (language,), ep=ep).sources[0]
-        device.cache[key] = compile_kernel(src, device, ep.tangent, ep.param_vec4s)
+        device.cache[key] = compile_kernel(src, device, ep.tangent, ep.param_vec4s, textures=len(ep.textures))
     return device.cache[key]
 
 
-def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values) -> np.ndarray:
+def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, texels=()) -> np.ndarray:
+    from ..runtime.eval_kernel import Texture
+
     kernel = gpu_kernel(ep.spec, language, lib)
     f32 = [v.astype(np.float32) for v in vecs]
-    return kernel.run(f32, _param_block(ep, values)).astype(np.float64)
+    textures = [Texture(np.asarray(x), bool(d.get("srgb"))) for x, (_, _, d) in zip(texels, ep.textures)]
+    return kernel.run(f32, _param_block(ep, values), textures=textures or None).astype(np.float64)
 
 
 def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str = "reference",
-             dtype: str | None = None, lib=None) -> np.ndarray:
+             dtype: str | None = None, lib=None, textures: dict | None = None) -> np.ndarray:
     """f_r (N, 3) float64 of BRDF `spec` for unit vectors L, V, N (and T) of shape (N, 3).
+
+    textures: {name: texels (H, W, 4)} for a BRDF that samples lookup tables; the GPU samples
+    them bilinearly with clamp-to-edge at level 0 (runtime.device.Sampler) and the NumPy target
+    filters the same texels the same way.
 
     dtype: float64 (default) for reference and numpy; float32/float16 for numpy;
     GPU targets compute in float32 (the default for them; any other is an error).
@@ -222,9 +255,10 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
     n = len(vecs[0])
     if n == 0:
         return np.zeros((0, 3), np.float64)
+    texels = resolve_textures(ep, textures)
     if target == "reference":
         return _run_reference(ep, vecs, values, n)
     if target == "numpy":
-        return _run_numpy(ep, lib, vecs, values, dtype, n)
-    return _run_gpu(ep, lib, target, vecs, values)
+        return _run_numpy(ep, lib, vecs, values, dtype, n, texels)
+    return _run_gpu(ep, lib, target, vecs, values, texels)
 
