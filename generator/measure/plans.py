@@ -25,7 +25,7 @@ Models of the course's table (``course_costs.toml``) are measured the same
 way, whole: shift-invariant as the eval kernel of the model's spec minus the
 stand-in BRDF; shift-variant as the synthetic fragment shader with the
 model's BRDF and the textured packing minus the all-stand-in one. The
-stand-ins live in ``generator/cost_bricks/`` (slot fillers are generated
+stand-ins live in ``generator/measure/standins/`` (slot fillers are generated
 from the slot signature) and are loaded only here.
 """
 from __future__ import annotations
@@ -184,7 +184,7 @@ def _compose(fn) -> Composed | str:
 # ------------------------------------------------------------------ per brick
 
 def standin(lib: Library, kind: str) -> Brick | None:
-    """The stand-in brick of a kind (generator/cost_bricks, or generated for slot kinds)."""
+    """The stand-in brick of a kind (generator/measure/standins, or generated for slot kinds)."""
     return next((b for b in lib.of_kind(kind) if is_standin(b)), None)
 
 

@@ -148,7 +148,7 @@ LEGEND = [
     "when HLSL, GLSL and WGSL agree, otherwise HLSL / GLSL / WGSL. tex, ALU, transc. (transcendental) and "
     "instr. count instructions (a vec3 operation is one); ALU ops is the scalarized ALU count (a vec3 add is "
     "3, a dot of vec3 5); regs is an estimate of the peak number of live 32-bit scalars. Rules: "
-    "`generator/cost/classify.py`, `generator/cost/liveness.py`.",
+    "`generator/analysis/classify.py`, `generator/analysis/liveness.py`.",
     "",
     "Course: Hoffman & Baker 2006, \"BRDF Costs\" tables, texture / ALU for one point light in hand-counted "
     "pixel-shader instructions, where every arithmetic instruction (transcendentals too) is ALU: compare it "
@@ -181,7 +181,7 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
     if bricks:
         out += ["## Per brick", "",
                 "What a brick adds: the shader with the brick minus the same shader with a trivial stand-in "
-                "of its kind (`generator/costs.py` says which shader for each kind: eval kernels for BRDF "
+                "of its kind (`generator/measure/plans.py` says which shader for each kind: eval kernels for BRDF "
                 "terms and slot fillers, a one-light fragment shader for the others). Negative values: the "
                 "brick lets the optimizer remove more than it adds.", ""]
         lines = [[next(iter(v.values())).kind, f"`{k[1]}`", *_metric_cells(v)] for k, v in bricks]
