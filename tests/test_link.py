@@ -470,3 +470,12 @@ def test_cube_texture_brdf_on_lavapipe_agrees_with_numpy(lib, frame, language):
     assert inner.sum() > len(r) // 2
     np.testing.assert_allclose(got[inner], want[inner], rtol=1e-6, atol=1e-9)
     assert len(np.unique(np.round(got[inner & (got[:, 0] > 0), 0], 6))) >= 5
+
+
+def test_linked_programs_are_memoized_per_library_object(lib):
+    from generator.eval.evaluate import program
+
+    other = load_library([LINK_BRICKS])
+    assert program("lobes", lib) is program("lobes", lib)
+    assert program("lobes", other) is not program("lobes", lib)
+    assert lib.serial != other.serial and ("eval_program", "lobes") in lib.memo
