@@ -8,7 +8,7 @@ GPU_TARGETS = ("glsl", "hlsl", "wgsl")
 DTYPES = ("float64", "float32", "float16")
 
 
-def evaluate(spec, L, V, N, T=None, params=None, target="reference", dtype=None, lib=None):
+def evaluate(spec, L, V, N, T=None, params=None, target="reference", dtype=None, lib=None, textures=None):
     """f_r (N, 3) float64 of a BRDF spec on samples; see generator.eval.evaluate.evaluate."""
     from .eval.evaluate import evaluate as _evaluate  # lazy: numpy and the targets load on first use
-    return _evaluate(spec, L, V, N, T=T, params=params, target=target, dtype=dtype, lib=lib)
+    return _evaluate(spec, L, V, N, T=T, params=params, target=target, dtype=dtype, lib=lib, textures=textures)

@@ -479,3 +479,49 @@ def test_linked_programs_are_memoized_per_library_object(lib):
     assert program("lobes", lib) is program("lobes", lib)
     assert program("lobes", other) is not program("lobes", lib)
     assert lib.serial != other.serial and ("eval_program", "lobes") in lib.memo
+
+
+MIXED = ["lobes(lobes=2)", "lambert", "lut_diffuse", "lut_diffuse+blinn_phong_normalized", "lobes(lobes=1)"]
+
+
+GPU = [pytest.param(x, marks=[pytest.mark.lavapipe, pytest.mark.toolchain]) for x in LANGS]
+
+
+@pytest.mark.parametrize("target", ["numpy"] + GPU)
+def test_switch_over_arrays_counts_and_a_shared_texture(lib, frame, lut, target):
+    """Each BRDF keeps its own parameters (b<k>_<name>); a texture sampled by two BRDFs is bound once;
+    per sample the switch equals that BRDF's own program (NumPy float64; on lavapipe bit for bit)."""
+    from generator.eval.evaluate import evaluate
+    from generator.eval.switch import evaluate_switch, switch_kernel_program
+
+    if target != "numpy":
+        from generator.runtime.probe import lavapipe_present
+        from tests.conftest import require
+        require(lavapipe_present(), "no lavapipe Vulkan device")
+    ep = switch_kernel_program(MIXED, lib)
+    assert [t.param for t in ep.interface.textures] == ["lut"]
+    L, V, N, _, _ = frame
+    ids = np.arange(len(L)) % len(MIXED)
+    p = {"rho_d": 0.7, "b0_lobes": LOBES, "b4_lobes": LOBES[::-1]}
+    got = evaluate_switch(MIXED, ids, L, V, N, params=p, target=target, lib=lib, textures={"lut": lut})
+    for k, spec in enumerate(MIXED):
+        own = {n: p[f"b{k}_{n}"] if f"b{k}_{n}" in p else p[n] for n in ep.own[k] if f"b{k}_{n}" in p or n in p}
+        m = ids == k
+        want = evaluate(spec, L[m], V[m], N[m], params=own, target=target, lib=lib,
+                        textures={"lut": lut} if "lut" in spec else None)
+        if target == "numpy":
+            np.testing.assert_allclose(got[m], want, rtol=1e-12, atol=0.0)
+        else:
+            assert np.array_equal(got[m], want), spec
+
+
+@pytest.mark.toolchain
+def test_one_brick_at_two_array_counts_links_into_one_program(lib):
+    from generator.link import Program
+    from generator.matrix.permutation import parse_brdf
+
+    prog = Program()
+    for spec in ("lobes(lobes=1)", "lobes(lobes=2)", "lobes"):
+        prog.link(parse_brdf(spec, lib)[0])
+    names = [f.name for f in prog.functions]
+    assert len(names) == len(set(names)) == 3 and all(n.startswith("lobes_") for n in names)

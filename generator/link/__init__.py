@@ -16,7 +16,7 @@ from ..lang.types import Type
 from ..library.bricks import Library
 from ..library.params import ParamSpec, flat
 from ..matrix.permutation import Node, Permutation, check_packing, parse_brdf, resolve
-from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue
+from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue, switch_params, switch_textures
 from .interface import (FRAME_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
                         vec4_array_block)
 from .program import Program, function_name
@@ -43,6 +43,7 @@ class EvalProgram:
     entry: str = "brdf"
     textures: tuple = ()  # (name, type, declaration) of textures the BRDF reads
     specs_of: tuple = ()  # for a switch: the canonical spec of each id
+    own: tuple = ()  # for a switch: per id, the names of its BRDF's parameters
 
     @property
     def params(self) -> dict[str, Type]:
@@ -59,7 +60,7 @@ class EvalProgram:
         return {k: p.range for k, p in self.specs.items()}
 
 
-def _eval_interface(specs: dict[str, ParamSpec], tangent: bool, reads: list[str], textures) -> tuple[list[Slot], int, Interface]:
+def _eval_interface(specs: dict[str, ParamSpec], reads: list[str], textures) -> tuple[list[Slot], int, Interface]:
     slots, count = layout([(n, k, e, ty, p, None) for n, k, e, ty, p in flat(specs)])
     params = vec4_array_block("Params", 0, 2, slots, max(count, 1), header=[EVAL_INFO])
     samples = Block("Samples", 0, 0, "storage", [{"name": "data", "type": "vec4[]", "offset": 0, "size": 0,
@@ -81,7 +82,7 @@ def eval_program(spec: str, lib: Library) -> EvalProgram:
     canon = "+".join(n.canonical() for n in nodes)
     prog = Program()
     g: BrdfGlue = brdf_glue(prog, nodes)
-    slots, count, iface = _eval_interface(g.params, g.tangent, g.reads, g.textures)
+    slots, count, iface = _eval_interface(g.params, g.reads, g.textures)
     return EvalProgram(canon, nodes, prog, g.params, g.signature, slots, count, g.tangent, iface,
                        textures=tuple(g.textures))
 
@@ -92,15 +93,15 @@ def switch_program(specs: list[str], lib: Library) -> EvalProgram:
     canon = [("+".join(n.canonical() for n in nodes)) for nodes in brdfs]
     prog = Program()
     f, glues = brdf_switch(prog, brdfs)
-    from ..library.params import spec_params
-    union = spec_params([n for nodes in brdfs for n in nodes])
+    union = switch_params(glues)
     tangent = any(g.tangent for g in glues)
-    reads = sorted({r for g in glues for r in g.reads}, key=lambda r: [x for g in glues for x in g.reads].index(r))
-    textures = [t for g in glues for t in g.textures]
-    slots, count, iface = _eval_interface(union, tangent, reads, textures)
+    reads = list(dict.fromkeys(r for g in glues for r in g.reads))
+    textures = switch_textures(glues)
+    slots, count, iface = _eval_interface(union, reads, textures)
     sig = [(p.name, p.ty) for p in f.params]
     return EvalProgram("|".join(canon), [n for nodes in brdfs for n in nodes], prog, union, sig, slots, count,
-                       tangent, iface, entry="brdf_switch", textures=tuple(textures), specs_of=tuple(canon))
+                       tangent, iface, entry="brdf_switch", textures=tuple(textures), specs_of=tuple(canon),
+                       own=tuple(tuple(g.params) for g in glues))
 
 
 @dataclass

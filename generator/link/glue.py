@@ -12,6 +12,7 @@ inputs, parameters and textures.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 from ..lang import SourceError, ir
@@ -22,9 +23,6 @@ from ..matrix.permutation import Node, Resolved
 from .interface import Texture
 from .irgen import Builder
 from .program import Program
-
-TEXTURE_TYPES = ("texture",)
-
 
 def _texture_decl(nodes, name: str) -> dict:
     for top in nodes:
@@ -318,33 +316,50 @@ def bind_texture(bind: _Binder, name: str, ty: Type, nodes) -> ir.Var:
 # ------------------------------------------------------------------ several BRDFs in one program
 
 
-def brdf_switch(prog: Program, brdfs: list[list[Node]], b: Builder | None = None) -> tuple[ir.Function, list[BrdfGlue]]:
-    """`brdf_switch(id: int, L, V, N[, T, B], params...) -> vec3`: brdf_<k> for id k, 0 for another id.
+def switch_params(glues: list[BrdfGlue]) -> dict[str, ParamSpec]:
+    """The parameters of a switch: BRDF k's parameter `name` is `b<k>_<name>`, so each BRDF keeps
+    its own values, type, range and default (unrelated BRDFs may share a name)."""
+    out = {}
+    for k, g in enumerate(glues):
+        for name, spec in g.params.items():
+            out[f"b{k}_{name}"] = dataclasses.replace(spec, name=f"b{k}_{name}")
+    return out
 
-    The parameters are the union over the BRDFs (a shared name must agree on type:
-    library/params.py checks it across all of them).
+
+def switch_textures(glues: list[BrdfGlue]) -> list[tuple[str, Type, dict]]:
+    """The textures of a switch, each once (a texture name is one table in every BRDF that samples it)."""
+    out = []
+    for g in glues:
+        for tex in g.textures:
+            if tex[0] not in {x[0] for x in out}:
+                out.append(tex)
+    return out
+
+
+def brdf_switch(prog: Program, brdfs: list[list[Node]], b: Builder | None = None) -> tuple[ir.Function, list[BrdfGlue]]:
+    """`brdf_switch(id: int, L, V, N[, T, B], b0_params..., b1_params..., textures...) -> vec3`.
+
+    id k evaluates brdf_<k> with its own parameters (switch_params); another id gives 0.
     """
     b = b or Builder()
     glues = [brdf_glue(prog, nodes, suffix=f"_{k}", b=b) for k, nodes in enumerate(brdfs)]
-    union = spec_params([n for nodes in brdfs for n in nodes])
     tangent = any(g.tangent for g in glues)
     frame = [(n, BY_NAME[n].ty) for n in FRAME + (TANGENT_FRAME if tangent else ())]
-    textures = []
-    for g in glues:
-        for t in g.textures:
-            if t[0] not in {x[0] for x in textures}:
-                textures.append(t)
-    sig = [("id", INT)] + frame + [(k, p.ty) for k, p in union.items()] + [(n, t) for n, t, _ in textures]
+    textures = switch_textures(glues)
+    sig = [("id", INT)] + frame + [(n, ty) for n, _, _, ty, _ in flat(switch_params(glues))] \
+        + [(n, ty) for n, ty, _ in textures]
     env = dict(sig)
 
     def body():
         cases = []
         for k, g in enumerate(glues):
-            call = b.call(g.guarded, [b.var(n, env[n]) for n, _ in g.signature])
-            cases.append(((k,), [b.ret(call)]))
+            own = {n for n, _, _, _, _ in flat(g.params)}
+            args = [b.var(f"b{k}_{n}" if n in own else n, env[f"b{k}_{n}" if n in own else n])
+                    for n, _ in g.signature]
+            cases.append(((k,), [b.ret(b.call(g.guarded, args))]))
         return [ir.Switch(b.loc(), b.var("id", INT), cases, [b.ret(b.construct(VEC3, b.const(0.0)))])]
     f = prog.add(b.function("brdf_switch", sig, VEC3, body))
     return f, glues
 
 
-__all__ = ["BrdfGlue", "ShadeGlue", "brdf_glue", "shade_glue", "brdf_switch", "TEXTURE_TYPES", "VEC4"]
+__all__ = ["BrdfGlue", "ShadeGlue", "brdf_glue", "shade_glue", "brdf_switch", "switch_params", "switch_textures"]

@@ -1,7 +1,7 @@
 """One IR program from any set of resolved brick nodes.
 
-Function names are keyed by the canonical node: a brick without fillers keeps
-`<id>_<function>`; a brick with fillers is `<id>_<6 hex of sha256(canonical)>_<function>`,
+Function names are keyed by the canonical node: a brick without fillers or array
+counts keeps `<id>_<function>`; any other is `<id>_<6 hex of sha256(canonical)>_<function>`,
 so several fillers of one host (microfacet with ggx and with beckmann) coexist in
 one program, and the same node always gets the same name.
 
@@ -26,7 +26,7 @@ from ..matrix.permutation import Node
 
 def function_name(node: Node, fname: str) -> str:
     """The linked name of function `fname` of `node` (see the module docstring)."""
-    if not node.fillers:
+    if not node.fillers and not node.counts:
         return f"{node.brick.id}_{fname}"
     digest = hashlib.sha256(node.canonical().encode()).hexdigest()[:6]
     return f"{node.brick.id}_{digest}_{fname}"
