@@ -525,3 +525,52 @@ def test_one_brick_at_two_array_counts_links_into_one_program(lib):
         prog.link(parse_brdf(spec, lib)[0])
     names = [f.name for f in prog.functions]
     assert len(names) == len(set(names)) == 3 and all(n.startswith("lobes_") for n in names)
+
+
+def test_loader_refuses_what_the_link_stage_cannot_bind(tmp_path):
+    buf = _brick(tmp_path, "diffuse/buf.py", '"""Buf."""\nBRICK = {"kind": "diffuse", "cite": "x"}\n\n\n'
+                 'class Entry:\n    v: vec4\n\n\ntable: uniform_buffer[Entry, 4]\n\n\n'
+                 'def diffuse(N: vec3) -> vec3:\n    return table[0].v.xyz\n')
+    with pytest.raises(SourceError, match=r"buf\.py:9:\d+: buffer 'table' is declared .* binds no brick buffers"):
+        load_brick(buf)
+    arr = _brick(tmp_path, "light/arr.py", '"""Arr."""\nBRICK = {"kind": "light", "cite": "x", "params": '
+                 '{"w": {"type": "float", "count": 2, "default": [1.0, 2.0]}}}\n\n\n'
+                 'def light_dir(P: vec3) -> vec3:\n    return P\n\n\ndef light_radiance(P: vec3) -> vec3:\n    return P\n')
+    with pytest.raises(SourceError, match="of a light brick has a count"):
+        load_brick(arr)
+
+
+def test_packing_that_provides_a_parameter_with_the_wrong_type_is_a_clear_error(tmp_path):
+    from generator.link import link_permutation
+    from generator.matrix.permutation import LightKey, Permutation
+
+    d = tmp_path / "b"
+    _brick(d, "packing/rough.py", '"""Rough."""\nBRICK = {"kind": "packing", "cite": "x", '
+           '"slots": {"normal": {"kind": "normal", "default": "vertex"}}}\n\n\n'
+           'def get_alpha(uv: vec2) -> vec3:\n    return vec3(uv, 0.0)\n')
+    lib = load_library([d])
+    with pytest.raises(SourceError) as e:
+        link_permutation(Permutation("microfacet", (LightKey("point", "none"),), "rough"), lib)
+    assert "provides alpha as vec3" in str(e.value) and "rough.py:5" in str(e.value)
+    assert "make get_alpha return float" in str(e.value)
+
+
+@pytest.mark.toolchain
+def test_scene_sets_output_parameters_per_material_and_the_upload_carries_them(lib, tmp_path):
+    from generator.build import build_scene
+    from generator.matrix.scene import load_scene
+    import json
+    import struct as st
+
+    scene = tmp_path / "s.toml"
+    scene.write_text('[scene]\nname = "t"\noutput = "exposure"\n[materials.m]\nbrdf = "lambert"\n'
+                     'params = { ev = 1.5 }\n[lights.sun]\ntype = "directional"\n[light_sets]\nall = ["sun"]\n'
+                     '[[objects]]\nname = "o"\nmaterial = "m"\nlights = "all"\n')
+    s = load_scene(scene, lib)
+    res = build_scene(s, lib, tmp_path / "out", languages=("glsl",))
+    assert res.ok, res.failures
+    m = json.loads((tmp_path / "out" / "manifest.json").read_text())
+    assert m["materials"]["m"]["params"]["ev"] == 1.5
+    perm = m["permutations"][0]
+    ev = next(x for x in perm["interface"]["frag"]["uniform_blocks"][-1]["parameters"] if x["name"] == "ev")
+    assert st.unpack_from("<f", bytes.fromhex(perm["uploads"][0]["Material"]), ev["offset"])[0] == 1.5

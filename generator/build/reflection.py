@@ -36,7 +36,7 @@ def scene_tables(scene: Scene, interfaces: dict) -> dict:
             continue
         iface = c.interface
         m = scene.materials[obj["material"]]
-        specs = {s.param: s.spec for s in c.material if s.spec is not None and s.name.startswith("m_")}
+        specs = {s.param: s.spec for s in c.material if s.spec is not None}
         materials.setdefault(m.name, {"brdf": m.brdf, "packing": m.packing,
                                       "params": material_values(scene, m.name, specs)})
         for i, ln in enumerate(obj["lights"]):
@@ -56,11 +56,8 @@ def uploads(scene: Scene, h: str, c) -> list[dict]:
         if obj["permutation"] != h or (obj["material"], obj["light_set"]) in seen:
             continue
         seen.add((obj["material"], obj["light_set"]))
-        specs = {s.param: s.spec for s in c.material if s.spec is not None}
-        mvals = material_values(scene, obj["material"], {s.param: s.spec for s in c.material
-                                                         if s.spec is not None and s.name.startswith("m_")})
-        values = {s.name: _element(mvals[s.param] if s.name.startswith("m_") else specs[s.param].default, s)
-                  for s in c.material}
+        mvals = material_values(scene, obj["material"], {s.param: s.spec for s in c.material if s.spec is not None})
+        values = {s.name: _element(mvals[s.param], s) for s in c.material}
         item = {"material": obj["material"], "light_set": obj["light_set"], "objects": []}
         mat = c.interface.block("Material")
         if mat is not None:

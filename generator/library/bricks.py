@@ -17,6 +17,8 @@ from ..lang.types import BUILTIN_TYPES, INT, Type, array
 from .inputs import SHADING, SURFACE
 from .kinds import KINDS
 
+BRDF_ARRAY_KINDS = ("diffuse", "specular", "ndf", "fresnel", "visibility")
+
 REPO = Path(__file__).resolve().parents[2]
 BUILTIN_BRICKS = REPO / "bricks"
 
@@ -155,6 +157,10 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     if not isinstance(cite, str) or not cite.strip():
         raise _meta_error(shown, loc, "BRICK has no 'cite'", 'add "cite": "Author Year, eq. N" (the source of the formula)')
     params = _params(shown, loc, meta.get("params", {}))
+    arrays = [n for n, prm in params.items() if prm.ty.kind == "array"]
+    if arrays and kind not in BRDF_ARRAY_KINDS:
+        raise _meta_error(shown, loc, f"parameter '{arrays[0]}' of a {kind} brick has a count",
+                          "array parameters are for BRDF terms and slot fillers (their count is part of the BRDF spec)")
     slots = _slots(shown, loc, meta.get("slots", {}))
     textures = meta.get("textures", {})
     if not isinstance(textures, dict):
@@ -165,6 +171,11 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         if k.slot:  # called from this brick's code, type-checked against the contract's arguments
             externals[sname] = Signature(k.signature(k.entries[0].name), k.entries[0].ret)
     module = parse_module(text, shown, externals)
+    for g in module.globals.values():
+        where = g.loc or loc
+        raise SourceError(shown, where.line, where.col, f"buffer '{g.name}' is declared at the top level of a {kind} brick, "
+                          "and the link stage binds no brick buffers yet",
+                          "pass the values as parameters (an array parameter: \"count\": N) or a texture")
     brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip())
     _check_entries(brick, loc)
     return brick
@@ -254,7 +265,7 @@ def _check_entries(b: Brick, loc) -> None:
     inputs = SHADING if k.reads == "shading" else SURFACE
     for f in b.entries:
         contract = k.entry(f.name)
-        if f.ret != contract.ret:
+        if contract.ret is not None and f.ret != contract.ret:
             raise SourceError(b.display_path, f.loc.line, f.loc.col, f"'{f.name}' must return {contract.ret}, not {f.ret}",
                               "fix the return annotation")
         args = {a.name: a.ty for a in contract.args}

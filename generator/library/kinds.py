@@ -29,7 +29,7 @@ class Arg:
 @dataclass(frozen=True)
 class Entry:
     name: str
-    ret: Type
+    ret: Type | None  # None: the type of what it provides (a packing's get_<input>)
     args: tuple[Arg, ...] = ()
 
 
@@ -38,7 +38,8 @@ class Kind:
     """One kind of brick.
 
     entries: the functions the generator calls; a packing's entries are every
-      function named `get_<material input>` (prefix_entries), returning that input.
+      function named `get_<material input>` (prefix_entries), returning that input
+      with the type the BRDF gives it (matrix/permutation.check_packing).
     reads: "shading" (the inputs table) or "surface" (P, N, T, B, uv).
     slot: a kind that fills a slot of a host brick (called from the host, not the glue).
     """
@@ -55,7 +56,7 @@ class Kind:
             if e.name == name:
                 return e
         if self.prefix_entries and name.startswith(self.prefix_entries):
-            return Entry(name, VEC3)
+            return Entry(name, None)  # returns the type of the material input it provides (checked when linked)
         return None
 
     def signature(self, entry: str) -> tuple[tuple[str, Type], ...]:

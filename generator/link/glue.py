@@ -181,7 +181,8 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     bind = _Binder(b)
     dynamic_lights: list[ir.Global] = []
     provided: dict[str, ir.Expr] = {}
-    packing_params = spec_params([r.packing])
+    spec_params(list(r.brdf) + [r.packing, out_node])  # one policy across the material's bricks (raises)
+    packing_params = {k: s for k, s in spec_params([r.packing]).items() if k not in bg.params}
     output_params = spec_params([out_node])
     lights = []
 

@@ -48,7 +48,7 @@ class Slot:
         if self.light is not None:
             d["light"] = self.light
         if self.spec is not None:
-            d["default"] = self.spec.default
+            d["default"] = self.spec.default if self.element is None else self.spec.default[self.element]
             d["range"] = list(self.spec.range) if self.spec.range else None
         return d
 

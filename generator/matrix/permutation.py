@@ -249,6 +249,10 @@ def check_packing(r: Resolved) -> tuple[str, str]:
         if name not in params:
             return (f"packing '{r.packing.brick.id}' provides {name}, which BRDF '{brdf}' does not read",
                     "use the constants packing for this BRDF")
+        if f.ret != params[name].ty:
+            return (f"packing '{r.packing.brick.id}' provides {name} as {f.ret} ({r.packing.brick.display_path}:"
+                    f"{f.loc.line}), but BRDF '{brdf}' reads {name} as {params[name].ty}",
+                    f"make get_{name} return {params[name].ty}")
     tangent = sorted({p.name for n in r.brdf for x in n.walk() for f in x.brick.entries for p in f.params
                       if p.name in SHADING and BY_NAME[p.name].tangent})
     frame = any(p.name in ("T", "B") for x in r.packing.walk() for f in x.brick.entries for p in f.params)

@@ -131,7 +131,9 @@ def load_scene(path, lib: Library) -> Scene:
                         lambda s: canonical(parse_spec(s, lib, ("packing",))))
         nodes = parse_brdf(brdf, lib)
         try:
-            specs = spec_params(nodes) | spec_params(parse_spec(packing, lib, ("packing",)))
+            # one policy over the BRDF, the packing and the output brick (whose parameters,
+            # exposure say, are set per material: they live in the Material block)
+            specs = spec_params(list(nodes) + parse_spec(packing, lib, ("packing",)) + [lib.get("output", output)])
         except SourceError as e:
             raise loc.error(where, e.message, e.hint) from None
         params = m.get("params", {})
