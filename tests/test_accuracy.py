@@ -139,6 +139,7 @@ def test_float16_is_reported_not_required():
 
 
 @pytest.mark.lavapipe
+@pytest.mark.toolchain  # compiles eval kernels
 def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device):
     rep = accuracy.run(SPECS, list(accuracy.GPU_TARGETS), ["float32"], LIB, hemisphere_k=6)
     for r in rep["results"]:
@@ -149,6 +150,7 @@ def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device):
 
 
 @pytest.mark.lavapipe
+@pytest.mark.toolchain  # compiles eval kernels
 def test_measure_releases_the_kernel_buffers_after_each_spec(device):
     from generator.eval.evaluate import gpu_kernel
 

@@ -110,6 +110,7 @@ def assert_close(got, want, kappa, what):
 
 @pytest.mark.parametrize("params", list(PARAM_SETS), ids=list(PARAM_SETS))
 @pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.toolchain  # compiles eval kernels
 def test_gpu_kernels_agree_with_numpy(device, samples, spec, params):
     from generator.eval.evaluate import evaluate, program, resolve_params
 
@@ -140,6 +141,7 @@ def probe_lib():
 
 
 @pytest.mark.parametrize("target", ("numpy",) + LANGS)
+@pytest.mark.toolchain  # compiles eval kernels
 def test_tangent_frame_and_parameter_layout(device, samples, probe_lib, target):
     """T is read from the fourth vec4 with B = cross(N, T); float, vec3 and mat4 parameters land in place."""
     from generator.eval.evaluate import evaluate
@@ -214,6 +216,7 @@ def save(path, a):
     return path
 
 
+@pytest.mark.toolchain  # compiles eval kernels
 def test_cli_round_trip_matches_the_python_function(tmp_path, samples):
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
@@ -252,6 +255,7 @@ def diffuse(rho_d: vec3) -> vec3:
 '''
 
 
+@pytest.mark.toolchain  # compiles eval kernels
 def test_cli_kernel_that_does_not_compile_is_one_line_error(tmp_path):
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)

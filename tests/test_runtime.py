@@ -107,6 +107,7 @@ def test_buffer_whose_memory_fails_leaks_nothing(monkeypatch, fails):
     assert dev.messages == [], "\n".join(map(str, dev.messages))
 
 
+@pytest.mark.toolchain  # compiles eval kernels
 def test_eval_kernel_chunks_large_inputs(device):
     """Inputs beyond one dispatch's workgroup limit run in chunks with the same results."""
     from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
@@ -126,6 +127,7 @@ def test_eval_kernel_chunks_large_inputs(device):
     np.testing.assert_array_equal(chunked, whole)
 
 
+@pytest.mark.toolchain  # compiles eval kernels
 def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
     """A chunk's samples and results each fit one storage descriptor (lavapipe: 128 MiB, 2.8 M samples)."""
     from types import SimpleNamespace
@@ -148,6 +150,7 @@ def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
     assert max_dispatch_samples(wide, 3) == 100 * WORKGROUP
 
 
+@pytest.mark.toolchain  # compiles eval kernels
 def test_eval_kernel_times_loaded_samples_and_releases_buffers(device):
     from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
 
