@@ -24,7 +24,7 @@ that approximate nothing (Lambert, the normalized Phong lobes) are compared
 with their own reference: their error is float32 arithmetic. Errors are over
 a jittered, stratified k⁴ grid of (L, V) over the hemisphere (k = 12: 20736
 pairs) of the GLSL kernel's output on lavapipe, with the exact model evaluated
-at the float32-rounded vectors the kernel gets (as in generator/accuracy.py):
+at the float32-rounded vectors the kernel gets (as in generator/eval/accuracy.py):
 - `rel_rms`: cosine-weighted relative RMS error over all samples and RGB
   channels, sqrt(Σ cosθ_l (f - f*)²) / sqrt(Σ cosθ_l f*²) — the error of the
   reflected radiance under uniform light;

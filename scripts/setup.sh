@@ -30,7 +30,7 @@ if ((${#missing[@]})); then
 fi
 
 # naga (WGSL front end + validator), pinned, from crates.io into .tools/bin
-# (generator/toolchain.py looks there before PATH). A naga of the pinned
+# (generator/toolchain/__init__.py looks there before PATH). A naga of the pinned
 # version already on PATH is used as is.
 naga_version() { "$1" --version 2>/dev/null || true; }
 if [[ "$(naga_version .tools/bin/naga)" != "$NAGA_VERSION" ]] &&

@@ -56,8 +56,21 @@ def test_fillers_of_one_host_link_into_one_program_deterministically(lib):
     assert {"ggx_ndf", "beckmann_ndf", "blinn_phong_ndf", "brdf_switch"} <= set(names)
     again = switch_program(NDFS, load_library([LINK_BRICKS]))
     glsl = get_target("glsl")
-    assert glsl.emit(ep.program.structs, ep.program.functions).text == \
-        glsl.emit(again.program.structs, again.program.functions).text
+    text = glsl.emit(ep.program.structs, ep.program.functions).text
+    assert text == glsl.emit(again.program.structs, again.program.functions).text
+    import hashlib
+    import os
+    import subprocess
+    import sys
+    code = ("import hashlib; from pathlib import Path; from generator.library.bricks import load_library; "
+            "from generator.link import switch_program; from generator.targets import get_target; "
+            f"ep = switch_program({NDFS!r}, load_library([Path({str(LINK_BRICKS)!r})])); "
+            "print(hashlib.sha256(get_target('glsl').emit(ep.program.structs, ep.program.functions).text.encode())"
+            ".hexdigest())")
+    for seed in ("1", "2"):  # another process, another hash seed: the same bytes
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=REPO)
+        assert out.stdout.strip() == hashlib.sha256(text.encode()).hexdigest(), out.stderr
 
 
 def test_switch_program_equals_the_specialized_programs_in_numpy(lib, frame):
@@ -83,7 +96,8 @@ def test_switch_kernel_compiles_and_validates_in_every_language(lib):
             for s in c.sources]
     results = compile_many(jobs)
     assert all(r.ok for r in results.values()), {k: r.errors() for k, r in results.items()}
-    assert "switch" in c.sources[0].text
+    heads = {"glsl": "switch (id) {", "hlsl": "switch (id) {", "wgsl": "switch id {"}
+    assert all(heads[s.language] in s.text for s in c.sources)
 
 
 # ------------------------------------------------------------------ a filler reading the tangent frame

@@ -4,8 +4,8 @@ Read from the module's binary words after ``spirv-opt -O`` (which inlines
 every function, so an entry point is one function). Counts are static: each
 instruction once, wherever it sits in the control flow (both sides of a
 branch count; a loop body counts once). Classes and the scalar rules are in
-:mod:`generator.cost.classify`, the register estimate in
-:mod:`generator.cost.liveness`.
+:mod:`generator.analysis.classify`, the register estimate in
+:mod:`generator.analysis.liveness`.
 """
 from __future__ import annotations
 
@@ -41,7 +41,7 @@ class Cost:
     transcendental_scalar: int = 0
     loads_scalar: int = 0     # 32-bit components loaded
     stores_scalar: int = 0
-    registers: int = 0        # peak live 32-bit scalars (an estimate: see generator.cost.liveness)
+    registers: int = 0        # peak live 32-bit scalars (an estimate: see generator.analysis.liveness)
     calls: int = 0            # OpFunctionCall left after optimization (0 when fully inlined)
     opcodes: dict = field(default_factory=dict)           # histogram: "OpFMul" / "Exp" -> count
     loads_by_storage: dict = field(default_factory=dict)  # "Uniform" / "Input" / ... -> load count

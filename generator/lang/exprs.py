@@ -11,8 +11,6 @@ from __future__ import annotations
 import ast
 
 from . import ir
-from .errors import SourceError
-from .annotations import check_identifier, node_error, parse_type  # noqa: F401  (re-exported)
 from .intrinsics import CONSTANTS, INTRINSICS
 from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, TEXTURE2D, TEXTURECUBE, UINT, Type, vector
 

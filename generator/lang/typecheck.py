@@ -10,7 +10,8 @@ import ast
 from . import ir
 from .errors import SourceError
 from .control import ControlChecker, always_returns
-from .exprs import ARITH, ExprChecker, check_identifier, parse_type
+from .annotations import check_identifier, parse_type
+from .exprs import ARITH, ExprChecker
 from .intrinsics import CONSTANTS, INTRINSICS
 from .types import BOOL, BUILTIN_TYPES, Type
 

@@ -55,14 +55,6 @@ class Type:
         return self.kind in ("scalar", "vector", "matrix") and self.scalar == "float"
 
     @property
-    def is_array(self) -> bool:
-        return self.kind == "array"
-
-    @property
-    def is_buffer(self) -> bool:
-        return self.kind == "buffer"
-
-    @property
     def dim(self) -> str:
         """A texture's dimension: "2d" or "cube" ("" for other types)."""
         return {"texture2d": "2d", "texturecube": "cube"}.get(self.name, "") if self.kind == "texture" else ""

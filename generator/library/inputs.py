@@ -159,11 +159,6 @@ def closure(names) -> list[str]:
     return [r.name for r in INPUTS if r.name in needed and r.expr is not None]
 
 
-def needs_tangent(names) -> bool:
-    """True when computing `names` needs T and B."""
-    return any(BY_NAME[n].tangent for n in set(names) | set(closure(names)) if n in BY_NAME)
-
-
 _PATH = "<inputs>"
 _PARSED: dict[str, ir.Expr] = {}
 

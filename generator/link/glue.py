@@ -274,10 +274,13 @@ def _light_buffer(prog: Program, b: Builder, i: int, lb, sh, out: list) -> dict[
     HLSL structured buffers and WGSL storage agree byte for byte.
     """
     params = spec_params([Node(lb, ()), sh])
-    textures = [x for n in sh.walk() for x in n.brick.textures] + list(lb.textures)
-    if textures:
-        raise SourceError(lb.display_path, 1, 1, f"a loop over a buffer of '{lb.id}' lights cannot bind textures "
-                          f"({', '.join(textures)})", "use a shadow filter without a texture (shadow none) for buffer lights")
+    owners = [(n.brick, x) for n in [Node(lb, ()), *sh.walk()] for x in n.brick.textures]
+    if owners:
+        brick, tex = owners[0]
+        loc = brick.module.meta_loc
+        raise SourceError(brick.display_path, loc.line, loc.col, f"a loop over a buffer of '{lb.id}' lights cannot "
+                          f"bind texture '{tex}' of {brick.kind} '{brick.id}' per light",
+                          "use a shadow filter without a texture (shadow none) for buffer lights")
     fields = []
     for k, p in params.items():
         fields += [(f"{k}_c{c}", VEC4) for c in range(4)] if p.ty == MAT4 else [(k, VEC4)]

@@ -83,7 +83,7 @@ class Builder:
                 self._renumber(s.default)
 
     def function(self, name: str, params: list[tuple[str, Type]], ret: Type, body_fn, doc: str = "") -> ir.Function:
-        """A function whose body `body_fn(builder)` returns (statements are numbered after the signature)."""
+        """A function whose body `body_fn()` builds; its statements are numbered in emission order."""
         first = self.line
         body = body_fn()
         self.line = first  # number the statements in the order they are emitted: one #line per function

@@ -1,7 +1,7 @@
 """Measured costs: per permutation of a scene, and per brick as "with it" minus "with a stand-in".
 
 Every figure comes from the optimized SPIR-V of real shaders, in each
-language (:mod:`generator.cost` reads it). A brick's cost is the difference
+language (:mod:`generator.analysis` reads it). A brick's cost is the difference
 between two shaders that differ only in that brick. The stand-ins do no
 arithmetic and read no parameter; the BRDF stand-ins return the view vector
 V, so that fetching V (an input, as in the course's accounting) is in every

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..library.inputs import INPUTS, NV_MIN, float64_geometry
+from ..library.inputs import INPUTS, NV_MIN, float64_geometry  # noqa: F401  (NV_MIN: re-exported by reference)
 
 
 def _dot(a, b):

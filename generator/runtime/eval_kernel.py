@@ -122,12 +122,6 @@ class EvalKernel:
         self.pipeline.bind({0: self.samples, 1: self.result, 2: self.params})
 
     # ------------------------------------------------------------ textures
-    def image(self, texture) -> Image:
-        """The uploaded Image of one texture input (a Texture, an array or an (array, srgb) tuple), cached."""
-        img = self._upload(texture)
-        self._evict(keep=[img])
-        return img
-
     def _upload(self, texture) -> Image:
         t = Texture.of(texture)
         arr, cube = texels(t.data, t.cube)

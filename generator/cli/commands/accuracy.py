@@ -6,7 +6,7 @@
 Without SPECs: every BRDF brick (each diffuse term, each specular term with
 every combination of slot fillers). Without --targets: numpy, plus GLSL, HLSL
 and WGSL when a lavapipe device is present. Two sample sets per spec: a
-stratified hemisphere (K⁴ samples) and the stress set (see generator/accuracy.py).
+stratified hemisphere (K⁴ samples) and the stress set (see generator/eval/accuracy.py).
 Exit status 1 when any float32 evaluation gives NaN or Inf (or, with
 --fail-above, a float32 hemisphere error exceeds TOL), or on bad input.
 """
@@ -19,14 +19,14 @@ from pathlib import Path
 from ... import DTYPES, GPU_TARGETS
 
 HELP = "error of every target × dtype against the float64 references: hemisphere and stress set (Markdown/JSON)"
-EVAL_TARGETS = ("numpy",) + GPU_TARGETS
+ACCURACY_TARGETS = ("numpy",) + GPU_TARGETS
 MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 s (K grows memory as K⁴)
 
 
 def add_arguments(p) -> None:
     p.add_argument("specs", nargs="*", metavar="SPEC", help="BRDF specs (default: every BRDF brick)")
     p.add_argument("--targets", metavar="LIST",
-                   help=f"comma-separated, from {', '.join(EVAL_TARGETS)} (default: numpy, plus the GPU "
+                   help=f"comma-separated, from {', '.join(ACCURACY_TARGETS)} (default: numpy, plus the GPU "
                         "languages when lavapipe is present)")
     p.add_argument("--dtypes", default=",".join(DTYPES), metavar="LIST",
                    help="comma-separated, from float64, float32, float16 (GPU targets run float32 only)")
@@ -64,7 +64,7 @@ def run(args) -> int:
         dtypes = _list(args.dtypes, DTYPES, "dtype")
         notes = []
         if args.targets:
-            targets = _list(args.targets, EVAL_TARGETS, "target")
+            targets = _list(args.targets, ACCURACY_TARGETS, "target")
         else:
             targets = accuracy.default_targets()
             if targets == ["numpy"]:
