@@ -32,12 +32,38 @@ def golden_sources() -> dict[str, tuple[str, str, str]]:
     for spec in cases["eval"]:
         for src in compose_eval(spec, lib).sources:
             out[f"{src.language}/eval/{slug(spec)}.comp.{src.language}"] = (src.language, "comp", src.text)
+    out.update(_link_sources(cases))
     for scene_path in cases["scenes"]:
         scene = load_scene(REPO / scene_path, lib)
         name = Path(scene_path).stem
         for h, perm in sorted(scene.permutations.items()):
             for src in compose_permutation(perm, lib).sources:
                 out[f"{src.language}/{name}/{h}.{src.stage}.{src.language}"] = (src.language, src.stage, src.text)
+    return out
+
+
+def _link_sources(cases: dict) -> dict[str, tuple[str, str, str]]:
+    """The link-stage cases: eval kernels, switch kernels and permutations over the test bricks."""
+    from generator.compose import compose_eval, compose_permutation
+    from generator.library.bricks import load_library
+    from generator.link import switch_program
+    from generator.matrix.permutation import LightKey, Permutation
+
+    lib = load_library([REPO / cases["link_bricks"]])
+    out = {}
+    for spec in cases["link_eval"]:
+        for src in compose_eval(spec, lib).sources:
+            out[f"{src.language}/link/{slug(spec)}.comp.{src.language}"] = (src.language, "comp", src.text)
+    for specs in cases["link_switch"]:
+        ep = switch_program(specs, lib)
+        for src in compose_eval(ep.spec, lib, ep=ep).sources:
+            out[f"{src.language}/link/switch_{slug('_'.join(specs))}.comp.{src.language}"] = \
+                (src.language, "comp", src.text)
+    for case in cases["link_permutation"]:
+        lights = tuple(LightKey(*k.lstrip("*").split("/"), dynamic=k.startswith("*")) for k in case["lights"])
+        perm = Permutation(case["brdf"], lights, case["packing"], case["output"])
+        for src in compose_permutation(perm, lib).sources:
+            out[f"{src.language}/link/{perm.hash}.{src.stage}.{src.language}"] = (src.language, src.stage, src.text)
     return out
 
 
