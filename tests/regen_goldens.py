@@ -44,7 +44,7 @@ def golden_sources() -> dict[str, tuple[str, str, str]]:
 
 def _link_sources(cases: dict) -> dict[str, tuple[str, str, str]]:
     """The link-stage cases: eval kernels, switch kernels and permutations over the test bricks."""
-    from generator.compose import compose_eval, compose_permutation
+    from generator.compose import compose_eval, compose_permutation, compose_shade_kernel
     from generator.library.bricks import load_library
     from generator.link import switch_program
     from generator.matrix.permutation import LightKey, Permutation
@@ -64,6 +64,8 @@ def _link_sources(cases: dict) -> dict[str, tuple[str, str, str]]:
         perm = Permutation(case["brdf"], lights, case["packing"], case["output"])
         for src in compose_permutation(perm, lib).sources:
             out[f"{src.language}/link/{perm.hash}.{src.stage}.{src.language}"] = (src.language, src.stage, src.text)
+        for src in (compose_shade_kernel(perm, lib).sources if case.get("shade_kernel") else []):
+            out[f"{src.language}/link/{perm.hash}.shade.comp.{src.language}"] = (src.language, "comp", src.text)
     return out
 
 

@@ -588,3 +588,50 @@ def test_scene_sets_output_parameters_per_material_and_the_upload_carries_them(l
     perm = m["permutations"][0]
     ev = next(x for x in perm["interface"]["frag"]["uniform_blocks"][-1]["parameters"] if x["name"] == "ev")
     assert st.unpack_from("<f", bytes.fromhex(perm["uploads"][0]["Material"]), ev["offset"])[0] == 1.5
+
+
+# ------------------------------------------------------------------ the fragment glue on lavapipe (shade kernels)
+
+SHADE_BRDF = "lambert+blinn_phong_normalized"
+
+
+@pytest.fixture(scope="module")
+def surface():
+    rng = np.random.default_rng(5)
+    n = 256
+    P = rng.uniform(-1.0, 1.0, (n, 3))
+    Ng, V = _unit(rng, n), _unit(rng, n)
+    lights = {"position": rng.uniform(-3.0, 3.0, (3, 3)), "color": rng.uniform(0.1, 2.0, (3, 3))}
+    return P, Ng, V, lights
+
+
+@pytest.mark.lavapipe
+@pytest.mark.toolchain
+@pytest.mark.parametrize("language", LANGS)
+def test_buffer_light_loop_and_exposure_run_on_lavapipe(lib, surface, language):
+    """shade() of a fragment shader, run per sample in a compute kernel on lavapipe:
+    a storage buffer of 3 point lights with a runtime count equals 3 static point lights,
+    an exposure of +1 stop doubles the output, and both agree with the float64 NumPy glue."""
+    from generator.eval.shade import shade_samples
+    from generator.matrix.permutation import LightKey, Permutation
+    from generator.runtime.probe import lavapipe_present
+    from tests.conftest import require
+
+    require(lavapipe_present(), "no lavapipe Vulkan device")
+    P, Ng, V, lights = surface
+    packing = "constants(normal=vertex)"
+    dyn = Permutation(SHADE_BRDF, (LightKey("point", "none", dynamic=True),), packing, "exposure")
+    static = Permutation(SHADE_BRDF, (LightKey("point", "none"),) * 3, packing, "exposure")
+    mat = {"m_rho_d": [0.6, 0.5, 0.4], "m_n": 32.0, "m_f0": [0.04, 0.04, 0.04]}
+    lv = {f"l{i}_{k}": lights[k][i] for i in range(3) for k in ("position", "color")}
+    got = shade_samples(dyn, P, Ng, V, values={**mat, "o_ev": 0.0}, buffers={0: lights}, target=language, lib=lib)
+    want = shade_samples(static, P, Ng, V, values={**mat, **lv, "o_ev": 0.0}, target=language, lib=lib)
+    np.testing.assert_allclose(got, want, rtol=1e-6, atol=1e-7)  # the same sums, a loop against unrolled code
+    ref = shade_samples(dyn, P, Ng, V, values={**mat, "o_ev": 0.0}, buffers={0: lights}, target="numpy", lib=lib)
+    np.testing.assert_allclose(got, ref, rtol=1e-5, atol=1e-6 * np.abs(ref).max())
+    up = shade_samples(dyn, P, Ng, V, values={**mat, "o_ev": 1.0}, buffers={0: lights}, target=language, lib=lib)
+    np.testing.assert_allclose(up[:, :3], 2.0 * got[:, :3], rtol=1e-6)
+    assert np.all(got[:, 3] == 1.0) and got[:, :3].max() > 0.0
+    one = shade_samples(dyn, P, Ng, V, values={**mat, "o_ev": 0.0},
+                        buffers={0: {k: v[:1] for k, v in lights.items()}}, target=language, lib=lib)
+    assert np.all(one[:, :3] <= got[:, :3] + 1e-6) and np.any(one[:, :3] < got[:, :3])  # the count is read at run time

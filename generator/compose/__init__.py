@@ -91,7 +91,7 @@ def _render(template: str, target, ctx: dict, emitted, name: str) -> Source:
     text = "\n".join(lines)
     offset = text[: text.index(emitted.text)].count("\n") if emitted.text else 0
     stage = template.split("/")[1].split(".")[0]
-    stage = {"vertex": "vert", "fragment": "frag", "eval": "comp"}[stage]
+    stage = {"vertex": "vert", "fragment": "frag", "eval": "comp", "shade": "comp"}[stage]
     return Source(target.name, stage, text, emitted.shifted(offset))
 
 
@@ -127,23 +127,56 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram |
 
 # ------------------------------------------------------------------ permutation
 
+def _call_args(lp) -> list[dict]:
+    """How a template passes each shade() parameter: a local, a texture, or a slot of a block."""
+    slots = {s.name: ("material", s) for s in lp.material} | {s.name: ("lights", s) for ls in lp.lights for s in ls}
+    out = []
+    for name, ty in lp.glue.signature:
+        if ty.kind == "texture":
+            out.append({"kind": "texture", "name": name})
+        elif name in slots:
+            out.append({"kind": slots[name][0], "name": name, "slot": slots[name][1]})
+        else:
+            out.append({"kind": "local", "name": name})
+    return out
+
+
+def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -> Composed:
+    """A compute kernel running the permutation's shade() per sample (P, Ng, V[, T][, uv] from a buffer).
+
+    The fragment glue, executed without a graphics pipeline: tests run it on lavapipe.
+    Layout: link.SHADE_KERNEL (set 0: samples 0, result 1, Info 2, Lights 3, Material 4, light buffers 5+).
+    """
+    lp = link_permutation(perm, lib, kernel=True)
+    prog, iface = lp.program, lp.interface
+    h = hashlib.sha256(("shade:" + perm.canonical()).encode()).hexdigest()[:12]
+    bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
+    surface = iface.surface
+    layout_ = ["P", "Ng", "V"] + (["T"] if "T" in surface else []) + (["uv"] if "uv" in surface else [])
+    templates, sources = {}, []
+    for lang in languages:
+        target = get_target(lang)
+        emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        tname = f"{lang}/shade.{lang}.j2"
+        used = _templates_used(lang, tname)
+        templates.update(used)
+        ctx = {"provenance": _provenance("shade kernel", perm.canonical(), h, bricks, used),
+               "inputs": surface, "samples": layout_, "call_args": _call_args(lp), "shade": target.ident("shade"),
+               "material_vec4s": iface.block("Material").members[-1]["size"] // 16,
+               "light_vec4s": iface.block("Lights").members[-1]["size"] // 16}
+        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
+    return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
+
+
 def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) -> Composed:
     """Vertex and fragment shaders of one permutation in each language."""
     lp = link_permutation(perm, lib)
-    prog, g, iface = lp.program, lp.glue, lp.interface
+    prog, iface = lp.program, lp.interface
     h = perm.hash
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
     sources = []
-    slots = {s.name: ("material", s) for s in lp.material} | {s.name: ("lights", s) for ls in lp.lights for s in ls}
-    call_args = []  # how the template passes each shade() parameter
-    for name, ty in g.signature:
-        if ty.kind == "texture":
-            call_args.append({"kind": "texture", "name": name})
-        elif name in slots:
-            call_args.append({"kind": slots[name][0], "name": name, "slot": slots[name][1]})
-        else:
-            call_args.append({"kind": "local", "name": name})
+    call_args = _call_args(lp)
     mat, lights = iface.block("Material"), iface.block("Lights")
     for lang in languages:
         target = get_target(lang)

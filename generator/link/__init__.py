@@ -21,7 +21,7 @@ from .interface import (FRAME_BLOCK, Block, Interface, Location, Slot, Texture, 
                         vec4_array_block)
 from .program import Program, function_name
 
-__all__ = ["EvalProgram", "LinkedPermutation", "Program", "Interface", "Slot", "Block", "Texture", "layout",
+__all__ = ["EvalProgram", "LinkedPermutation", "SHADE_KERNEL", "Program", "Interface", "Slot", "Block", "Texture", "layout",
            "eval_program", "switch_program", "link_permutation", "function_name"]
 
 EVAL_INFO = {"name": "info", "type": "uvec4", "offset": 0, "size": 16}
@@ -116,23 +116,39 @@ class LinkedPermutation:
     lights: list[list[Slot]]
 
 
-def link_permutation(perm: Permutation, lib: Library) -> LinkedPermutation:
-    """Link the bricks of a permutation and lay out what its fragment shader reads."""
+SHADE_KERNEL = {"Info": 2, "Lights": 3, "Material": 4, "buffers": 5}  # set 0 bindings of a shade kernel
+
+
+def link_permutation(perm: Permutation, lib: Library, kernel: bool = False) -> LinkedPermutation:
+    """Link the bricks of a permutation and lay out what its fragment shader reads.
+
+    kernel: lay it out for a shade kernel instead (compose.compose_shade_kernel): shade() in a
+    compute shader, every block in set 0 (SHADE_KERNEL), no textures and no Frame.
+    """
     r = resolve(perm, lib)
     problem, todo = check_packing(r)
     if problem:
         raise SourceError("<key>", 1, 1, problem, todo)
     prog = Program()
     g = shade_glue(prog, r)
+    if kernel and g.textures:
+        t0 = g.textures[0]
+        raise SourceError("<key>", 1, 1, f"a shade kernel binds no textures, and {perm.canonical()} samples "
+                          f"'{t0.param}'", "run texture-sampling permutations as fragment shaders")
     assign_bindings(g.textures, {"light": 2, "material": 1})
     mat_slots, mat_count = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.material])
     light_slots, light_count = layout([(n, p, e, t, s, i) for i, vals in enumerate(g.lights) for n, p, e, t, s in vals])
-    blocks = [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK))]
-    if light_count:
-        blocks.append(vec4_array_block("Lights", 0, 1, light_slots, light_count))
-    if mat_count:
-        blocks.append(vec4_array_block("Material", 1, 0, mat_slots, mat_count))
-    binding = max([1] + [t.binding + 1 for t in g.textures if t.set == 0]) + 1
+    if kernel:
+        blocks = [vec4_array_block("Lights", 0, SHADE_KERNEL["Lights"], light_slots, max(light_count, 1)),
+                  vec4_array_block("Material", 0, SHADE_KERNEL["Material"], mat_slots, max(mat_count, 1))]
+        binding = SHADE_KERNEL["buffers"]
+    else:
+        blocks = [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK))]
+        if light_count:
+            blocks.append(vec4_array_block("Lights", 0, 1, light_slots, light_count))
+        if mat_count:
+            blocks.append(vec4_array_block("Material", 1, 0, mat_slots, mat_count))
+        binding = max([1] + [t.binding + 1 for t in g.textures if t.set == 0]) + 1
     for gl in g.light_buffers:  # dynamic lights: read-only storage buffers after the light textures
         gl.set, gl.binding = 0, binding
         binding += 1
@@ -145,7 +161,8 @@ def link_permutation(perm: Permutation, lib: Library) -> LinkedPermutation:
     params = {"material": {p: s for _, p, _, _, s in g.material}}
     for i, (lb, sh) in enumerate(r.lights):
         params[f"light{i}"] = spec_params([Node(lb, ()), sh])
-    iface = Interface({"vert": "main", "frag": "main"}, g.brdf.reads, g.surface, blocks, g.textures,
+    stages = {"comp": "main"} if kernel else {"vert": "main", "frag": "main"}
+    iface = Interface(stages, g.brdf.reads, g.surface, blocks, g.textures,
                       [Location(0, "out_color", "vec4")], params=params)
     lights = [[s for s in light_slots if s.light == i] for i in range(len(r.lights))]
     return LinkedPermutation(perm, prog, g, iface, mat_slots, lights)

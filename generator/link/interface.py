@@ -70,6 +70,7 @@ def pack(slots: list[Slot], values: dict[str, object], count: int) -> bytes:
         v = values.get(s.name)
         if v is None:
             continue
+        v = v.tolist() if hasattr(v, "tolist") else v  # a NumPy array or scalar
         flat = list(v) if isinstance(v, (list, tuple)) else [v]
         if s.ty.kind == "vector" and len(flat) == 1:
             flat = flat * s.ty.size
