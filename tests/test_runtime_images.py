@@ -465,7 +465,7 @@ def test_texel_shapes_and_formats_are_checked(device):
 
 def test_close_releases_images_and_samplers():
     """Images, samplers and kernels die with their device; the layer's leak check is live."""
-    from generator.runtime.device import Image, Sampler
+    from generator.runtime.images import Image, Sampler
 
     dev = open_device()
     try:

@@ -224,7 +224,7 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
     """f_r (N, 3) float64 of BRDF `spec` for unit vectors L, V, N (and T) of shape (N, 3).
 
     textures: {name: texels (H, W, 4)} for a BRDF that samples lookup tables; the GPU samples
-    them bilinearly with clamp-to-edge at level 0 (runtime.device.Sampler) and the NumPy target
+    them bilinearly with clamp-to-edge at level 0 (runtime.images.Sampler) and the NumPy target
     filters the same texels the same way.
 
     dtype: float64 (default) for reference and numpy; float32/float16 for numpy;

@@ -14,7 +14,8 @@ written before the dispatch (top of pipe) and one after it (bottom of pipe).
 """
 from __future__ import annotations
 
-from .device import Buffer, Device, Image, Sampler
+from .device import Buffer, Device
+from .images import Image, Sampler
 
 STORAGE = "storage"
 UNIFORM = "uniform"

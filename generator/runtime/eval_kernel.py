@@ -26,7 +26,8 @@ import numpy as np
 
 from ..lang.errors import UserError
 from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM, ComputePipeline
-from .device import Device, Image, texels, validation_requested
+from .device import Device, validation_requested
+from .images import Image, texels
 
 WORKGROUP = 64  # local_size_x of templates/*/eval.*.j2
 TEXTURE_BINDING = 3  # texture k: image at TEXTURE_BINDING + 2k, its sampler at TEXTURE_BINDING + 2k + 1
