@@ -15,6 +15,7 @@ from pathlib import Path
 import jinja2
 
 from .. import __version__
+from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link import EvalProgram, Interface, Slot, eval_program, link_permutation
 from ..matrix.permutation import Permutation
@@ -188,7 +189,8 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
             ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, used),
                    "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
                    "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
-                   "textures": iface.textures, "call_args": call_args, "shade": target.ident("shade")}
+                   "textures": iface.textures, "call_args": call_args, "shade": target.ident("shade"),
+                   "iface": iface, "spell": lambda name, _t=target: _t.type_name(BUILTIN_TYPES[name])}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
     return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
