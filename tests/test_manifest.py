@@ -16,6 +16,7 @@ import pytest
 from generator.analysis.reflect import reflect
 
 REPO = Path(__file__).resolve().parent.parent
+FORMATS = {"vec2": "R32G32_SFLOAT", "vec3": "R32G32B32_SFLOAT", "vec4": "R32G32B32A32_SFLOAT"}
 EXAMPLE = REPO / "scenes" / "example.toml"
 
 
@@ -88,6 +89,8 @@ def test_reflection_matches_the_spirv_of_every_permutation_in_every_language(bui
                 assert _reflected_resources(entry) == _expected_resources(want), where
                 assert _stage_vars(entry.inputs) == _locations(want["inputs"]), where
                 assert _stage_vars(entry.outputs) == _locations(want["outputs"]), where
+                for x in want["inputs"] if stage == "vert" else []:  # the format an engine's vertex layout uses
+                    assert FORMATS[x["type"]] == x["format"], (where, x)
                 checked += 1
     assert checked == 5 * 3 * 2
 
