@@ -635,3 +635,19 @@ def test_buffer_light_loop_and_exposure_run_on_lavapipe(lib, surface, language):
     one = shade_samples(dyn, P, Ng, V, values={**mat, "o_ev": 0.0},
                         buffers={0: {k: v[:1] for k, v in lights.items()}}, target=language, lib=lib)
     assert np.all(one[:, :3] <= got[:, :3] + 1e-6) and np.any(one[:, :3] < got[:, :3])  # the count is read at run time
+
+
+def test_stress_set_covers_the_extremes_of_every_tangent_row_of_the_inputs_table():
+    from generator.eval.accuracy import stress_geometry
+    from generator.library.inputs import INPUTS, float64_geometry
+
+    L, V, labels = stress_geometry()
+    n = len(L)
+    N, T = np.tile([0.0, 0.0, 1.0], (n, 1)), np.tile([1.0, 0.0, 0.0], (n, 1))
+    g = float64_geometry(L, V, N, T)
+    for row in INPUTS:
+        if row.tangent and row.expr:
+            hi = [i for i, s in enumerate(labels) if s.startswith(f"{row.name} ≈ 1")]
+            zero = [i for i, s in enumerate(labels) if s.startswith(f"{row.name} = 0")]
+            assert hi and zero, row.name
+            assert np.all(np.abs(g[row.name][hi]) > 0.99) and np.all(np.abs(g[row.name][zero]) < 1e-12), row.name

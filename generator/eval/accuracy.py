@@ -4,7 +4,8 @@ Two sample sets per BRDF spec:
 - `hemisphere`: L and V stratified jointly over the upper hemisphere (uniform in
   solid angle: cos θ and φ in a jittered k⁴ grid), with the bricks' default
   parameters, in a rotated frame so that float32 directions carry rounding;
-- `stress`: the degenerate and extreme configurations of issue 3 (grazing cosines
+- `stress`: the degenerate and extreme configurations of issue 3, plus the extremes of every
+  tangent-frame row of the inputs table (library/inputs.py) for anisotropic models (grazing cosines
   0, 1e-7, 1e-4, 1e-2; L = V; L = -V; V below the horizon; the mirror direction,
   also at grazing; h = n and 0.05° off it) crossed with parameter sweeps (alpha
   0 … 1, exponents 1 … 1e5, f0 = 0 and 1, sigma 0 … 1.2 rad), in the canonical
@@ -133,6 +134,7 @@ def stress_geometry() -> tuple[np.ndarray, np.ndarray, list[str]]:
         add(f"V below horizon (n·v={c:g}), L 45° mirror side", direction(c45, np.pi), v)
         add(f"V below horizon (n·v={c:g}), L 45° same side", direction(c45, 0.0), v)
         add(f"V below horizon (n·v={c:g}), L grazing opposite", direction(1e-4, np.pi), v)
+    rows += _tangent_rows()
     d = math.radians(0.05)
     for deg in (0.0, 30.0, 60.0, 85.0):
         t = math.radians(deg)
@@ -140,6 +142,38 @@ def stress_geometry() -> tuple[np.ndarray, np.ndarray, list[str]]:
         add(f"mirror, h 0.05° off n (θ={deg:g}°)", _polar(t + d, 0.0), _polar(t - d, np.pi))
     L, V, labels = zip(*rows)
     return np.stack(L), np.stack(V), list(labels)
+
+
+def _tangent_rows() -> list[tuple[np.ndarray, np.ndarray, str]]:
+    """For every tangent-frame row of the inputs table (dot(X, T) or dot(X, B)), configurations where it
+    is near ±1 at grazing and where it is 0: the extremes anisotropic models square or divide by.
+
+    In the canonical frame T = x and B = y (azimuth 0 and π/2); X is H (L and V mirrored about the
+    axis), L (V = n) or V (L = n).
+    """
+    import re
+
+    from ..library.inputs import INPUTS
+
+    z = np.array([0.0, 0.0, 1.0])
+    out = []
+    for row in INPUTS:
+        m = re.fullmatch(r"dot\((\w), ([TB])\)", row.expr or "")
+        if not (row.tangent and m):
+            continue
+        x, axis = m.groups()
+        phi = 0.0 if axis == "T" else np.pi / 2
+        for c in (1e-4, 0.5):
+            if x == "H":
+                L, V = direction(c, phi + 0.05), direction(c, phi - 0.05)
+                out.append((L, V, f"{row.name} ≈ 1 (h near {axis}, cos={c:g})"))
+                out.append((direction(c, phi + np.pi / 2), direction(c, phi - np.pi / 2), f"{row.name} = 0 (cos={c:g})"))
+            else:
+                along, ortho = direction(c, phi), direction(c, phi + np.pi / 2)
+                pair = lambda a: (a, z) if x == "L" else (z, a)  # noqa: E731
+                out.append((*pair(along), f"{row.name} ≈ 1 ({x} near {axis}, cos={c:g})"))
+                out.append((*pair(ortho), f"{row.name} = 0 (cos={c:g})"))
+    return [(np.asarray(a, np.float64), np.asarray(b, np.float64), s) for a, b, s in out]
 
 
 def stress_params(declared: dict) -> list[dict]:
