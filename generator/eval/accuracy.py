@@ -164,14 +164,15 @@ def _tangent_rows() -> list[tuple[np.ndarray, np.ndarray, str]]:
         x, axis = m.groups()
         phi = 0.0 if axis == "T" else np.pi / 2
         for c in (1e-4, 0.5):
+            big = "≈ 1" if c < 0.01 else "= sin θ"  # in the T-N (B-N) plane, |x·axis| is sin θ_x
             if x == "H":
                 L, V = direction(c, phi + 0.05), direction(c, phi - 0.05)
-                out.append((L, V, f"{row.name} ≈ 1 (h near {axis}, cos={c:g})"))
+                out.append((L, V, f"{row.name} {big} (h near {axis}, cos={c:g})"))
                 out.append((direction(c, phi + np.pi / 2), direction(c, phi - np.pi / 2), f"{row.name} = 0 (cos={c:g})"))
             else:
                 along, ortho = direction(c, phi), direction(c, phi + np.pi / 2)
                 pair = lambda a: (a, z) if x == "L" else (z, a)  # noqa: E731
-                out.append((*pair(along), f"{row.name} ≈ 1 ({x} near {axis}, cos={c:g})"))
+                out.append((*pair(along), f"{row.name} {big} ({x} near {axis}, cos={c:g})"))
                 out.append((*pair(ortho), f"{row.name} = 0 (cos={c:g})"))
     return [(np.asarray(a, np.float64), np.asarray(b, np.float64), s) for a, b, s in out]
 
