@@ -39,6 +39,10 @@ def golden_sources() -> dict[str, tuple[str, str, str]]:
         for h, perm in sorted(scene.permutations.items()):
             for src in compose_permutation(perm, lib).sources:
                 out[f"{src.language}/{name}/{h}.{src.stage}.{src.language}"] = (src.language, src.stage, src.text)
+        from generator.compose.uber import compose_ubershader
+        uber, _ = compose_ubershader([p for _, p in sorted(scene.permutations.items())], lib)
+        for src in uber.sources:
+            out[f"{src.language}/{name}/ubershader.{src.stage}.{src.language}"] = (src.language, src.stage, src.text)
     return out
 
 

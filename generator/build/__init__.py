@@ -17,7 +17,10 @@ from ..io import atomic_write, sha256
 from ..analysis import entry_cost
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
-from ..toolchain import tool_versions
+from ..compose.uber import compose_ubershader
+from ..lang import SourceError
+from ..link.uber import coverage
+from ..toolchain import CompileJob, compile_many, tool_versions
 from ..toolchain.scenes import compile_scene, job_key
 from .reflection import scene_tables, uploads
 
@@ -50,22 +53,8 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> B
             entry["interface"] = c.interface.as_dict()
             entry["uploads"] = uploads(scene, h, c)
             for src in c.sources:
-                r = results[job_key(h, src.stage, src.language)]
-                data = src.text.encode()
-                if r.ok and r.spirv:
-                    rel_src = f"{src.language}/{h}.{src.stage}.{src.language}"
-                    rel_spv = f"{src.language}/{h}.{src.stage}.spv"
-                    _count(res, atomic_write(out / rel_src, data))
-                    _count(res, atomic_write(out / rel_spv, r.spirv))
-                    item = {"source": rel_src, "source_sha256": sha256(data), "spirv": rel_spv,
-                            "spirv_sha256": sha256(r.spirv), "cost": entry_cost(r.spirv).as_dict(histograms=False)}
-                else:
-                    # A source that does not compile goes beside, under its own name: an earlier
-                    # build's source and SPIR-V stay a matching pair.
-                    rel_src = f"{src.language}/{h}.{src.stage}.failed.{src.language}"
-                    _count(res, atomic_write(out / rel_src, data))
-                    item = {"source": rel_src, "source_sha256": sha256(data)}
-                    errs += r.errors()
+                item, bad = _write(res, out, h, src, results[job_key(h, src.stage, src.language)])
+                errs += bad
                 entry["languages"].setdefault(src.language, {})[src.stage] = item
         entry["status"] = "failed" if errs else "ok"
         if errs:
@@ -78,11 +67,59 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> B
         "tools": tool_versions(),
         "languages": list(languages),
         "permutations": entries,
+        "ubershader": _ubershader(res, scene, lib, out, languages),
         **scene_tables(scene, composed),
     }
     text = json.dumps(res.manifest, indent=2, sort_keys=False) + "\n"
     _count(res, atomic_write(out / "manifest.json", text.encode()))
     return res
+
+
+def _write(res: BuildResult, out: Path, name: str, src, r) -> tuple[dict, list[str]]:
+    """Write one compiled source (and its SPIR-V); returns its manifest item and its errors."""
+    data = src.text.encode()
+    if r.ok and r.spirv:
+        rel_src = f"{src.language}/{name}.{src.stage}.{src.language}"
+        rel_spv = f"{src.language}/{name}.{src.stage}.spv"
+        _count(res, atomic_write(out / rel_src, data))
+        _count(res, atomic_write(out / rel_spv, r.spirv))
+        return {"source": rel_src, "source_sha256": sha256(data), "spirv": rel_spv,
+                "spirv_sha256": sha256(r.spirv), "cost": entry_cost(r.spirv).as_dict(histograms=False)}, []
+    # A source that does not compile goes beside, under its own name: an earlier
+    # build's source and SPIR-V stay a matching pair.
+    rel_src = f"{src.language}/{name}.{src.stage}.failed.{src.language}"
+    _count(res, atomic_write(out / rel_src, data))
+    return {"source": rel_src, "source_sha256": sha256(data)}, r.errors()
+
+
+def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, languages) -> dict:
+    """The fallback ubershader of the scene's matrix: sources, SPIR-V, its tables and Interface.
+
+    The build fails, naming the value, when an axis value of the matrix is not reachable in it.
+    """
+    perms = [p for _, p in sorted(scene.permutations.items())]
+    if not perms:
+        return {}
+    try:
+        c, u = compose_ubershader(perms, lib, languages)
+    except SourceError as e:
+        res.failures.append(f"ubershader:\n  {e}")
+        return {"status": "failed", "errors": [str(e)]}
+    problems = coverage(u, perms, lib)
+    jobs = [CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
+                       line_map=tuple(s.line_map)) for s in c.sources]
+    results = compile_many(jobs, optimize=True, validate=True)
+    entry = {"hash": c.hash, "languages": {}, "tables": u.tables(), "interface": c.interface.as_dict()}
+    errs = [f"coverage: {p}" for p in problems]
+    for src in c.sources:
+        item, bad = _write(res, out, "ubershader", src, results[job_key("ubershader", src.stage, src.language)])
+        errs += bad
+        entry["languages"].setdefault(src.language, {})[src.stage] = item
+    entry["status"] = "failed" if errs else "ok"
+    if errs:
+        entry["errors"] = errs
+        res.failures.append("ubershader:\n  " + "\n  ".join(errs))
+    return entry
 
 
 def _count(res: BuildResult, changed: bool) -> None:

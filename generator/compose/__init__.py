@@ -92,7 +92,7 @@ def _render(template: str, target, ctx: dict, emitted, name: str) -> Source:
     text = "\n".join(lines)
     offset = text[: text.index(emitted.text)].count("\n") if emitted.text else 0
     stage = template.split("/")[1].split(".")[0]
-    stage = {"vertex": "vert", "fragment": "frag", "eval": "comp", "shade": "comp"}[stage]
+    stage = {"vertex": "vert", "fragment": "frag", "ubershader": "frag", "eval": "comp", "shade": "comp"}[stage]
     return Source(target.name, stage, text, emitted.shifted(offset))
 
 
@@ -164,7 +164,7 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
         ctx = {"provenance": _provenance("shade kernel", perm.canonical(), h, bricks, used),
                "inputs": surface, "samples": layout_, "call_args": _call_args(lp), "shade": target.ident("shade"),
                "material_vec4s": iface.block("Material").members[-1]["size"] // 16,
-               "light_vec4s": iface.block("Lights").members[-1]["size"] // 16}
+               "light_vec4s": iface.block("Lights").members[-1]["size"] // 16, "uber": False}
         sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
     return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
 

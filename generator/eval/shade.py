@@ -140,3 +140,107 @@ def _gpu(source, c, n, P, Ng, V, T, uv, vals, fields, globs) -> np.ndarray:
         pipe.destroy()
         for b in bufs:
             b.destroy()
+
+
+# ------------------------------------------------------------------ the ubershader's shade()
+
+def uber_entries(u, materials: list[tuple[int, dict]], lights: list[tuple[str, str, dict]]):
+    """MaterialEntry and LightEntry contents (ids int32 (n, 4), data float (n, vec4s, 4)) as link/uber.py lays them out.
+
+    materials: (variant, {glue name: value}) per material; lights: (light type, shadow, {param: value}).
+    """
+    from ..link.interface import pack
+
+    mids = np.zeros((len(materials), 4), np.int32)
+    mdata = np.zeros((len(materials), u.material_vec4s, 4), np.float64)
+    for m, (k, values) in enumerate(materials):
+        v = u.variants[k]
+        full = _values_of(v.slots, values)
+        mids[m] = (k, 0, 0, 0)
+        mdata[m] = np.frombuffer(pack(v.slots, full, u.material_vec4s), np.float32).reshape(-1, 4)
+    lids = np.zeros((max(len(lights), 1), 4), np.int32)
+    ldata = np.zeros((max(len(lights), 1), u.light_vec4s, 4), np.float64)
+    for i, (t, s, values) in enumerate(lights):
+        lids[i] = (u.light_types.index(t), u.shadows.index(s), 0, 0)
+        for name, (j, ty) in u.light_layouts[(t, s)].items():
+            val = np.asarray(values[name], np.float64).reshape(-1)
+            for c in range(0, len(val), 4):
+                ldata[i, j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
+    return {"ids": mids, "data": mdata}, {"ids": lids[:len(lights)], "data": ldata[:len(lights)]}
+
+
+def _values_of(slots, values: dict) -> dict:
+    out = {}
+    for s in slots:
+        v = values.get(s.name)
+        out[s.name] = v if v is not None else (s.spec.default if s.element is None else s.spec.default[s.element])
+    return out
+
+
+def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "numpy", lib=None) -> np.ndarray:
+    """The ubershader kernel's shade() (N, 4): sample i shaded as material material[i] under `lights`.
+
+    materials: (variant index, {glue name: value}); lights: (light type, shadow, {param: value}), looped over
+    with a runtime count.
+    """
+    from ..compose.uber import compose_uber_kernel
+
+    lib = library_or_builtin(lib)
+    c, u = compose_uber_kernel(perms, lib, () if target == "numpy" else (target,))
+    mat, lts = uber_entries(u, materials, lights)
+    n = len(P)
+    material = np.asarray(material, np.int32)
+    if target == "numpy":
+        from ..targets.numpy import NumpyTarget
+        t = NumpyTarget()
+        shade = t.load(t.emit(u.program.structs, u.program.functions, u.program.globals), np.dtype("float64"),
+                       resources={"material_buffer": mat, "light_buffer": lts})["shade"]
+        norm = lambda a: np.asarray(a, np.float64) / np.linalg.norm(a, axis=1, keepdims=True)  # noqa: E731
+        local = {"P": np.asarray(P, np.float64), "Ng": norm(Ng), "V": norm(V), "material": material}
+        return np.broadcast_to(np.asarray(shade(*[local[name] for name, _ in u.signature]), np.float64),
+                               (n, 4)).copy()
+    return _gpu_uber(c.sources[0], n, P, Ng, V, material, mat, lts)
+
+
+def _gpu_uber(source, n, P, Ng, V, material, mat, lts) -> np.ndarray:
+    from ..runtime.compute import STORAGE, UNIFORM, ComputePipeline
+    from ..runtime.eval_kernel import KernelError, shared_device
+    from ..toolchain import CompileJob, compile_many
+
+    job = CompileJob(f"uber-{len(source.text)}.comp.{source.language}", source.language, "comp", source.text,
+                     line_map=tuple(map(tuple, source.line_map)))
+    res = compile_many([job])[job.key]
+    if not res.ok:
+        raise KernelError(f"the {source.language} ubershader kernel does not compile: " + "; ".join(res.errors()))
+    device = shared_device()
+    vk = device.vk
+    pipe = ComputePipeline(device, res.spirv, (STORAGE, STORAGE, UNIFORM, STORAGE, STORAGE))
+    sample = np.zeros((n, 3, 4), np.float32)
+    for j, r in enumerate((P, Ng, V)):
+        sample[:, j, :3] = r
+    sample[:, 0, 3] = material
+    usage_s, usage_u = vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
+
+    def entries(e):
+        k = e["data"].shape[1]
+        raw = np.zeros((len(e["ids"]), 1 + k, 4), np.float32)
+        raw[:, 1:, :] = e["data"]
+        raw = raw.view(np.uint32)
+        raw[:, 0, :] = e["ids"].astype(np.int32).view(np.uint32)
+        return raw
+
+    lraw, mraw = entries(lts), entries(mat)
+    bufs = [device.buffer(sample.nbytes, usage_s), device.buffer(16 * n, usage_s), device.buffer(16, usage_u),
+            device.buffer(max(lraw.nbytes, 16), usage_s), device.buffer(max(mraw.nbytes, 16), usage_s)]
+    try:
+        bufs[0].array(np.float32)[: sample.size] = sample.reshape(-1)
+        bufs[2].array(np.uint32)[:4] = (n, 0, 0, 0)
+        bufs[3].array(np.uint32)[: lraw.size] = lraw.reshape(-1)
+        bufs[4].array(np.uint32)[: mraw.size] = mraw.reshape(-1)
+        pipe.bind(bufs)
+        pipe.dispatch(-(-n // 64))
+        return bufs[1].array(np.float32)[: 4 * n].reshape(n, 4).astype(np.float64)
+    finally:
+        pipe.destroy()
+        for b in bufs:
+            b.destroy()

@@ -27,6 +27,12 @@ def run(args) -> int:
           f"{len(scene.lights)} lights → {len(perms)} permutations × {len(res.manifest['languages'])} languages")
     for p in perms:
         print(f"  {p['status']:<6} {p['hash']}  {p['id']}  [{', '.join(p['languages'])}]  ({', '.join(p['objects'])})")
+    uber = res.manifest.get("ubershader") or {}
+    if uber:
+        t = uber.get("tables", {})
+        print(f"  {uber['status']:<6} ubershader    {len(t.get('variants', []))} material variants, light types "
+              f"{', '.join(t.get('light_types', []))}, shadows {', '.join(t.get('shadows', []))}: every permutation reachable"
+              if uber["status"] == "ok" else f"  {uber['status']:<6} ubershader")
     print(f"{ok}/{len(perms)} permutations valid SPIR-V in every language; "
           f"{res.written} files written, {res.unchanged} unchanged → {args.out}/manifest.json")
     for f in res.failures:

@@ -9,7 +9,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
-// template glsl/macros.glsl.j2 sha256:b444f57a7364
+// template glsl/macros.glsl.j2 sha256:365e58138614
 // template glsl/vertex.glsl.j2 sha256:c14a3b1db282
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 camera_pos; } frame;

@@ -14,7 +14,7 @@
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template hlsl/fragment.hlsl.j2 sha256:a0815f0c78c6
-// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
+// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };
 

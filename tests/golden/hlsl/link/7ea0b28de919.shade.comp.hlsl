@@ -8,8 +8,8 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
-// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
-// template hlsl/shade.hlsl.j2 sha256:3fe25f17df7e
+// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
+// template hlsl/shade.hlsl.j2 sha256:726ad550b294
 
 // Shade kernel: the permutation's shade() for each sample, in a compute shader (the fragment
 // glue without a graphics pipeline). Samples are float4s, 3 per sample: P, Ng, V

@@ -8,7 +8,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
-// template hlsl/macros.hlsl.j2 sha256:1492ea9ec0b3
+// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
 // template hlsl/vertex.hlsl.j2 sha256:3b5c0dc3e751
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };

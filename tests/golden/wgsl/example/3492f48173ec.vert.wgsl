@@ -11,7 +11,7 @@
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
-// template wgsl/macros.wgsl.j2 sha256:80e35411c40a
+// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
 // template wgsl/vertex.wgsl.j2 sha256:b96d4d0e9cdd
 
 struct Frame { view_proj: mat4x4<f32>, model: mat4x4<f32>, camera_pos: vec4<f32> }

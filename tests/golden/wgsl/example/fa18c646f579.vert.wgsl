@@ -10,7 +10,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template wgsl/macros.wgsl.j2 sha256:80e35411c40a
+// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
 // template wgsl/vertex.wgsl.j2 sha256:b96d4d0e9cdd
 
 struct Frame { view_proj: mat4x4<f32>, model: mat4x4<f32>, camera_pos: vec4<f32> }

@@ -9,7 +9,7 @@
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
 // template wgsl/fragment.wgsl.j2 sha256:ff9fa85530de
-// template wgsl/macros.wgsl.j2 sha256:80e35411c40a
+// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
 
 struct Frame { view_proj: mat4x4<f32>, model: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -1,0 +1,78 @@
+"""The ubershader's sources: a vertex and fragment shader per language, and the compute stand-in tests run."""
+from __future__ import annotations
+
+import hashlib
+
+from ..lang.types import BUILTIN_TYPES
+from ..library.bricks import Library
+from ..link.uber import Uber, link_ubershader
+from ..matrix.permutation import Permutation
+from ..targets import LANGUAGES, get_target
+from ..targets.base import Emitted
+from . import Composed, _provenance, _render, _templates_used
+
+MATERIAL_INDEX = {"glsl": "draw.material.x", "hlsl": "draw_material.x", "wgsl": "draw.material.x"}
+
+
+def uber_key(perms: list[Permutation]) -> str:
+    """The ubershader's id: the sorted canonical keys it stands in for."""
+    return "ubershader:" + "|".join(sorted(p.canonical() for p in perms))
+
+
+def _call_args(u: Uber, material: dict | None) -> list[dict]:
+    out = []
+    for name, ty in u.signature:
+        if ty.kind == "texture":
+            out.append({"kind": "texture", "name": name})
+        elif name == "material" and material is not None:
+            out.append({"kind": "expr", "name": name, "text": material})
+        else:
+            out.append({"kind": "local", "name": name})
+    return out
+
+
+def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAGES) -> tuple[Composed, Uber]:
+    """The fragment ubershader (and its vertex shader) standing in for every permutation of `perms`."""
+    u = link_ubershader(perms, lib)
+    iface = u.interface()
+    key = uber_key(perms)
+    h = hashlib.sha256(key.encode()).hexdigest()[:12]
+    prog = u.program
+    bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
+    templates, sources = {}, []
+    for lang in languages:
+        target = get_target(lang)
+        emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        for stage, tname in (("vertex", f"{lang}/vertex.{lang}.j2"), ("fragment", f"{lang}/ubershader.{lang}.j2")):
+            used = _templates_used(lang, tname)
+            templates.update(used)
+            ctx = {"provenance": _provenance("ubershader", f"{len(perms)} permutations", h, bricks, used),
+                   "inputs": iface.surface, "textures": iface.textures, "shade": target.ident("shade"),
+                   "call_args": _call_args(u, MATERIAL_INDEX[lang]), "iface": iface,
+                   "spell": lambda name, _t=target: _t.type_name(BUILTIN_TYPES[name])}
+            sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
+                                   f"ubershader.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
+    return Composed(key, h, sources, bricks, templates, iface), u
+
+
+def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUAGES) -> tuple[Composed, Uber]:
+    """The ubershader's shade() in a compute kernel: the material index per sample in P.w (templates/*/shade)."""
+    u = link_ubershader(perms, lib, kernel=True)
+    iface = u.interface(kernel=True)
+    key = uber_key(perms)
+    h = hashlib.sha256(("kernel:" + key).encode()).hexdigest()[:12]
+    prog = u.program
+    bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
+    layout_ = ["P", "Ng", "V"] + (["T"] if "T" in u.surface else []) + (["uv"] if "uv" in u.surface else [])
+    templates, sources = {}, []
+    for lang in languages:
+        target = get_target(lang)
+        emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        tname = f"{lang}/shade.{lang}.j2"
+        used = _templates_used(lang, tname)
+        templates.update(used)
+        ctx = {"provenance": _provenance("ubershader kernel", f"{len(perms)} permutations", h, bricks, used),
+               "inputs": u.surface, "samples": layout_, "call_args": _call_args(u, None), "shade": target.ident("shade"),
+               "material_vec4s": 1, "light_vec4s": 1, "uber": True}
+        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
+    return Composed(key, h, sources, bricks, templates, iface), u

@@ -1,0 +1,346 @@
+"""The ubershader: every material variant and light type of a set of permutations in one program.
+
+Hoffman & Baker 2006, "Shader Combinatorics": "Ubershader — build one monolithic shader with
+all options"; the hybrid uses it as the fallback of the shader matrix. It is linked from the
+same bricks and the same glue pieces as the matrix (link/glue.py), so every permutation it
+stands in for computes the same code; `coverage()` proves every axis value reachable.
+
+Data (documented in NOTES.md, "Ubershader"; the manifest lists the tables):
+- `material_buffer`: MaterialEntry { ids: ivec4; data: vec4[M] } per material. ids.x is the
+  material *variant* — a (BRDF, packing, output) combination of the table `variants`; ids.y,
+  ids.z, ids.w are its BRDF, packing and output indices (for the engine's bookkeeping).
+  `data` holds exactly the variant's specialized Material block (the same bytes as the
+  specialized permutation's `uploads`), M the largest of them.
+- `light_buffer`: LightEntry { ids: ivec4; data: vec4[K] } per light, looped over with a
+  runtime count. ids.x indexes `light_types`, ids.y `shadows`, ids.z the shadow map the
+  light's filter samples (0 … shadow_maps-1). data[0 …) holds the light brick's parameters,
+  data[A …) the shadow filter's (A = the most vec4s any light type needs).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..lang import SourceError, ir
+from ..lang.types import FLOAT, INT, MAT4, TEXTURE2D, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
+from ..library.inputs import SURFACE
+from ..library.params import flat, spec_params
+from ..matrix.permutation import Node, Permutation, parse_brdf, parse_spec
+from .glue import _Binder, brdf_glue
+from .interface import FRAME_BLOCK, Block, Interface, Location, Slot, Texture
+from .irgen import Builder
+from .program import Program
+
+IVEC4 = vector("int", 4)
+
+
+@dataclass
+class Variant:
+    """One material variant: its bricks and the layout of its MaterialEntry.data (its Material block)."""
+
+    brdf: str
+    packing: str
+    output: str
+    slots: list[Slot]
+
+    @property
+    def key(self) -> tuple[str, str, str]:
+        return (self.brdf, self.packing, self.output)
+
+
+@dataclass
+class Uber:
+    """The linked ubershader: program, tables of reachable values, entry layouts."""
+
+    program: Program
+    variants: list[Variant]
+    light_types: list[str]
+    shadows: list[str]
+    shadow_maps: int  # textures the shadow filters sample, per light (one set per light slot)
+    material_vec4s: int
+    light_split: int  # A: where the shadow filter's parameters start in LightEntry.data
+    light_vec4s: int
+    light_layouts: dict = field(default_factory=dict)  # (light, shadow) -> {param: (index, type)}
+    textures: list[Texture] = field(default_factory=list)
+    signature: list[tuple[str, Type]] = field(default_factory=list)
+    surface: list[str] = field(default_factory=list)
+    reads: list[str] = field(default_factory=list)
+
+    def interface(self, kernel: bool = False) -> Interface:
+        """The ubershader's Interface: its buffers, the Draw block, textures, inputs and outputs."""
+        def entry(name, nids, vec4s):
+            members = [{"name": "ids", "type": "ivec4", "offset": 0, "size": 16},
+                       {"name": "data", "type": f"vec4[{vec4s}]", "offset": 16, "size": 16 * vec4s, "array_stride": 16}]
+            return [{"name": "data", "type": f"{name}[]", "offset": 0, "size": 0, "array_stride": 16 * (1 + vec4s),
+                     "members": members}]
+        where = UBER_KERNEL if kernel else UBER_FRAGMENT
+        blocks = [] if kernel else [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK)),
+                                    Block("Draw", *where["Draw"], "uniform",
+                                          [{"name": "material", "type": "ivec4", "offset": 0, "size": 16}])]
+        blocks += [Block("LightBuffer", *where["light_buffer"], "storage", entry("LightEntry", 4, self.light_vec4s)),
+                   Block("MaterialBuffer", *where["material_buffer"], "storage",
+                         entry("MaterialEntry", 4, self.material_vec4s))]
+        stages = {"comp": "main"} if kernel else {"vert": "main", "frag": "main"}
+        return Interface(stages, self.reads, self.surface, blocks, self.textures, [Location(0, "out_color", "vec4")])
+
+    def tables(self) -> dict:
+        return {"variants": [{"id": k, "brdf": v.brdf, "packing": v.packing, "output": v.output,
+                              "parameters": [s.as_dict() for s in v.slots]} for k, v in enumerate(self.variants)],
+                "light_types": self.light_types, "shadows": self.shadows, "shadow_maps": self.shadow_maps,
+                "material_entry": {"ids": "ivec4 (variant, brdf, packing, output)", "data_vec4s": self.material_vec4s},
+                "light_entry": {"ids": "ivec4 (light type, shadow, shadow map, 0)", "data_vec4s": self.light_vec4s,
+                                "shadow_parameters_at": self.light_split}}
+
+
+def _read(b: Builder, entry: ir.Expr, data_ty: Type, index: int, ty: Type) -> ir.Expr:
+    """The value of type `ty` at vec4 `index` of entry.data (a mat4 spans four)."""
+    def vec4(i):
+        return ir.Index(VEC4, b.here(), ir.Member(data_ty, b.here(), b.copy(entry), "data"), ir.Const(INT, b.here(), i))
+    if ty == MAT4:
+        return b.construct(MAT4, *(vec4(index + c) for c in range(4)))
+    if ty.components == 4:
+        return vec4(index)
+    return ir.Swizzle(ty, b.here(), vec4(index), "xyzw"[:ty.components])
+
+
+def _zero(b: Builder, ty: Type) -> ir.Expr:
+    return b.const(0.0) if ty == FLOAT else b.construct(ty, b.const(0.0))
+
+
+def _switch(b: Builder, selector: ir.Expr, cases: list[list[ir.Stmt]]) -> ir.Switch:
+    return ir.Switch(b.loc(), selector, [((k,), body) for k, body in enumerate(cases)], [])
+
+
+UBER_FRAGMENT = {"light_buffer": (0, 1), "shadow_maps": (0, 2), "Draw": (1, 0), "material_buffer": (1, 1),
+                 "material_textures": (1, 2)}
+UBER_KERNEL = {"light_buffer": (0, 3), "material_buffer": (0, 4)}  # after samples 0, result 1, Info 2
+
+
+def link_ubershader(perms: list[Permutation], lib, kernel: bool = False) -> Uber:
+    """One program whose shade(P, Ng, V[, T, B][, uv], material, textures...) stands in for every permutation.
+
+    Bindings: UBER_FRAGMENT for the fragment ubershader (set 0: Frame 0, light buffer 1, shadow maps 2+;
+    set 1: Draw 0 (ivec4: x the material index), material buffer 1, material textures 2+), UBER_KERNEL
+    for the compute stand-in the tests run (no textures).
+    """
+    from . import link_permutation
+
+    variants: list[Variant] = []
+    light_types: list[str] = []
+    shadows: list[str] = []
+    shadowed = 0
+    for p in perms:
+        if (p.brdf, p.packing, p.output) not in [v.key for v in variants]:
+            probe = link_permutation(Permutation(p.brdf, (), p.packing, p.output, p.precision), lib)
+            variants.append(Variant(p.brdf, p.packing, p.output, probe.material))
+        for lk in p.lights:
+            light_types += [lk.light] if lk.light not in light_types else []
+            shadows += [lk.shadow] if lk.shadow not in shadows else []
+        shadowed = max(shadowed, sum(1 for lk in p.lights if _shadow_textures(lib, lk.shadow)))
+    prog, b = Program(), Builder()
+    bind = _Binder(b)
+    M = max([1] + [max([1] + [s.index + s.width for s in v.slots]) for v in variants])
+    lnodes = {t: Node(lib.get("light", t), ()) for t in light_types}
+    snodes = {s: parse_spec(s, lib, ("shadow",))[0] for s in shadows}
+    A = max([1] + [_vec4s(spec_params([n])) for n in lnodes.values()])
+    S = max([0] + [_vec4s(spec_params([n])) for n in snodes.values()])
+    K = A + max(S, 1)
+    mat_data, light_data = array(VEC4, M), array(VEC4, K)
+    MaterialEntry = struct("MaterialEntry", (("ids", IVEC4), ("data", mat_data)))
+    LightEntry = struct("LightEntry", (("ids", IVEC4), ("data", light_data)))
+    mbuf = ir.Global("material_buffer", storage_buffer(MaterialEntry))
+    lbuf = ir.Global("light_buffer", storage_buffer(LightEntry))
+    prog.structs += [MaterialEntry, LightEntry]
+    prog.globals += [mbuf, lbuf]
+
+    glues, packings, outputs = [], [], []
+    for k, v in enumerate(variants):
+        glues.append(brdf_glue(prog, parse_brdf(v.brdf, lib), suffix=f"_{k}", guarded=False, b=b))
+        pk = parse_spec(v.packing, lib, ("packing",))[0]
+        prog.link(pk)
+        packings.append(pk)
+        on = Node(lib.get("output", v.output), ())
+        prog.link(on)
+        outputs.append(on)
+    for n in list(lnodes.values()) + list(snodes.values()):
+        prog.link(n)
+    layouts = {}
+    for t, ln in lnodes.items():
+        for s, sn in snodes.items():
+            lay, i = {}, 0
+            for name, _, _, ty, _ in flat(spec_params([ln])):
+                lay[name] = (i, ty)
+                i += 4 if ty == MAT4 else 1
+            i = A
+            for name, _, _, ty, _ in flat(spec_params([sn])):
+                lay[name] = (i, ty)
+                i += 4 if ty == MAT4 else 1
+            layouts[(t, s)] = lay
+
+    me = b.var("me", MaterialEntry)
+    variant = ir.Swizzle(INT, b.here(), ir.Member(IVEC4, b.here(), b.copy(me), "ids"), "x")
+    provided: dict[str, Type] = {}
+    for pk in packings:
+        for f in pk.brick.entries:
+            provided[f.name[len("get_"):]] = f.ret
+
+    def material_args(k) -> dict[str, ir.Expr]:
+        """Variant k's parameters read from the entry, by the name an entry binds (alpha, lobes_0, ev)."""
+        return {s.name[2:]: _read(b, me, mat_data, s.index, s.ty) for s in variants[k].slots}
+
+    def body():
+        stmts = [b.decl("me", ir.Index(MaterialEntry, b.here(), ir.Var(mbuf.ty, b.here(), mbuf.name, "global"),
+                                       b.var("material", INT, "param")))]
+        for name, ty in provided.items():
+            stmts.append(b.decl(f"p_{name}", _zero(b, ty)))
+        stmts.append(b.decl("N", b.construct(VEC3, b.const(0.0))))
+        cases = []
+        for k, pk in enumerate(packings):
+            args = material_args(k)
+            case = [b.assign(b.var(f"p_{f.name[len('get_'):]}", f.ret),
+                             bind.call(prog, pk, f.name, "m_", "material", None, {}, args)) for f in pk.brick.entries]
+            normal = dict(pk.fillers)["normal"]
+            case.append(b.assign(b.var("N", VEC3), bind.call(prog, normal, normal.brick.entries[0].name, "m_",
+                                                            "material", None, {}, args)))
+            cases.append(case)
+        stmts.append(_switch(b, b.copy(variant), cases))
+        stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
+        stmts.append(_light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues,
+                                 packings, provided, material_args, variant, shadowed))
+        stmts.append(b.decl("color", b.construct(VEC4, b.const(0.0))))
+        outs = [[b.assign(b.var("color", VEC4), bind.call(prog, on, "output", "o_", "material", None, {},
+                                                          {**material_args(k), "color": b.var("Lo", VEC3)}))]
+                for k, on in enumerate(outputs)]
+        stmts.append(_switch(b, b.copy(variant), outs))
+        stmts.append(b.ret(b.var("color", VEC4)))
+        return stmts
+
+    stmts = body()
+    leftover = [n for n in bind.params]
+    if leftover:
+        raise SourceError("<ubershader>", 1, 1, f"the ubershader cannot bind {', '.join(leftover)}",
+                          "every parameter comes from the material or light entry")
+    tangent = any(g.tangent for g in glues)
+    surface = ["P", "N"] + (["T", "B"] if tangent or bind.surface & {"T", "B"} else []) \
+        + (["uv"] if "uv" in bind.surface else [])
+    sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")]
+    sig += [("material", INT)] + [(t.name, TEXTURE2D) for t in bind.textures]
+    prog.add(b.function("shade", sig, VEC4, lambda: stmts))
+    reads = list(dict.fromkeys(r for g in glues for r in g.reads))
+    where = UBER_KERNEL if kernel else UBER_FRAGMENT
+    mbuf.set, mbuf.binding = where["material_buffer"]
+    lbuf.set, lbuf.binding = where["light_buffer"]
+    if kernel and bind.textures:
+        raise SourceError("<ubershader>", 1, 1, f"an ubershader kernel binds no textures, and its bricks sample "
+                          f"'{bind.textures[0].param}'", "run texture-sampling materials in the fragment ubershader")
+    nxt = {"light": where.get("shadow_maps", (0, 0))[1], "material": where.get("material_textures", (1, 0))[1]}
+    for tex in bind.textures:
+        tex.set = 0 if tex.group == "light" else 1
+        tex.binding = nxt[tex.group]
+        nxt[tex.group] += 2
+    return Uber(prog, variants, light_types, shadows, shadowed, M, A, K, layouts, bind.textures, sig, surface, reads)
+
+
+def _shadow_textures(lib, shadow: str) -> list[str]:
+    node = parse_spec(shadow, lib, ("shadow",))[0]
+    return [t for n in node.walk() for t in n.brick.textures]
+
+
+def _vec4s(specs) -> int:
+    """vec4s a parameter set occupies (four per mat4)."""
+    return sum(4 if ty == MAT4 else 1 for _, _, _, ty, _ in flat(specs))
+
+
+def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues, packings, provided,
+                material_args, variant, shadowed) -> ir.For:
+    """for i in range(buffer_length(light_buffer)): switch on light type, on shadow filter, on variant."""
+    le = b.var("le", LightEntry)
+    ids = ir.Member(IVEC4, b.here(), b.copy(le), "ids")
+
+    def sel(c):
+        return ir.Swizzle(INT, b.here(), b.copy(ids), c)
+
+    def light_args(t, s):
+        return {name: _read(b, le, light_data, i, ty) for name, (i, ty) in layouts[(t, s)].items()}
+
+    first_shadow = next(iter(snodes))
+    body = [b.decl("le", ir.Index(LightEntry, b.here(), ir.Var(lbuf.ty, b.here(), lbuf.name, "global"),
+                                  b.var("i", UINT))),
+            b.decl("L", b.construct(VEC3, b.const(0.0)))]
+    body.append(_switch(b, sel("x"), [[b.assign(b.var("L", VEC3), bind.call(
+        prog, ln, "light_dir", "l_", "light", None, {"N": VEC3}, light_args(t, first_shadow)))]
+        for t, ln in lnodes.items()]))
+    body.append(b.decl("NdotL", b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var("L", VEC3))))
+    lit = [b.decl("c", b.construct(VEC3, b.const(0.0))), b.decl("s", b.const(1.0))]
+    lit.append(_switch(b, sel("x"), [[b.assign(b.var("c", VEC3), bind.call(
+        prog, ln, "light_radiance", "l_", "light", None, {"N": VEC3}, light_args(t, first_shadow)))]
+        for t, ln in lnodes.items()]))
+    first_light = next(iter(lnodes))
+    shadow_cases = []
+    for s, sn in snodes.items():
+        texnames = [x for n in sn.walk() for x in n.brick.textures]
+        args = light_args(first_light, s)
+        if not texnames:
+            shadow_cases.append([b.assign(b.var("s", FLOAT), bind.call(prog, sn, sn.brick.entries[0].name, "l_",
+                                                                       "light", None, {"N": VEC3}, args))])
+            continue
+        per_map = []
+        for j in range(max(shadowed, 1)):
+            targs = dict(args)
+            for tex in texnames:
+                name = f"shadow{j}_{tex}"
+                if name not in {t.name for t in bind.textures}:
+                    bind.textures.append(Texture(name, tex, "light", False, "2d", j))
+                targs[tex] = b.var(name, TEXTURE2D, "param")
+            per_map.append([b.assign(b.var("s", FLOAT), bind.call(prog, sn, sn.brick.entries[0].name, "l_", "light",
+                                                                  None, {"N": VEC3}, targs))])
+        shadow_cases.append([_switch(b, sel("z"), per_map)])
+    lit.append(_switch(b, sel("y"), shadow_cases))
+    lit.append(b.decl("f", b.construct(VEC3, b.const(0.0))))
+    brdf_cases = []
+    for k, g in enumerate(glues):
+        margs = material_args(k)
+        own = {f.name[len("get_"):] for f in packings[k].brick.entries}  # what variant k's packing provides
+        args = []
+        for n, t in g.signature:
+            if n == "L":
+                args.append(b.var("L", VEC3))
+            elif n == "N":
+                args.append(b.var("N", VEC3))
+            elif n in ("V", "T", "B"):
+                args.append(b.var(n, t, "param"))
+            elif n in own:
+                args.append(b.var(f"p_{n}", provided[n]))
+            elif t.kind == "texture":
+                tname = f"t_{n}"
+                if tname not in {x.name for x in bind.textures}:
+                    bind.textures.append(Texture(tname, n, "material", False, t.dim))
+                args.append(b.var(tname, t, "param"))
+            else:
+                args.append(b.copy(margs[n]))
+        brdf_cases.append([b.assign(b.var("f", VEC3), b.call(g.lit, args))])
+    lit.append(_switch(b, b.copy(variant), brdf_cases))
+    term = b.arith("*", b.arith("*", b.arith("*", b.named_const("PI"), b.var("f", VEC3)), b.var("c", VEC3)),
+                   b.arith("*", b.var("NdotL", FLOAT), b.var("s", FLOAT)))
+    lit.append(b.assign(b.var("Lo", VEC3), term, "+"))
+    body.append(b.if_(b.compare(">", b.var("NdotL", FLOAT), b.const(0.0)), lit))
+    bound = b.intrinsic("buffer_length", UINT, ir.Var(lbuf.ty, b.here(), lbuf.name, "global"))
+    return ir.For(b.loc(), "i", 0, body, bound)
+
+
+def coverage(uber: Uber, perms: list[Permutation], lib) -> list[str]:
+    """Every axis value the matrix uses that the ubershader cannot reach, as one line each."""
+    problems = []
+    keys = {v.key for v in uber.variants}
+    for p in perms:
+        if (p.brdf, p.packing, p.output) not in keys:
+            problems.append(f"material (brdf={p.brdf}, packing={p.packing}, output={p.output}) of {p.hash} "
+                            "is no variant of the ubershader")
+        for lk in p.lights:
+            if lk.light not in uber.light_types:
+                problems.append(f"light type '{lk.light}' of {p.hash} is not in the ubershader's light switch")
+            if lk.shadow not in uber.shadows:
+                problems.append(f"shadow filter '{lk.shadow}' of {p.hash} is not in the ubershader's shadow switch")
+        need = sum(1 for lk in p.lights if _shadow_textures(lib, lk.shadow))
+        if need > max(uber.shadow_maps, 0):
+            problems.append(f"{p.hash} samples {need} shadow maps; the ubershader binds {uber.shadow_maps}")
+    return problems
