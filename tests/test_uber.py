@@ -138,3 +138,41 @@ def test_one_dispatch_shades_samples_of_different_materials(lib, surface):
     for k in range(3):
         alone = uber_samples(PERMS, P, Ng, V, np.full(len(P), k), mats, lights, lib=lib)
         np.testing.assert_array_equal(mixed[ids == k], alone[ids == k])
+
+
+@pytest.mark.parametrize("target", ["numpy"] + [pytest.param(x, marks=[pytest.mark.lavapipe, pytest.mark.toolchain])
+                                                for x in LANGS])
+def test_specialization_constant_ubershader_matches_the_buffer_id_one(lib, surface, target):
+    """The variant as a specialization constant (one pipeline per variant from one module) shades like the
+    ubershader that reads it from the material entry."""
+    from generator.eval.shade import uber_samples
+
+    if target != "numpy":
+        from generator.runtime.probe import lavapipe_present
+        from tests.conftest import require
+        require(lavapipe_present(), "no lavapipe Vulkan device")
+    P, Ng, V = surface
+    lights = [("point", "none", LIGHTS["point"][0]), ("directional", "none", LIGHTS["directional"][0])]
+    for k in range(len(PERMS)):
+        by_id = uber_samples(PERMS, P, Ng, V, np.zeros(len(P), int), [(k, {})], lights, target=target, lib=lib)
+        spec = uber_samples(PERMS, P, Ng, V, np.zeros(len(P), int), [(k, {})], lights, target=target, lib=lib,
+                            variant=k)
+        np.testing.assert_allclose(spec, by_id, rtol=2 * 2.0 ** -23, atol=1e-7, err_msg=f"{target} {k}")
+
+
+@pytest.mark.toolchain
+def test_specialization_constant_ubershader_keeps_one_module_in_glsl_and_hlsl(lib):
+    from generator.compose.uber import compose_uber_kernel
+    from generator.toolchain import CompileJob, compile_many
+
+    c, _ = compose_uber_kernel(PERMS, lib, specialized=True)
+    jobs = [CompileJob(f"s.comp.{s.language}", s.language, "comp", s.text, line_map=tuple(s.line_map),
+                       overrides=(("0", 1),) if s.language == "wgsl" else ())
+            for s in c.sources]
+    res = compile_many(jobs, optimize=False)
+    import struct as st
+    for key, r in res.items():
+        assert r.ok, r.errors()
+        words = st.unpack(f"<{len(r.spirv) // 4}I", r.spirv)
+        spec_id = any(words[i] & 0xFFFF == 71 and words[i + 2] == 1 for i in range(5, len(words) - 3))  # OpDecorate SpecId
+        assert spec_id == (".glsl" in key or ".hlsl" in key), key  # WGSL: naga resolves the override

@@ -31,11 +31,15 @@ def _call_args(u: Uber, material: dict | None) -> list[dict]:
     return out
 
 
-def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAGES) -> tuple[Composed, Uber]:
-    """The fragment ubershader (and its vertex shader) standing in for every permutation of `perms`."""
-    u = link_ubershader(perms, lib)
+def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAGES,
+                       specialized: bool = False) -> tuple[Composed, Uber]:
+    """The fragment ubershader (and its vertex shader) standing in for every permutation of `perms`.
+
+    specialized: the variant is specialization constant 0, one pipeline per material variant.
+    """
+    u = link_ubershader(perms, lib, specialized=specialized)
     iface = u.interface()
-    key = uber_key(perms)
+    key = uber_key(perms) + (";specialized" if specialized else "")
     h = hashlib.sha256(key.encode()).hexdigest()[:12]
     prog = u.program
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
@@ -55,12 +59,16 @@ def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAG
     return Composed(key, h, sources, bricks, templates, iface), u
 
 
-def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUAGES) -> tuple[Composed, Uber]:
-    """The ubershader's shade() in a compute kernel: the material index per sample in P.w (templates/*/shade)."""
-    u = link_ubershader(perms, lib, kernel=True)
+def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUAGES,
+                        specialized: bool = False) -> tuple[Composed, Uber]:
+    """The ubershader's shade() in a compute kernel: the material index per sample in P.w (templates/*/shade).
+
+    specialized: the variant comes from specialization constant 0 (link.uber.SPEC_VARIANT).
+    """
+    u = link_ubershader(perms, lib, kernel=True, specialized=specialized)
     iface = u.interface(kernel=True)
     key = uber_key(perms)
-    h = hashlib.sha256(("kernel:" + key).encode()).hexdigest()[:12]
+    h = hashlib.sha256((f"kernel:{int(specialized)}:" + key).encode()).hexdigest()[:12]
     prog = u.program
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     layout_ = ["P", "Ng", "V"] + (["T"] if "T" in u.surface else []) + (["uv"] if "uv" in u.surface else [])

@@ -177,44 +177,54 @@ def _values_of(slots, values: dict) -> dict:
     return out
 
 
-def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "numpy", lib=None) -> np.ndarray:
+def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "numpy", lib=None,
+                 variant: int | None = None) -> np.ndarray:
     """The ubershader kernel's shade() (N, 4): sample i shaded as material material[i] under `lights`.
 
     materials: (variant index, {glue name: value}); lights: (light type, shadow, {param: value}), looped over
-    with a runtime count.
+    with a runtime count. variant: run the specialization-constant ubershader with its variant set to this
+    (a pipeline of its own: SpecId 0 in GLSL/HLSL, naga's override in WGSL) instead of reading ids.x.
     """
     from ..compose.uber import compose_uber_kernel
+    from ..link.uber import SPEC_VARIANT
 
     lib = library_or_builtin(lib)
-    c, u = compose_uber_kernel(perms, lib, () if target == "numpy" else (target,))
+    c, u = compose_uber_kernel(perms, lib, () if target == "numpy" else (target,), specialized=variant is not None)
     mat, lts = uber_entries(u, materials, lights)
     n = len(P)
     material = np.asarray(material, np.int32)
     if target == "numpy":
         from ..targets.numpy import NumpyTarget
         t = NumpyTarget()
+        res = {"material_buffer": mat, "light_buffer": lts}
+        if variant is not None:
+            res["material_variant"] = np.int32(variant)
         shade = t.load(t.emit(u.program.structs, u.program.functions, u.program.globals), np.dtype("float64"),
-                       resources={"material_buffer": mat, "light_buffer": lts})["shade"]
+                       resources=res)["shade"]
         norm = lambda a: np.asarray(a, np.float64) / np.linalg.norm(a, axis=1, keepdims=True)  # noqa: E731
         local = {"P": np.asarray(P, np.float64), "Ng": norm(Ng), "V": norm(V), "material": material}
         return np.broadcast_to(np.asarray(shade(*[local[name] for name, _ in u.signature]), np.float64),
                                (n, 4)).copy()
-    return _gpu_uber(c.sources[0], n, P, Ng, V, material, mat, lts)
+    spec = None if variant is None else {SPEC_VARIANT: int(variant)}
+    return _gpu_uber(c.sources[0], n, P, Ng, V, material, mat, lts, spec)
 
 
-def _gpu_uber(source, n, P, Ng, V, material, mat, lts) -> np.ndarray:
+def _gpu_uber(source, n, P, Ng, V, material, mat, lts, spec=None) -> np.ndarray:
     from ..runtime.compute import STORAGE, UNIFORM, ComputePipeline
     from ..runtime.eval_kernel import KernelError, shared_device
     from ..toolchain import CompileJob, compile_many
 
+    # WebGPU keys an override declared with @id(N) by N
+    over = tuple((str(i), v) for i, v in spec.items()) if spec and source.language == "wgsl" else ()
     job = CompileJob(f"uber-{len(source.text)}.comp.{source.language}", source.language, "comp", source.text,
-                     line_map=tuple(map(tuple, source.line_map)))
+                     line_map=tuple(map(tuple, source.line_map)), overrides=over)
     res = compile_many([job])[job.key]
     if not res.ok:
         raise KernelError(f"the {source.language} ubershader kernel does not compile: " + "; ".join(res.errors()))
     device = shared_device()
     vk = device.vk
-    pipe = ComputePipeline(device, res.spirv, (STORAGE, STORAGE, UNIFORM, STORAGE, STORAGE))
+    pipe = ComputePipeline(device, res.spirv, (STORAGE, STORAGE, UNIFORM, STORAGE, STORAGE),
+                           specialization=spec if source.language != "wgsl" else None)
     sample = np.zeros((n, 3, 4), np.float32)
     for j, r in enumerate((P, Ng, V)):
         sample[:, j, :3] = r

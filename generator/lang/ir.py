@@ -230,7 +230,8 @@ class Function:
 class Global:
     """A global resource declaration: a buffer or texture that functions read as Var(..., "global").
 
-    ty: a buffer type (types.storage_buffer / uniform_buffer) or a texture type.
+    ty: a buffer type (types.storage_buffer / uniform_buffer), a texture type, or int/uint: a
+    specialization constant whose SpecId is `binding` (set unused).
     set, binding: its descriptor set and binding (a texture takes B and B+1 for its
     sampler). Emitters declare it with Target.declare_global(g) between the
     structs and the functions (Target.emit(..., globals=[...])). Bricks declare

@@ -115,7 +115,10 @@ UBER_FRAGMENT = {"light_buffer": (0, 1), "shadow_maps": (0, 2), "Draw": (1, 0), 
 UBER_KERNEL = {"light_buffer": (0, 3), "material_buffer": (0, 4)}  # after samples 0, result 1, Info 2
 
 
-def link_ubershader(perms: list[Permutation], lib, kernel: bool = False) -> Uber:
+SPEC_VARIANT = 0  # SpecId of the material variant in the specialization-constant ubershader
+
+
+def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, specialized: bool = False) -> Uber:
     """One program whose shade(P, Ng, V[, T, B][, uv], material, textures...) stands in for every permutation.
 
     Bindings: UBER_FRAGMENT for the fragment ubershader (set 0: Frame 0, light buffer 1, shadow maps 2+;
@@ -177,7 +180,12 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False) -> Uber
             layouts[(t, s)] = lay
 
     me = b.var("me", MaterialEntry)
-    variant = ir.Swizzle(INT, b.here(), ir.Member(IVEC4, b.here(), b.copy(me), "ids"), "x")
+    if specialized:
+        spec = ir.Global("material_variant", INT, 0, SPEC_VARIANT)
+        prog.globals.append(spec)
+        variant = ir.Var(INT, b.here(), spec.name, "global")
+    else:
+        variant = ir.Swizzle(INT, b.here(), ir.Member(IVEC4, b.here(), b.copy(me), "ids"), "x")
     provided: dict[str, Type] = {}
     for pk in packings:
         for f in pk.brick.entries:

@@ -28,7 +28,8 @@ _RESOURCE = {STORAGE: Buffer, UNIFORM: Buffer, SAMPLED_IMAGE: Image, SAMPLER: Sa
 class ComputePipeline:
     """A compute pipeline whose set 0 holds `bindings` (STORAGE / UNIFORM / SAMPLED_IMAGE / SAMPLER at 0, 1, ...)."""
 
-    def __init__(self, device: Device, spirv: bytes, bindings: tuple[str, ...], entry: str = "main"):
+    def __init__(self, device: Device, spirv: bytes, bindings: tuple[str, ...], entry: str = "main",
+                 specialization: dict[int, int] | None = None):
         vk = self.vk = device.vk
         self.device, self.bindings = device, tuple(bindings)
         self.handle = self.module = self.layout = self.set_layout = self.pool = self.queries = None
@@ -51,8 +52,14 @@ class ComputePipeline:
             # The entry-point name must outlive the call (TOOLCHAIN.md: the binding frees nested
             # strings early, and vkCreateComputePipelines then finds no entry point named "").
             name = vk.ffi.new("char[]", entry.encode())
+            spec = None
+            if specialization:  # int32 values by SpecId; the data and entries must outlive the call
+                ids = sorted(specialization)
+                data = vk.ffi.new("int32_t[]", [int(specialization[i]) for i in ids])
+                entries = [vk.VkSpecializationMapEntry(constantID=i, offset=4 * k, size=4) for k, i in enumerate(ids)]
+                spec = vk.VkSpecializationInfo(pMapEntries=entries, dataSize=4 * len(ids), pData=data)
             stage = vk.VkPipelineShaderStageCreateInfo(stage=vk.VK_SHADER_STAGE_COMPUTE_BIT,
-                                                       module=self.module, pName=name)
+                                                       module=self.module, pName=name, pSpecializationInfo=spec)
             info = vk.VkComputePipelineCreateInfo(stage=stage, layout=self.layout)
             self.handle = vk.vkCreateComputePipelines(dev, None, 1, [info], None)[0]
             counts = {}

@@ -42,7 +42,14 @@ class ResourceMixin(Target):
             return self.declare_buffer(g.name, g.ty.elem, g.set, g.binding, g.ty.space, g.ty.size)
         if g.ty.kind == "texture":
             return self.declare_texture(g.name, g.set, g.binding, g.ty.dim)
-        raise ValueError(f"global '{g.name}' is {g.ty}: only buffers and textures are global resources")
+        if g.ty.kind == "scalar" and g.ty.scalar in ("int", "uint"):
+            return self.declare_spec_constant(g.name, g.ty, g.binding)
+        raise ValueError(f"global '{g.name}' is {g.ty}: only buffers, textures and int specialization constants "
+                         "are global resources")
+
+    def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
+        """An int/uint specialization constant NAME with SpecId `constant_id`, 0 unless the pipeline sets it."""
+        raise NotImplementedError
 
     def declare_buffer(self, name: str, elem: Type, set: int, binding: int, kind: str = "storage",
                        capacity: int = 0) -> str:

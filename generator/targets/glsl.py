@@ -36,6 +36,9 @@ class GlslTarget(CLikeTarget):
         """`#line N "path"` with a file name needs this extension in glslang."""
         return "#extension GL_GOOGLE_cpp_style_line_directive : require"
 
+    def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
+        return f"layout(constant_id = {int(constant_id)}) const {self.type_name(ty)} {self.ident(name)} = 0;"
+
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
         """texture2D (textureCube) NAME at binding B and sampler _smp_NAME at B+1 of set S (as HLSL and WGSL)."""
         s, b = int(set), int(binding)

@@ -36,6 +36,9 @@ class HlslTarget(CLikeTarget):
         "sample_level": "{0}.SampleLevel({smp}, {1}, {2})",
     }
 
+    def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
+        return f"[[vk::constant_id({int(constant_id)})]] const {self.type_name(ty)} {self.ident(name)} = 0;"
+
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
         """Texture2D (TextureCube) NAME at binding B and SamplerState _smp_NAME at B+1 of set S (t/s registers alike)."""
         s, b = int(set), int(binding)

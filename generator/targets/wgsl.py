@@ -37,6 +37,10 @@ class WgslTarget(CLikeTarget):
         "sample_level": "textureSampleLevel({0}, {smp}, {1}, {2})",
     }
 
+    def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
+        zero = "0i" if ty.scalar == "int" else "0u"
+        return f"@id({int(constant_id)}) override {self.ident(name)}: {self.type_name(ty)} = {zero};"
+
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
         """texture_2d<f32> (texture_cube<f32>) NAME at binding B and sampler _smp_NAME at B+1 of group S."""
         s, b = int(set), int(binding)

@@ -107,6 +107,9 @@ class CompileJob:
     # (path, line + g - generated_line) for the last such entry; lines before
     # the first entry map to the job key itself.
     line_map: tuple = ()
+    # WGSL pipeline-overridable constants, ((name or @id, int value), ...): naga resolves them when it
+    # translates (as WebGPU does when a pipeline is created); GLSL/HLSL keep SpecIds instead.
+    overrides: tuple = ()
 
 
 @dataclass
@@ -341,7 +344,9 @@ def _naga_one(naga: str, tmp: str, idx: int, job: CompileJob) -> _Front:
     src, out = f"j{idx:06d}.wgsl", f"j{idx:06d}.spv"
     Path(tmp, src).write_text(job.source, encoding="utf-8")
     env = dict(os.environ, NO_COLOR="1", RUST_LOG="off")
-    rc, text = _run([naga, "--spirv-version", SPIRV_VERSION, "--keep-coordinate-space", "--entry-point", job.entry, src, out],
+    over = ["--override", ",".join(f"{n}={int(v)}" for n, v in job.overrides)] if job.overrides else []
+    rc, text = _run([naga, "--spirv-version", SPIRV_VERSION, "--keep-coordinate-space", "--entry-point", job.entry,
+                     *over, src, out],
                     cwd=tmp, env=env)
     out_path = Path(tmp, out)
     spv = out_path.read_bytes() if rc == 0 and out_path.is_file() else None
