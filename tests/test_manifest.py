@@ -95,6 +95,20 @@ def test_reflection_matches_the_spirv_of_every_permutation_in_every_language(bui
     assert checked == 5 * 3 * 2
 
 
+@pytest.mark.toolchain
+def test_ubershader_reflection_matches_its_spirv_in_every_language(built):
+    out, manifest = built
+    uber = manifest["ubershader"]
+    for lang, stages in uber["languages"].items():
+        for stage, item in stages.items():
+            entry = reflect((out / item["spirv"]).read_bytes()).entry(stage)
+            want = uber["interface"][stage]
+            where = f"ubershader {lang} {stage}"
+            assert _reflected_resources(entry) == _expected_resources(want), where
+            assert _stage_vars(entry.inputs) == _locations(want["inputs"]), where
+            assert _stage_vars(entry.outputs) == _locations(want["outputs"]), where
+
+
 def test_every_parameter_lies_inside_its_block(built):
     _, manifest = built
     for perm in manifest["permutations"]:
