@@ -29,7 +29,7 @@ class ComputePipeline:
     """A compute pipeline whose set 0 holds `bindings` (STORAGE / UNIFORM / SAMPLED_IMAGE / SAMPLER at 0, 1, ...)."""
 
     def __init__(self, device: Device, spirv: bytes, bindings: tuple[str, ...], entry: str = "main",
-                 specialization: dict[int, int] | None = None):
+                 specialization: dict[int, int] | None = None, cache=None):
         vk = self.vk = device.vk
         self.device, self.bindings = device, tuple(bindings)
         self.handle = self.module = self.layout = self.set_layout = self.pool = self.queries = None
@@ -61,7 +61,8 @@ class ComputePipeline:
             stage = vk.VkPipelineShaderStageCreateInfo(stage=vk.VK_SHADER_STAGE_COMPUTE_BIT,
                                                        module=self.module, pName=name, pSpecializationInfo=spec)
             info = vk.VkComputePipelineCreateInfo(stage=stage, layout=self.layout)
-            self.handle = vk.vkCreateComputePipelines(dev, None, 1, [info], None)[0]
+            # cache: a runtime.pipeline_cache.PipelineCacheFile (its VkPipelineCache), or None
+            self.handle = vk.vkCreateComputePipelines(dev, cache.handle if cache else None, 1, [info], None)[0]
             counts = {}
             for t in self._types:
                 counts[t] = counts.get(t, 0) + 1
