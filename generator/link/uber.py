@@ -67,7 +67,7 @@ class Uber:
 
     def interface(self, kernel: bool = False) -> Interface:
         """The ubershader's Interface: its buffers, the Draw block, textures, inputs and outputs."""
-        def entry(name, nids, vec4s):
+        def entry(name, vec4s):
             members = [{"name": "ids", "type": "ivec4", "offset": 0, "size": 16},
                        {"name": "data", "type": f"vec4[{vec4s}]", "offset": 16, "size": 16 * vec4s, "array_stride": 16}]
             return [{"name": "data", "type": f"{name}[]", "offset": 0, "size": 0, "array_stride": 16 * (1 + vec4s),
@@ -76,9 +76,9 @@ class Uber:
         blocks = [] if kernel else [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK)),
                                     Block("Draw", *where["Draw"], "uniform",
                                           [{"name": "material", "type": "ivec4", "offset": 0, "size": 16}])]
-        blocks += [Block("LightBuffer", *where["light_buffer"], "storage", entry("LightEntry", 4, self.light_vec4s)),
+        blocks += [Block("LightBuffer", *where["light_buffer"], "storage", entry("LightEntry", self.light_vec4s)),
                    Block("MaterialBuffer", *where["material_buffer"], "storage",
-                         entry("MaterialEntry", 4, self.material_vec4s))]
+                         entry("MaterialEntry", self.material_vec4s))]
         stages = {"comp": "main"} if kernel else {"vert": "main", "frag": "main"}
         return Interface(stages, self.reads, self.surface, blocks, self.textures, [Location(0, "out_color", "vec4")])
 
