@@ -224,6 +224,9 @@ class OffscreenTarget:
         self._drawn = False
         dev = device.handle
         try:
+            flags = vk.vkGetPhysicalDeviceQueueFamilyProperties(device.physical)[device.queue_family].queueFlags
+            if not flags & vk.VK_QUEUE_GRAPHICS_BIT:
+                raise VulkanUnavailable(f"{device.name}: queue family {device.queue_family} has no graphics")
             for fmt, need, what in ((self.color_format, vk.VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT, "colour"),
                                     (self.depth_format, vk.VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "depth")):
                 feats = vk.vkGetPhysicalDeviceFormatProperties(device.physical, fmt).optimalTilingFeatures
