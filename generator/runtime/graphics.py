@@ -501,8 +501,9 @@ class GraphicsPipeline:
 
     def __init__(self, device: Device, target: OffscreenTarget, vert_spirv: bytes, frag_spirv: bytes,
                  vertex_inputs, set_layouts: dict[int, dict[int, str]], specialization: dict[int, int] | None = None,
-                 vert_entry: str = "main", frag_entry: str = "main"):
+                 vert_entry: str = "main", frag_entry: str = "main", cache=None):
         vk = self.vk = device.vk
+        self.cache = cache  # a runtime.pipeline_cache.PipelineCacheFile, or None
         self.device, self.target = device, target
         self.vertex_inputs = tuple(vertex_inputs)
         self.attribute_names = tuple(x.name for x in self.vertex_inputs)
@@ -597,7 +598,8 @@ class GraphicsPipeline:
             pViewportState=viewport_state, pRasterizationState=raster, pMultisampleState=multisample,
             pDepthStencilState=depth, pColorBlendState=blend, layout=self.layout, renderPass=t.render_pass,
             subpass=0, basePipelineIndex=-1)
-        self.handle = vk.vkCreateGraphicsPipelines(self.device.handle, None, 1, [info], None)[0]
+        cache = self.cache.handle if self.cache is not None else None
+        self.handle = vk.vkCreateGraphicsPipelines(self.device.handle, cache, 1, [info], None)[0]
         del vname, fname, spec_data, spec_entries  # alive until here
 
     def destroy(self) -> None:
