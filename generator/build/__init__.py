@@ -22,7 +22,8 @@ from ..lang import SourceError
 from ..link.uber import coverage
 from ..toolchain import CompileJob, compile_many, tool_versions
 from ..toolchain.scenes import compile_scene, job_key
-from .reflection import scene_tables, uploads
+from ..link.values import uploads
+from .reflection import scene_tables
 
 
 @dataclass

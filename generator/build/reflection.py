@@ -9,19 +9,8 @@ laid out by that permutation's Interface (little-endian float32, hex).
 """
 from __future__ import annotations
 
-from ..link.interface import pack
+from ..link.values import light_values, material_values
 from ..matrix.scene import Scene
-
-
-def material_values(scene: Scene, name: str, specs: dict) -> dict:
-    """A material's parameters by name: the scene's values, the bricks' defaults for the rest."""
-    given = scene.materials[name].params
-    return {k: given.get(k, s.default) for k, s in specs.items()}
-
-
-def light_values(scene: Scene, name: str, specs: dict) -> dict:
-    given = scene.lights[name].params
-    return {k: given.get(k, s.default) for k, s in specs.items()}
 
 
 def scene_tables(scene: Scene, interfaces: dict) -> dict:
@@ -47,35 +36,3 @@ def scene_tables(scene: Scene, interfaces: dict) -> dict:
             "light_sets": {k: list(v) for k, v in sorted(scene.light_sets.items())},
             "objects": [{"name": o["name"], "material": o["material"], "light_set": o["light_set"],
                          "permutation": o["permutation"]} for o in scene.objects]}
-
-
-def uploads(scene: Scene, h: str, c) -> list[dict]:
-    """Per (material, light set) drawn with permutation `h`: the Material and Lights blocks, ready to upload."""
-    out, seen = [], set()
-    for obj in scene.objects:
-        if obj["permutation"] != h or (obj["material"], obj["light_set"]) in seen:
-            continue
-        seen.add((obj["material"], obj["light_set"]))
-        mvals = material_values(scene, obj["material"], {s.param: s.spec for s in c.material if s.spec is not None})
-        values = {s.name: _element(mvals[s.param], s) for s in c.material}
-        item = {"material": obj["material"], "light_set": obj["light_set"], "objects": []}
-        mat = c.interface.block("Material")
-        if mat is not None:
-            item["Material"] = pack(c.material, values, mat.members[-1]["size"] // 16).hex()
-        lb = c.interface.block("Lights")
-        if lb is not None:
-            lvals = {}
-            for i, (ln, slots) in enumerate(zip(obj["lights"], c.lights)):
-                v = light_values(scene, ln, c.interface.params.get(f"light{i}", {}))
-                lvals.update({s.name: _element(v[s.param], s) for s in slots})
-            item["Lights"] = pack([s for ls in c.lights for s in ls], lvals, lb.members[-1]["size"] // 16).hex()
-        out.append(item)
-    for item in out:
-        item["objects"] = [o["name"] for o in scene.objects if o["permutation"] == h
-                           and (o["material"], o["light_set"]) == (item["material"], item["light_set"])]
-    return out
-
-
-def _element(value, slot):
-    """The value a slot holds: an array parameter's element, or the value itself."""
-    return value if slot.element is None else value[slot.element]
