@@ -593,14 +593,20 @@ class GraphicsPipeline:
         blend = vk.VkPipelineColorBlendStateCreateInfo(logicOpEnable=vk.VK_FALSE, logicOp=vk.VK_LOGIC_OP_COPY,
                                                        pAttachments=[blend_attachment],
                                                        blendConstants=[0.0, 0.0, 0.0, 0.0])
+        # Creation feedback (core in Vulkan 1.3): whether the pipeline cache supplied the pipeline.
+        feedback = vk.ffi.new("VkPipelineCreationFeedback*")
+        feedback_info = vk.VkPipelineCreationFeedbackCreateInfo(pPipelineCreationFeedback=feedback,
+                                                                pipelineStageCreationFeedbackCount=0)
         info = vk.VkGraphicsPipelineCreateInfo(
-            pStages=stages, pVertexInputState=vertex_input, pInputAssemblyState=assembly,
+            pNext=feedback_info, pStages=stages, pVertexInputState=vertex_input, pInputAssemblyState=assembly,
             pViewportState=viewport_state, pRasterizationState=raster, pMultisampleState=multisample,
             pDepthStencilState=depth, pColorBlendState=blend, layout=self.layout, renderPass=t.render_pass,
             subpass=0, basePipelineIndex=-1)
         cache = self.cache.handle if self.cache is not None else None
         self.handle = vk.vkCreateGraphicsPipelines(self.device.handle, cache, 1, [info], None)[0]
-        del vname, fname, spec_data, spec_entries  # alive until here
+        HIT = 0x2  # VK_PIPELINE_CREATION_FEEDBACK_APPLICATION_PIPELINE_CACHE_HIT_BIT
+        self.cache_hit = bool(feedback.flags & HIT) and cache is not None
+        del vname, fname, spec_data, spec_entries, feedback_info  # alive until here
 
     def destroy(self) -> None:
         vk, dev = self.vk, self.device.handle

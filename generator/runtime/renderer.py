@@ -138,6 +138,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                                     gx.layouts_from_interface(iface), cache=cache)
             report.pipeline_create_ms.append((time.perf_counter() - t0) * 1e3)
             report.pipelines_created += 1
+            report.pipeline_cache_hits += p.cache_hit  # the driver's creation feedback
             return p
 
         n = len(scene.objects)
