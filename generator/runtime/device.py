@@ -192,8 +192,12 @@ class Device:
 
         queue_info = vk.VkDeviceQueueCreateInfo(queueFamilyIndex=self.queue_family, queueCount=1,
                                                 pQueuePriorities=[1.0])
+        # VK_EXT_pipeline_creation_feedback (when the driver has it): pipelines report cache hits.
+        have = {e.extensionName for e in vk.vkEnumerateDeviceExtensionProperties(self.physical, None)}
+        self.extensions = [e for e in ("VK_EXT_pipeline_creation_feedback",) if e in have]
         self.handle = vk.vkCreateDevice(self.physical, vk.VkDeviceCreateInfo(
-            pQueueCreateInfos=[queue_info], pEnabledFeatures=vk.VkPhysicalDeviceFeatures()), None)
+            pQueueCreateInfos=[queue_info], pEnabledFeatures=vk.VkPhysicalDeviceFeatures(),
+            ppEnabledExtensionNames=self.extensions), None)
         self.queue = vk.vkGetDeviceQueue(self.handle, self.queue_family, 0)
         self.command_pool = vk.vkCreateCommandPool(self.handle, vk.VkCommandPoolCreateInfo(
             flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, queueFamilyIndex=self.queue_family), None)

@@ -595,8 +595,10 @@ class GraphicsPipeline:
                                                        blendConstants=[0.0, 0.0, 0.0, 0.0])
         # Creation feedback (core in Vulkan 1.3): whether the pipeline cache supplied the pipeline.
         feedback = vk.ffi.new("VkPipelineCreationFeedback*")
-        feedback_info = vk.VkPipelineCreationFeedbackCreateInfo(pPipelineCreationFeedback=feedback,
-                                                                pipelineStageCreationFeedbackCount=0)
+        feedback_info = None
+        if "VK_EXT_pipeline_creation_feedback" in getattr(self.device, "extensions", ()):
+            feedback_info = vk.VkPipelineCreationFeedbackCreateInfo(pPipelineCreationFeedback=feedback,
+                                                                    pipelineStageCreationFeedbackCount=0)
         info = vk.VkGraphicsPipelineCreateInfo(
             pNext=feedback_info, pStages=stages, pVertexInputState=vertex_input, pInputAssemblyState=assembly,
             pViewportState=viewport_state, pRasterizationState=raster, pMultisampleState=multisample,
