@@ -96,3 +96,17 @@ def test_bad_arguments_are_one_line_errors(tmp_path):
         r = subprocess.run([sys.executable, "-m", "generator.cli", "render", str(EXAMPLE), "--out", str(tmp_path / "x"),
                             *args], capture_output=True, text=True, timeout=120, cwd=REPO)
         assert r.returncode == 1 and what in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+def test_the_specialization_constant_ubershader_renders_the_same_image(renders, tmp_path):
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+    from generator.runtime.renderer import render_scene
+
+    lib = load_library()
+    ref = _image(renders["specialized"][0] / "frame_0000.png")
+    for lang in ("glsl", "wgsl"):
+        rep = render_scene(load_scene(EXAMPLE, lib), lib, "ubershader", 1, tmp_path / lang, (96, 48), lang,
+                           uber_ids="specialization")
+        assert rep.pipelines_created == 5  # one ubershader pipeline per material variant
+        _agree(_image(tmp_path / lang / "frame_0000.png"), ref, f"{lang} specialization-constant ubershader")

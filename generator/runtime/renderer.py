@@ -67,6 +67,21 @@ def _textures(device):
             "shadow_map": device.image(shadow)}
 
 
+def camera(n: int, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """(eye, view_proj) looking at a row of n objects (see the module docstring)."""
+    from . import graphics as gx
+
+    eye = np.array([0.0, 2.5, 3.0 + 1.6 * n])
+    return eye, gx.perspective(40.0, width / height, 0.1, 100.0) @ gx.look_at(eye, (0.0, 0.0, 0.0))
+
+
+def placement(i: int, n: int) -> np.ndarray:
+    """The model matrix of object i of n: a unit sphere in the row along x."""
+    model = np.eye(4)
+    model[0, 3] = (i - (n - 1) / 2.0) * SPACING
+    return model
+
+
 def _entries(ids: np.ndarray, data: np.ndarray) -> np.ndarray:
     """Storage-buffer entries: ids as int32 in the first vec4, then the data vec4s (link/uber.py)."""
     raw = np.zeros((len(ids), 1 + data.shape[1], 4), np.float32)
@@ -77,8 +92,13 @@ def _entries(ids: np.ndarray, data: np.ndarray) -> np.ndarray:
 
 
 def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), language: str = "glsl",
-                 device=None, progress: bool = False) -> Report:
-    """Render `frames` frames of `scene` into out/frame_NNNN.png; returns the report (also out/report.json)."""
+                 device=None, progress: bool = False, uber_ids: str = "buffer") -> Report:
+    """Render `frames` frames of `scene` into out/frame_NNNN.png; returns the report (also out/report.json).
+
+    uber_ids: "buffer" (the variant read from the material entry: one ubershader pipeline) or
+    "specialization" (the variant as specialization constant 0: one ubershader pipeline per material
+    variant from the one module; WGSL: naga resolves the override per pipeline).
+    """
     from ..link.values import uploads
     from ..compose import compose_permutation
     from ..compose.uber import compose_ubershader
@@ -87,6 +107,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..toolchain import CompileJob, compile_many
     from . import graphics as gx
     from .device import Device, validation_requested
+    from ..link.uber import SPEC_VARIANT
     from .meshes import uv_sphere
     from .pipeline_cache import PipelineCacheFile
 
@@ -99,12 +120,18 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     W, H = size
     perms = dict(sorted(scene.permutations.items()))
     composed = {h: compose_permutation(p, lib, (language,)) for h, p in perms.items()}
-    uber, u = compose_ubershader(list(perms.values()), lib, (language,))
+    spec_ids = uber_ids == "specialization"
+    uber, u = compose_ubershader(list(perms.values()), lib, (language,), specialized=spec_ids)
     jobs = {}
     for tag, c in [*composed.items(), ("ubershader", uber)]:
         for s in c.sources:
             jobs[(tag, s.stage)] = CompileJob(f"{tag}.{s.stage}.{language}", language, s.stage, s.text,
                                               line_map=tuple(map(tuple, s.line_map)))
+            if tag == "ubershader" and spec_ids and language == "wgsl" and s.stage == "frag":
+                for k in range(len(u.variants)):  # WebGPU resolves an override when the pipeline is made
+                    jobs[(f"ubershader{k}", "frag")] = CompileJob(f"ubershader{k}.frag.wgsl", language, "frag", s.text,
+                                                                  line_map=tuple(map(tuple, s.line_map)),
+                                                                  overrides=((str(SPEC_VARIANT), k),))
     results = compile_many(jobs.values())
     bad = [e for r in results.values() if not r.ok for e in r.errors()]
     if bad:
@@ -132,18 +159,23 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             owned.append(b)
             return b
 
-        def make_pipeline(tag, iface):
+        def make_pipeline(tag, iface, variant=None):
             t0 = time.perf_counter()
-            p = gx.GraphicsPipeline(device, target, spv[(tag, "vert")], spv[(tag, "frag")], iface.vertex_inputs,
-                                    gx.layouts_from_interface(iface), cache=cache)
+            frag, spec = spv[(tag, "frag")], None
+            if variant is not None:
+                if language == "wgsl":
+                    frag = spv[(f"{tag}{variant}", "frag")]
+                else:
+                    spec = {SPEC_VARIANT: variant}
+            p = gx.GraphicsPipeline(device, target, spv[(tag, "vert")], frag, iface.vertex_inputs,
+                                    gx.layouts_from_interface(iface), cache=cache, specialization=spec)
             report.pipeline_create_ms.append((time.perf_counter() - t0) * 1e3)
             report.pipelines_created += 1
             report.pipeline_cache_hits += p.cache_hit  # the driver's creation feedback
             return p
 
         n = len(scene.objects)
-        eye = np.array([0.0, 2.5, 3.0 + 1.6 * n])
-        vp = gx.perspective(40.0, W / H, 0.1, 100.0) @ gx.look_at(eye, (0.0, 0.0, 0.0))
+        eye, vp = camera(n, W, H)
         variant = {v.key: k for k, v in enumerate(u.variants)}
         draws = []
         materials = sorted({o["material"] for o in scene.objects})
@@ -179,9 +211,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         for i, obj in enumerate(scene.objects):
             h = obj["permutation"]
             c = composed[h]
-            model = np.eye(4)
-            model[0, 3] = (i - (n - 1) / 2.0) * SPACING
-            frame = buf(gx.frame_bytes(vp, model, eye), U)
+            frame = buf(gx.frame_bytes(vp, placement(i, n), eye), U)
             up = next(x for x in uploads(scene, h, c) if x["material"] == obj["material"]
                       and x["light_set"] == obj["light_set"])
             spec = {(0, 0): frame}
@@ -201,7 +231,12 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         specialized: dict[str, object] = {}
         order = list(dict.fromkeys(h for h, _, _ in draws))  # first use
         start = time.perf_counter()
-        uber_pipe = make_pipeline("ubershader", uber.interface) if mode != "specialized" else None
+        uber_pipes = {}
+        if mode != "specialized":
+            for k in (sorted({m[0] for m in mat_ids}) if spec_ids else [None]):
+                uber_pipes[k] = make_pipeline("ubershader", uber.interface, k)
+        uber_of = {h: (variant[(perms[h].brdf, perms[h].packing, perms[h].output)] if spec_ids else None)
+                   for h in perms}
         worker = None
         if mode == "specialized":
             for h in order:
@@ -212,7 +247,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     specialized[h] = make_pipeline(h, composed[h].interface)
             worker = threading.Thread(target=create, name="pipelines", daemon=True)
             worker.start()
-        owned_pipelines = lambda: [p for p in [uber_pipe, *specialized.values()] if p is not None]  # noqa: E731
+        owned_pipelines = lambda: [*uber_pipes.values(), *specialized.values()]  # noqa: E731
 
         def draw_frame(index: int | None) -> Frame:
             t0 = time.perf_counter()
@@ -223,7 +258,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     items.append(gx.DrawItem(pipe, sphere, spec))
                     ns += 1
                 else:
-                    items.append(gx.DrawItem(uber_pipe, sphere, ub))
+                    items.append(gx.DrawItem(uber_pipes[uber_of[h]], sphere, ub))
                     nu += 1
             gpu = target.draw(items, clear=(0.06, 0.07, 0.09, 1.0))
             image = target.read()
