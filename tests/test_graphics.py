@@ -123,10 +123,12 @@ def test_layouts_from_an_interface_put_blocks_and_texture_pairs_at_their_binding
     c = compose_permutation(Permutation(BRDF, lights, TEX), lib, ())
     lay = layouts_from_interface(c.interface)
     assert lay == {0: {0: "uniform", 1: "uniform"},
-                   1: {0: "uniform", 1: "sampled_image", 2: "sampler", 3: "sampled_image", 4: "sampler"}}
+                   1: {0: "uniform", 1: "sampled_image", 2: "sampler", 3: "sampled_image", 4: "sampler"},
+                   2: {0: "uniform"}}  # the per-draw Object block
     assert resource_keys(lay)[:3] == [(0, 0), (0, 1), (1, 0)]
     cu, _ = compose_ubershader([Permutation(BRDF, lights, C)], lib, ())
-    assert layouts_from_interface(cu.interface) == {0: {0: "uniform", 1: "storage"}, 1: {0: "uniform", 1: "storage"}}
+    assert layouts_from_interface(cu.interface) == {0: {0: "uniform", 1: "storage"}, 1: {0: "uniform", 1: "storage"},
+                                                    2: {0: "uniform"}}
     clash = SimpleNamespace(blocks=c.interface.blocks, textures=[SimpleNamespace(name="t", set=0, binding=0)])
     with pytest.raises(ValueError, match="set 0 binding 0"):
         layouts_from_interface(clash)
@@ -221,14 +223,14 @@ def gpu(device):
 
     def camera(eye):
         vp = gx.perspective(45.0, W / H, 0.1, 20.0) @ gx.look_at(eye, (0.0, 0.0, 0.0))
-        return lambda model: buf(gx.frame_bytes(vp, model, eye), U)
+        return lambda model: (buf(gx.frame_bytes(vp, eye), U), buf(gx.object_bytes(model), U))  # Frame, Object
 
     def spec_resources(key, frame, values=None):
         """(set, binding) -> resource of the specialized permutation `key`."""
         c = composed[f"spec-{key}"]
         ls = [s for group in c.lights for s in group]
         lv = {f"l0_{k}": v for k, v in LIGHT.items()}
-        out = {(0, 0): frame,
+        out = {(0, 0): frame[0], (2, 0): frame[1],
                (0, 1): buf(pack(ls, _values(ls, lv), c.interface.block("Lights").size // 16), U),
                (1, 0): buf(pack(c.material, _values(c.material, values or MATERIALS[key]),
                                 c.interface.block("Material").size // 16), U)}
@@ -255,7 +257,7 @@ def gpu(device):
 
     def uber_resources(tag, frame, lights_buf, materials_buf, material):
         c, _ = ubers[tag]
-        out = {(0, 0): frame, (0, 1): lights_buf, (1, 0): buf(np.array([material, 0, 0, 0], np.int32), U),
+        out = {(0, 0): frame[0], (2, 0): frame[1], (0, 1): lights_buf, (1, 0): buf(np.array([material, 0, 0, 0], np.int32), U),
                (1, 1): materials_buf}
         for t in c.interface.textures:
             out[(t.set, t.binding)] = albedo if t.param == "albedo_map" else nmap
@@ -433,3 +435,18 @@ def test_the_renderer_refuses_missing_resources_and_reads_before_drawing(device)
             target.draw([gx.DrawItem(None, None, {})])
     finally:
         target.destroy()
+
+
+def test_object_block_carries_the_inverse_transpose_so_normals_survive_non_uniform_scale():
+    from generator.runtime import graphics as gx
+
+    model = np.diag([2.0, 0.5, 1.0, 1.0])
+    model[:3, 3] = (1.0, -2.0, 0.5)
+    raw = np.frombuffer(gx.object_bytes(model), "<f4").reshape(2, 4, 4)  # two column-major mat4
+    m, nm = raw[0].T.astype(np.float64), raw[1].T.astype(np.float64)
+    np.testing.assert_allclose(m, model, rtol=1e-7)
+    mesh = uv_sphere(8, 16)
+    n = mesh.normals.astype(np.float64) @ nm[:3, :3].T
+    t = mesh.tangents[:, :3].astype(np.float64) @ m[:3, :3].T
+    np.testing.assert_allclose(np.sum(n * t, 1), 0.0, atol=1e-6)  # still perpendicular to the surface
+    assert np.abs(np.sum((mesh.normals @ m[:3, :3].T) * t, 1)).max() > 0.1  # mat3(model) would not be

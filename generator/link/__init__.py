@@ -17,7 +17,7 @@ from ..library.bricks import Library
 from ..library.params import ParamSpec, flat
 from ..matrix.permutation import Node, Permutation, check_packing, parse_brdf, resolve
 from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue, switch_params, switch_textures
-from .interface import (FRAME_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
+from .interface import (FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
                         vec4_array_block)
 from .program import Program, function_name
 
@@ -143,7 +143,7 @@ def link_permutation(perm: Permutation, lib: Library, kernel: bool = False) -> L
                   vec4_array_block("Material", 0, SHADE_KERNEL["Material"], mat_slots, max(mat_count, 1))]
         binding = SHADE_KERNEL["buffers"]
     else:
-        blocks = [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK))]
+        blocks = [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK)), Block("Object", 2, 0, "uniform", list(OBJECT_BLOCK))]
         if light_count:
             blocks.append(vec4_array_block("Lights", 0, 1, light_slots, light_count))
         if mat_count:

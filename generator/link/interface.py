@@ -120,8 +120,12 @@ def vec4_array_block(name: str, set_: int, binding: int, slots: list[Slot], coun
 
 
 FRAME_BLOCK = [{"name": "view_proj", "type": "mat4", "offset": 0, "size": 64, "matrix_stride": 16},
-               {"name": "model", "type": "mat4", "offset": 64, "size": 64, "matrix_stride": 16},
-               {"name": "camera_pos", "type": "vec4", "offset": 128, "size": 16}]
+               {"name": "camera_pos", "type": "vec4", "offset": 64, "size": 16}]
+# Per draw (set 2, binding 0, read by the vertex shader): the model matrix and its inverse transpose
+# (as a mat4; the upper 3x3 is used), so normals stay perpendicular under non-uniform scale.
+OBJECT_BLOCK = [{"name": "model", "type": "mat4", "offset": 0, "size": 64, "matrix_stride": 16},
+                {"name": "normal_matrix", "type": "mat4", "offset": 64, "size": 64, "matrix_stride": 16}]
+VERTEX_ONLY = ("Object",)  # blocks the fragment shader does not declare
 
 
 @dataclass
@@ -212,7 +216,8 @@ class Interface:
     def as_dict(self) -> dict:
         """The reflection written to manifest.json (per stage: what the engine binds)."""
         frag = {"entry_point": self.stage_entries.get("frag", "main"),
-                "uniform_blocks": [b.as_dict() for b in self.blocks if b.kind == "uniform"],
+                "uniform_blocks": [b.as_dict() for b in self.blocks if b.kind == "uniform"
+                                   and b.name not in VERTEX_ONLY],
                 "storage_blocks": [b.as_dict() for b in self.blocks if b.kind == "storage"],
                 "textures": [t.as_dict() for t in self.textures],
                 "inputs": [x.as_dict() for x in self.interpolants],
@@ -220,7 +225,7 @@ class Interface:
         out = {"shading_inputs": self.shading_inputs, "frag": frag}
         if "vert" in self.stage_entries:
             out["vert"] = {"entry_point": self.stage_entries["vert"],
-                           "uniform_blocks": [self.block("Frame").as_dict()],
+                           "uniform_blocks": [self.block("Frame").as_dict(), self.block("Object").as_dict()],
                            "inputs": [x.as_dict() for x in self.vertex_inputs],
                            "outputs": [x.as_dict() for x in self.interpolants]}
         return out

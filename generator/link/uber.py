@@ -26,7 +26,7 @@ from ..library.inputs import SURFACE
 from ..library.params import flat, spec_params
 from ..matrix.permutation import Node, Permutation, parse_brdf, parse_spec
 from .glue import _Binder, brdf_glue
-from .interface import FRAME_BLOCK, Block, Interface, Location, Slot, Texture
+from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture
 from .irgen import Builder
 from .program import Program
 
@@ -73,7 +73,7 @@ class Uber:
             return [{"name": "data", "type": f"{name}[]", "offset": 0, "size": 0, "array_stride": 16 * (1 + vec4s),
                      "members": members}]
         where = UBER_KERNEL if kernel else UBER_FRAGMENT
-        blocks = [] if kernel else [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK)),
+        blocks = [] if kernel else [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK)), Block("Object", 2, 0, "uniform", list(OBJECT_BLOCK)),
                                     Block("Draw", *where["Draw"], "uniform",
                                           [{"name": "material", "type": "ivec4", "offset": 0, "size": 16}])]
         blocks += [Block("LightBuffer", *where["light_buffer"], "storage", entry("LightEntry", self.light_vec4s)),

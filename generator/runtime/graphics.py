@@ -14,8 +14,8 @@
   viewport and scissor = the target, no blending.
 - :class:`GpuMesh`: a :class:`~.meshes.Mesh` uploaded, one vertex buffer per attribute, and its
   uint32 index buffer.
-- :func:`perspective`, :func:`look_at`, :func:`frame_bytes`: a camera in Vulkan's clip space
-  (y down, depth 0 … 1) and the Frame block's bytes (link/interface.FRAME_BLOCK, column-major).
+- :func:`perspective`, :func:`look_at`, :func:`frame_bytes`, :func:`object_bytes`: a camera in Vulkan's clip
+  space (y down, depth 0 … 1), the Frame block's and the per-draw Object block's bytes (column-major).
 - :func:`save_png`: an (H, W, 3|4) uint8 array to a PNG file, written atomically.
 
 Descriptor sets are allocated per frame from a pool sized for that frame's items and freed after
@@ -109,17 +109,27 @@ def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
     return m
 
 
-def frame_bytes(view_proj, model, camera_pos) -> bytes:
-    """The Frame block (link/interface.FRAME_BLOCK: view_proj mat4, model mat4, camera_pos vec4; 144 bytes):
-    the row-major math matrices written column-major, as std140 mat4 (and every target's) reads them."""
+def _columns(m) -> np.ndarray:
+    """A 4×4 math matrix as std140 reads a mat4: column-major (every target reads the same bytes)."""
+    return np.asarray(m, np.float64).reshape(4, 4).T.reshape(-1)
+
+
+def frame_bytes(view_proj, camera_pos) -> bytes:
+    """The Frame block (link/interface.FRAME_BLOCK: view_proj mat4, camera_pos vec4; 80 bytes)."""
     cam = np.zeros(4)
     c = np.asarray(camera_pos, np.float64).reshape(-1)
     cam[:len(c)] = c
     if len(c) < 4:
         cam[3] = 1.0
-    parts = [np.asarray(view_proj, np.float64).reshape(4, 4).T.reshape(-1),
-             np.asarray(model, np.float64).reshape(4, 4).T.reshape(-1), cam]
-    return np.concatenate(parts).astype("<f4").tobytes()
+    return np.concatenate([_columns(view_proj), cam]).astype("<f4").tobytes()
+
+
+def object_bytes(model) -> bytes:
+    """The per-draw Object block (link/interface.OBJECT_BLOCK: model, and its inverse transpose for normals)."""
+    m = np.asarray(model, np.float64).reshape(4, 4)
+    n = np.eye(4)
+    n[:3, :3] = np.linalg.inv(m[:3, :3]).T
+    return np.concatenate([_columns(m), _columns(n)]).astype("<f4").tobytes()
 
 
 # ------------------------------------------------------------------ PNG

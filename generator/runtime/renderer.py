@@ -208,20 +208,22 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 shadow_slot += textured
                 rows.append(data)
             light_buffers[set_name] = buf(_entries(np.array(ids), np.stack(rows)), S)
+        frame_buf = buf(gx.frame_bytes(vp, eye), U)
         for i, obj in enumerate(scene.objects):
             h = obj["permutation"]
             c = composed[h]
-            frame = buf(gx.frame_bytes(vp, placement(i, n), eye), U)
+            frame = frame_buf
+            obj_buf = buf(gx.object_bytes(placement(i, n)), U)
             up = next(x for x in uploads(scene, h, c) if x["material"] == obj["material"]
                       and x["light_set"] == obj["light_set"])
-            spec = {(0, 0): frame}
+            spec = {(0, 0): frame, (2, 0): obj_buf}
             if c.interface.block("Lights"):
                 spec[(0, 1)] = buf(bytes.fromhex(up["Lights"]), U)
             if c.interface.block("Material"):
                 spec[(1, 0)] = buf(bytes.fromhex(up["Material"]), U)
             for t in c.interface.textures:
                 spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = textures[t.param], sampler
-            ub = {(0, 0): frame, (0, 1): light_buffers[obj["light_set"]],
+            ub = {(0, 0): frame, (2, 0): obj_buf, (0, 1): light_buffers[obj["light_set"]],
                   (1, 0): buf(np.array([materials.index(obj["material"]), 0, 0, 0], np.int32), U),
                   (1, 1): material_buffer}
             for t in uber.interface.textures:

@@ -5,7 +5,7 @@
 // hash: 9a8398637d4c
 // brick bricks/brdf/specular/blinn_phong_normalized.py sha256:e0c2f79cd030
 // template glsl/eval.glsl.j2 sha256:9df531e080fc
-// template glsl/macros.glsl.j2 sha256:365e58138614
+// template glsl/macros.glsl.j2 sha256:0712fef74734
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

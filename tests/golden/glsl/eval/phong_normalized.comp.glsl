@@ -5,7 +5,7 @@
 // hash: bcf91138f6f2
 // brick bricks/brdf/specular/phong_normalized.py sha256:81d46719a0f0
 // template glsl/eval.glsl.j2 sha256:9df531e080fc
-// template glsl/macros.glsl.j2 sha256:365e58138614
+// template glsl/macros.glsl.j2 sha256:0712fef74734
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

@@ -9,10 +9,12 @@
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
-// template glsl/macros.glsl.j2 sha256:365e58138614
-// template glsl/vertex.glsl.j2 sha256:c14a3b1db282
+// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/vertex.glsl.j2 sha256:f82bfd289b63
 
-layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 camera_pos; } frame;
+layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
+
+layout(set = 2, binding = 0) uniform Object { mat4 model; mat4 normal_matrix; } object_data;
 
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
@@ -20,9 +22,9 @@ layout(location = 0) out vec3 v_position;
 layout(location = 1) out vec3 v_normal;
 
 void main() {
-    vec4 world = frame.model * vec4(a_position, 1.0);
+    vec4 world = object_data.model * vec4(a_position, 1.0);
     v_position = world.xyz;
-    // mat3(model) transforms normals as long as the model matrix has no non-uniform scale.
-    v_normal = mat3(frame.model) * a_normal;
+    // Normals by the inverse transpose (correct under non-uniform scale), tangents by the model matrix.
+    v_normal = mat3(object_data.normal_matrix) * a_normal;
     gl_Position = frame.view_proj * world;
 }

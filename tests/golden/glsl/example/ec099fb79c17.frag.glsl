@@ -16,9 +16,9 @@
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template glsl/fragment.glsl.j2 sha256:b0fd106ce720
-// template glsl/macros.glsl.j2 sha256:365e58138614
+// template glsl/macros.glsl.j2 sha256:0712fef74734
 
-layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 camera_pos; } frame;
+layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 
 layout(set = 0, binding = 1) uniform Lights { vec4 data[9]; } lights;
 layout(set = 1, binding = 0) uniform Material { vec4 data[3]; } material;

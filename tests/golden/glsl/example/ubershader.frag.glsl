@@ -24,10 +24,10 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template glsl/macros.glsl.j2 sha256:365e58138614
+// template glsl/macros.glsl.j2 sha256:0712fef74734
 // template glsl/ubershader.glsl.j2 sha256:5be427348912
 
-layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; mat4 model; vec4 camera_pos; } frame;
+layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 
 // Ubershader: the material's variant, parameters and lights come from buffers (link/uber.py).
 layout(set = 1, binding = 0) uniform Draw { ivec4 material; } draw;

@@ -5,7 +5,7 @@
 // hash: ccf2080ae645
 // brick tests/link_bricks/specular/lobes.py sha256:889e667a483b
 // template glsl/eval.glsl.j2 sha256:9df531e080fc
-// template glsl/macros.glsl.j2 sha256:365e58138614
+// template glsl/macros.glsl.j2 sha256:0712fef74734
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

@@ -3,7 +3,7 @@
 // hash: 9a8398637d4c
 // brick bricks/brdf/specular/blinn_phong_normalized.py sha256:e0c2f79cd030
 // template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
-// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
+// template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per
 // sample: L, V, N (xyz; w unused). info.x = sample count.

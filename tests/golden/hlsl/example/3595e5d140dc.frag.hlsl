@@ -13,9 +13,9 @@
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template hlsl/fragment.hlsl.j2 sha256:a0815f0c78c6
-// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
+// template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };
+cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
 cbuffer Lights : register(b1, space0) { float4 lights_data[9]; };
 cbuffer Material : register(b0, space1) { float4 material_data[2]; };

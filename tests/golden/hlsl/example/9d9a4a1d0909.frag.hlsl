@@ -9,9 +9,9 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // template hlsl/fragment.hlsl.j2 sha256:a0815f0c78c6
-// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
+// template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };
+cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
 cbuffer Lights : register(b1, space0) { float4 lights_data[4]; };
 cbuffer Material : register(b0, space1) { float4 material_data[3]; };

@@ -8,10 +8,12 @@
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
-// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
-// template hlsl/vertex.hlsl.j2 sha256:3b5c0dc3e751
+// template hlsl/macros.hlsl.j2 sha256:88a641fa5070
+// template hlsl/vertex.hlsl.j2 sha256:ad4a8af5dca3
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };
+cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
+
+cbuffer Object : register(b0, space2) { float4x4 model; float4x4 normal_matrix; };
 
 struct VSIn {
     [[vk::location(0)]] float3 a_position : POSITION;
@@ -28,8 +30,8 @@ VSOut main(VSIn i) {
     VSOut o;
     float4 world = mul(model, float4(i.a_position, 1.0));
     o.v_position = world.xyz;
-    // The upper-left 3x3 transforms normals as long as the model matrix has no non-uniform scale.
-    o.v_normal = mul((float3x3)model, i.a_normal);
+    // Normals by the inverse transpose (correct under non-uniform scale), tangents by the model matrix.
+    o.v_normal = mul((float3x3)normal_matrix, i.a_normal);
     o.position = mul(view_proj, world);
     return o;
 }

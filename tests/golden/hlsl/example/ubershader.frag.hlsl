@@ -22,10 +22,10 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
+// template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 // template hlsl/ubershader.hlsl.j2 sha256:7f2531609f51
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4x4 model; float4 camera_pos; };
+cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
 // Ubershader: the material's variant, parameters and lights come from buffers (link/uber.py).
 cbuffer Draw : register(b0, space1) { int4 draw_material; };

@@ -8,7 +8,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
-// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
+// template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 // template hlsl/shade.hlsl.j2 sha256:726ad550b294
 
 // Shade kernel: the permutation's shade() for each sample, in a compute shader (the fragment

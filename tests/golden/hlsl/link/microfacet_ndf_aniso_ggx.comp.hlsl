@@ -6,7 +6,7 @@
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick tests/link_bricks/ndf/aniso_ggx.py sha256:01caff2cd618
 // template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
-// template hlsl/macros.hlsl.j2 sha256:416bb3ef9a68
+// template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per
 // sample: L, V, N, T (xyz; w unused). info.x = sample count.

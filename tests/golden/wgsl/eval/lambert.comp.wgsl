@@ -3,7 +3,7 @@
 // hash: 55679a70c070
 // brick bricks/brdf/diffuse/lambert.py sha256:b1294e11a3ac
 // template wgsl/eval.wgsl.j2 sha256:f197bbce6026
-// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
+// template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

@@ -10,11 +10,14 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
-// template wgsl/vertex.wgsl.j2 sha256:b96d4d0e9cdd
+// template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
+// template wgsl/vertex.wgsl.j2 sha256:9c77a8d527bb
 
-struct Frame { view_proj: mat4x4<f32>, model: mat4x4<f32>, camera_pos: vec4<f32> }
+struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;
+
+struct Object { model: mat4x4<f32>, normal_matrix: mat4x4<f32> }
+@group(2) @binding(0) var<uniform> object_data: Object;
 
 struct VSOut {
     @builtin(position) position: vec4<f32>,
@@ -26,11 +29,13 @@ struct VSOut {
 @vertex
 fn main(@location(0) a_position: vec3<f32>, @location(1) a_normal: vec3<f32>, @location(3) a_uv: vec2<f32>) -> VSOut {
     var o: VSOut;
-    let world = frame.model * vec4<f32>(a_position, 1.0);
+    let world = object_data.model * vec4<f32>(a_position, 1.0);
     o.v_position = world.xyz;
-    // The upper-left 3x3 transforms normals as long as the model matrix has no non-uniform scale.
-    let m3 = mat3x3<f32>(frame.model[0].xyz, frame.model[1].xyz, frame.model[2].xyz);
-    o.v_normal = m3 * a_normal;
+    // Normals by the inverse transpose (correct under non-uniform scale), tangents by the model matrix.
+    let m3 = mat3x3<f32>(object_data.model[0].xyz, object_data.model[1].xyz, object_data.model[2].xyz);
+    let n3 = mat3x3<f32>(object_data.normal_matrix[0].xyz, object_data.normal_matrix[1].xyz,
+                         object_data.normal_matrix[2].xyz);
+    o.v_normal = n3 * a_normal;
     o.v_uv = a_uv;
     o.position = frame.view_proj * world;
     return o;

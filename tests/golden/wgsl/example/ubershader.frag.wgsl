@@ -22,10 +22,10 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
+// template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 // template wgsl/ubershader.wgsl.j2 sha256:50ec0d4730fc
 
-struct Frame { view_proj: mat4x4<f32>, model: mat4x4<f32>, camera_pos: vec4<f32> }
+struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;
 
 // Ubershader: the material's variant, parameters and lights come from buffers (link/uber.py).

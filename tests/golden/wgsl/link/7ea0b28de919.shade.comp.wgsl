@@ -8,7 +8,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
-// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
+// template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 // template wgsl/shade.wgsl.j2 sha256:fc293d053f00
 
 // Shade kernel: the permutation's shade() for each sample, in a compute shader (the fragment

@@ -11,9 +11,9 @@
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
 // template wgsl/fragment.wgsl.j2 sha256:ff9fa85530de
-// template wgsl/macros.wgsl.j2 sha256:31c40fd982b9
+// template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
-struct Frame { view_proj: mat4x4<f32>, model: mat4x4<f32>, camera_pos: vec4<f32> }
+struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;
 
 struct Lights { data: array<vec4<f32>, 7> }
