@@ -37,7 +37,7 @@ def test_saved_cache_is_reloaded_and_every_bad_file_is_ignored_with_its_reason(d
     assert again.problem == "" and again.loaded == len(good)
     _pipeline(device, again).destroy()
     foreign = HEADER.pack(32, 1, vendor ^ 1, dev, uuid) + good[32:]
-    cases = [(good[:20], "truncated"), (foreign, "another device or driver"),
+    cases = [(good[:20], "truncated"), (b"", "truncated: 0 bytes"), (foreign, "another device or driver"),
              (b"\x00" * 40, "not a Vulkan pipeline cache"), (HEADER.pack(32, 2, vendor, dev, uuid), "header version 2")]
     for data, why in cases:
         path.write_bytes(data)

@@ -176,3 +176,55 @@ def test_specialization_constant_ubershader_keeps_one_module_in_glsl_and_hlsl(li
         words = st.unpack(f"<{len(r.spirv) // 4}I", r.spirv)
         spec_id = any(words[i] & 0xFFFF == 71 and words[i + 2] == 1 for i in range(5, len(words) - 3))  # OpDecorate SpecId
         assert spec_id == (".glsl" in key or ".hlsl" in key), key  # WGSL: naga resolves the override
+
+
+@pytest.mark.parametrize("target", ["numpy"] + [pytest.param(x, marks=[pytest.mark.lavapipe, pytest.mark.toolchain])
+                                                for x in LANGS])
+def test_ubershader_with_a_tangent_frame_and_a_scalar_splat_matches_the_specialized_shader(lib, surface, target):
+    from generator.eval.shade import shade_samples, uber_samples
+
+    if target != "numpy":
+        from generator.runtime.probe import lavapipe_present
+        from tests.conftest import require
+        require(lavapipe_present(), "no lavapipe Vulkan device")
+    P, Ng, V = surface
+    rng = np.random.default_rng(9)
+    t = rng.normal(size=(len(P), 3))
+    t -= np.sum(t * Ng, 1)[:, None] * Ng  # perpendicular to the normal
+    T = np.c_[t / np.linalg.norm(t, axis=1)[:, None], np.where(rng.random(len(P)) < 0.5, -1.0, 1.0)]
+    perm = Permutation("microfacet(ndf=aniso_ggx)", (LightKey("point", "none"),), "constants(normal=vertex_tangent)")
+    light = {"position": [0.5, 2.0, 1.0], "color": 3.0}  # a scalar for a vec3 splats on both paths
+    got = uber_samples([perm], P, Ng, V, np.zeros(len(P), int), [(0, {})], [("point", "none", light)],
+                       target=target, lib=lib, T=T)
+    want = shade_samples(perm, P, Ng, V, T=T, values={"l0_position": light["position"], "l0_color": [3.0] * 3},
+                         target=target, lib=lib)
+    rtol = 2 * 2.0 ** -23 if target != "numpy" else 1e-6
+    np.testing.assert_allclose(got, want, rtol=rtol, atol=rtol * np.abs(want).max())
+    assert np.abs(want[:, :3]).max() > 0.0
+
+
+def test_a_scene_without_lights_gets_an_ubershader_without_a_light_loop(lib):
+    from generator.lang import ir
+    from generator.link.uber import link_ubershader
+
+    u = link_ubershader([Permutation("lambert", (), C)], lib)
+    assert u.light_types == [] and u.interface().block("LightBuffer") is None
+    assert not any(isinstance(n, ir.For) for f in u.program.functions for n in ir.walk_body(f.body))
+
+
+@pytest.mark.toolchain
+def test_the_build_fails_naming_a_value_the_ubershader_cannot_reach(tmp_path, monkeypatch):
+    """An ubershader that lost a variant (simulated by linking it from all but one permutation) fails the build."""
+    import generator.build as build
+    from generator.compose.uber import compose_ubershader
+    from generator.matrix.scene import load_scene
+
+    base = load_library()
+    scene = load_scene(REPO / "scenes" / "example.toml", base)
+    monkeypatch.setattr(build, "compose_ubershader", lambda perms, lib, langs: compose_ubershader(perms[1:], lib, langs))
+    res = build.build_scene(scene, base, tmp_path / "out", languages=("glsl",))
+    assert not res.ok
+    msg = "\n".join(res.failures)
+    assert "ubershader" in msg and "coverage:" in msg and "is no variant of the ubershader" in msg
+    first = sorted(scene.permutations.items())[0][1]
+    assert f"brdf={first.brdf}" in msg

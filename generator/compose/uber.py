@@ -15,8 +15,8 @@ MATERIAL_INDEX = {"glsl": "draw.material.x", "hlsl": "draw_material.x", "wgsl": 
 
 
 def uber_key(perms: list[Permutation]) -> str:
-    """The ubershader's id: the sorted canonical keys it stands in for."""
-    return "ubershader:" + "|".join(sorted(p.canonical() for p in perms))
+    """The ubershader's id: the canonical keys it stands in for, in order (the order numbers the variants)."""
+    return "ubershader:" + "|".join(p.canonical() for p in perms)
 
 
 def _call_args(u: Uber, material: dict | None) -> list[dict]:

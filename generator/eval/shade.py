@@ -164,6 +164,8 @@ def uber_entries(u, materials: list[tuple[int, dict]], lights: list[tuple[str, s
         lids[i] = (u.light_types.index(t), u.shadows.index(s), 0, 0)
         for name, (j, ty) in u.light_layouts[(t, s)].items():
             val = np.asarray(values[name], np.float64).reshape(-1)
+            if ty.kind == "vector" and len(val) == 1:  # a scalar for a vector parameter splats, as pack() does
+                val = np.repeat(val, ty.components)
             for c in range(0, len(val), 4):
                 ldata[i, j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
     return {"ids": mids, "data": mdata}, {"ids": lids[:len(lights)], "data": ldata[:len(lights)]}
@@ -178,12 +180,13 @@ def _values_of(slots, values: dict) -> dict:
 
 
 def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "numpy", lib=None,
-                 variant: int | None = None) -> np.ndarray:
+                 variant: int | None = None, T=None, uv=None) -> np.ndarray:
     """The ubershader kernel's shade() (N, 4): sample i shaded as material material[i] under `lights`.
 
     materials: (variant index, {glue name: value}); lights: (light type, shadow, {param: value}), looped over
     with a runtime count. variant: run the specialization-constant ubershader with its variant set to this
     (a pipeline of its own: SpecId 0 in GLSL/HLSL, naga's override in WGSL) instead of reading ids.x.
+    T: (N, 4) tangents (w: the bitangent's sign) and uv: (N, 2), when the ubershader reads them.
     """
     from ..compose.uber import compose_uber_kernel
     from ..link.uber import SPEC_VARIANT
@@ -193,6 +196,9 @@ def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "nu
     mat, lts = uber_entries(u, materials, lights)
     n = len(P)
     material = np.asarray(material, np.int32)
+    for name, given in (("T", T), ("uv", uv)):
+        if name in u.surface and given is None:
+            raise EvalError(f"the ubershader of these permutations reads {name}", f"pass {name}= per sample")
     if target == "numpy":
         from ..targets.numpy import NumpyTarget
         t = NumpyTarget()
@@ -203,13 +209,20 @@ def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "nu
                        resources=res)["shade"]
         norm = lambda a: np.asarray(a, np.float64) / np.linalg.norm(a, axis=1, keepdims=True)  # noqa: E731
         local = {"P": np.asarray(P, np.float64), "Ng": norm(Ng), "V": norm(V), "material": material}
+        if T is not None:
+            T4 = np.asarray(T, np.float64)
+            local["T"] = norm(T4[:, :3])
+            local["B"] = np.cross(local["Ng"], local["T"]) * T4[:, 3:4]
+        if uv is not None:
+            local["uv"] = np.asarray(uv, np.float64)
         return np.broadcast_to(np.asarray(shade(*[local[name] for name, _ in u.signature]), np.float64),
                                (n, 4)).copy()
     spec = None if variant is None else {SPEC_VARIANT: int(variant)}
-    return _gpu_uber(c.sources[0], n, P, Ng, V, material, mat, lts, spec)
+    rows = [P, Ng, V] + ([T] if "T" in u.surface else []) + ([uv] if "uv" in u.surface else [])
+    return _gpu_uber(c.sources[0], n, rows, material, mat, lts, spec)
 
 
-def _gpu_uber(source, n, P, Ng, V, material, mat, lts, spec=None) -> np.ndarray:
+def _gpu_uber(source, n, rows, material, mat, lts, spec=None) -> np.ndarray:
     from ..runtime.compute import STORAGE, UNIFORM, ComputePipeline
     from ..runtime.eval_kernel import KernelError, shared_device
     from ..toolchain import CompileJob, compile_many
@@ -225,9 +238,10 @@ def _gpu_uber(source, n, P, Ng, V, material, mat, lts, spec=None) -> np.ndarray:
     vk = device.vk
     pipe = ComputePipeline(device, res.spirv, (STORAGE, STORAGE, UNIFORM, STORAGE, STORAGE),
                            specialization=spec if source.language != "wgsl" else None)
-    sample = np.zeros((n, 3, 4), np.float32)
-    for j, r in enumerate((P, Ng, V)):
-        sample[:, j, :3] = r
+    sample = np.zeros((n, len(rows), 4), np.float32)  # P (w: the material), Ng, V[, T][, uv]: templates/*/shade
+    for j, r in enumerate(rows):
+        r = np.asarray(r)
+        sample[:, j, :r.shape[1]] = r
     sample[:, 0, 3] = material
     usage_s, usage_u = vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
 

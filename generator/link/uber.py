@@ -8,7 +8,7 @@ stands in for computes the same code; `coverage()` proves every axis value reach
 Data (documented in NOTES.md, "Ubershader"; the manifest lists the tables):
 - `material_buffer`: MaterialEntry { ids: ivec4; data: vec4[M] } per material. ids.x is the
   material *variant* — a (BRDF, packing, output) combination of the table `variants`; ids.y,
-  ids.z, ids.w are its BRDF, packing and output indices (for the engine's bookkeeping).
+  ids.z and ids.w are reserved (0).
   `data` holds exactly the variant's specialized Material block (the same bytes as the
   specialized permutation's `uploads`), M the largest of them.
 - `light_buffer`: LightEntry { ids: ivec4; data: vec4[K] } per light, looped over with a
@@ -76,9 +76,11 @@ class Uber:
         blocks = [] if kernel else [Block("Frame", 0, 0, "uniform", list(FRAME_BLOCK)), Block("Object", 2, 0, "uniform", list(OBJECT_BLOCK)),
                                     Block("Draw", *where["Draw"], "uniform",
                                           [{"name": "material", "type": "ivec4", "offset": 0, "size": 16}])]
-        blocks += [Block("LightBuffer", *where["light_buffer"], "storage", entry("LightEntry", self.light_vec4s)),
-                   Block("MaterialBuffer", *where["material_buffer"], "storage",
-                         entry("MaterialEntry", self.material_vec4s))]
+        if self.light_types:
+            blocks.append(Block("LightBuffer", *where["light_buffer"], "storage",
+                                entry("LightEntry", self.light_vec4s)))
+        blocks.append(Block("MaterialBuffer", *where["material_buffer"], "storage",
+                            entry("MaterialEntry", self.material_vec4s)))
         stages = {"comp": "main"} if kernel else {"vert": "main", "frag": "main"}
         return Interface(stages, self.reads, self.surface, blocks, self.textures, [Location(0, "out_color", "vec4")])
 
@@ -86,7 +88,7 @@ class Uber:
         return {"variants": [{"id": k, "brdf": v.brdf, "packing": v.packing, "output": v.output,
                               "parameters": [s.as_dict() for s in v.slots]} for k, v in enumerate(self.variants)],
                 "light_types": self.light_types, "shadows": self.shadows, "shadow_maps": self.shadow_maps,
-                "material_entry": {"ids": "ivec4 (variant, brdf, packing, output)", "data_vec4s": self.material_vec4s},
+                "material_entry": {"ids": "ivec4 (variant, 0, 0, 0)", "data_vec4s": self.material_vec4s},
                 "light_entry": {"ids": "ivec4 (light type, shadow, shadow map, 0)", "data_vec4s": self.light_vec4s,
                                 "shadow_parameters_at": self.light_split}}
 
@@ -153,7 +155,7 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
     mbuf = ir.Global("material_buffer", storage_buffer(MaterialEntry))
     lbuf = ir.Global("light_buffer", storage_buffer(LightEntry))
     prog.structs += [MaterialEntry, LightEntry]
-    prog.globals += [mbuf, lbuf]
+    prog.globals += [mbuf] + ([lbuf] if lnodes else [])  # no lights: nothing reads a light buffer
 
     glues, packings, outputs = [], [], []
     for k, v in enumerate(variants):
@@ -212,8 +214,9 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
             cases.append(case)
         stmts.append(_switch(b, b.copy(variant), cases))
         stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
-        stmts.append(_light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues,
-                                 packings, provided, material_args, variant, shadowed))
+        if lnodes:  # a scene without lights shades black: no loop, the light buffer is still bound
+            stmts.append(_light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues,
+                                     packings, provided, material_args, variant, shadowed))
         stmts.append(b.decl("color", b.construct(VEC4, b.const(0.0))))
         outs = [[b.assign(b.var("color", VEC4), bind.call(prog, on, "output", "o_", "material", None, {},
                                                           {**material_args(k), "color": b.var("Lo", VEC3)}))]
@@ -349,6 +352,6 @@ def coverage(uber: Uber, perms: list[Permutation], lib) -> list[str]:
             if lk.shadow not in uber.shadows:
                 problems.append(f"shadow filter '{lk.shadow}' of {p.hash} is not in the ubershader's shadow switch")
         need = sum(1 for lk in p.lights if _shadow_textures(lib, lk.shadow))
-        if need > max(uber.shadow_maps, 0):
+        if need > uber.shadow_maps:
             problems.append(f"{p.hash} samples {need} shadow maps; the ubershader binds {uber.shadow_maps}")
     return problems

@@ -24,7 +24,7 @@ HEADER = struct.Struct("<IIII16s")  # headerSize, headerVersion, vendorID, devic
 HEADER_VERSION_ONE = 1
 
 
-def _lib(vk):
+def _lib():
     import vulkan._vulkan as raw  # the binding wraps no vkGetPipelineCacheData; cffi's lib has it
     return raw.lib
 
@@ -59,12 +59,9 @@ class PipelineCacheFile:
         self.device, self.path = device, Path(path)
         self.problem = ""  # one line when an existing file was ignored
         self.loaded = 0  # bytes of valid data it started from
-        data = b""
-        try:
+        data, exists = b"", self.path.exists()
+        if exists:
             data = self.path.read_bytes()
-        except FileNotFoundError:
-            pass
-        if data:
             why = check(data, device)
             if why:
                 self.problem = f"{self.path}: pipeline cache ignored, {why} — it is replaced on save"
@@ -78,7 +75,7 @@ class PipelineCacheFile:
 
     def data(self) -> bytes:
         """What the driver holds now (vkGetPipelineCacheData)."""
-        vk, lib = self.vk, _lib(self.vk)
+        vk, lib = self.vk, _lib()
         size = vk.ffi.new("size_t*")
         lib.vkGetPipelineCacheData(self.device.handle, self.handle, size, vk.ffi.NULL)
         buf = vk.ffi.new("char[]", size[0])

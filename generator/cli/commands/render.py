@@ -33,8 +33,12 @@ def run(args) -> int:
         raise UserError(f"--frames {args.frames} — draw at least one frame")
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)
-    report = render_scene(scene, lib, args.mode, args.frames, Path(args.out), (int(m[1]), int(m[2])),
-                          args.language, progress=progress())
+    from ...runtime.device import VulkanUnavailable
+    try:
+        report = render_scene(scene, lib, args.mode, args.frames, Path(args.out), (int(m[1]), int(m[2])),
+                              args.language, progress=progress())
+    except VulkanUnavailable as e:
+        raise UserError(f"no Vulkan device to render on: {e} — install Mesa lavapipe (`make setup`)") from None
     if report.cache_problem:
         print(f"warning: {report.cache_problem}", file=sys.stderr)
     last = report.steady
