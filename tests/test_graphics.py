@@ -26,7 +26,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from generator.runtime.meshes import plane, uv_sphere
+from generator.runtime.meshes import box, plane, uv_sphere
 from tests.lavapipe import device, no_validation_messages  # noqa: F401 (fixtures)
 
 LANGS = ("glsl", "hlsl", "wgsl")
@@ -61,8 +61,9 @@ def _uv_frame_check(m):
     assert (np.einsum("ij,ij->i", dpdv, b) > 0).all()
 
 
-@pytest.mark.parametrize("make", [lambda: uv_sphere(12, 24, radius=2.0), lambda: plane(3.0, 4, height=-1.0)],
-                         ids=["sphere", "plane"])
+@pytest.mark.parametrize("make", [lambda: uv_sphere(12, 24, radius=2.0), lambda: plane(3.0, 4, height=-1.0),
+                                  lambda: box(), lambda: box((1.0, 0.5, 3.0))],
+                         ids=["sphere", "plane", "box", "box-non-uniform"])
 def test_meshes_are_deterministic_float32_with_unit_frames_and_outward_winding(make):
     m = make()
     assert all(a.dtype == np.float32 and a.flags.c_contiguous for a in m.attributes().values())
@@ -91,6 +92,19 @@ def test_sphere_positions_lie_on_the_sphere_along_their_normals():
     assert m.index_count == 3 * 2 * 16 * (8 - 1)
     with pytest.raises(ValueError):
         uv_sphere(1, 16)
+
+
+def test_the_box_spans_its_size_with_flat_faces():
+    m = box((2.0, 1.0, 4.0))
+    assert m.vertex_count == 24 and m.index_count == 36
+    np.testing.assert_array_equal(m.positions.min(0), [-1.0, -0.5, -2.0])
+    np.testing.assert_array_equal(m.positions.max(0), [1.0, 0.5, 2.0])
+    # every vertex lies on the face its normal names
+    extent = np.array([1.0, 0.5, 2.0])
+    np.testing.assert_allclose(np.einsum("ij,ij->i", m.positions, m.normals), np.abs(m.normals) @ extent)
+    assert len(np.unique(m.normals, axis=0)) == 6
+    with pytest.raises(ValueError):
+        box((1.0, 0.0, 1.0))
 
 
 def test_save_png_writes_atomically_and_round_trips(tmp_path):
@@ -270,7 +284,8 @@ def gpu(device):
 
     yield SimpleNamespace(gx=gx, target=target, sphere=sphere, floor=floor, pipeline=pipeline, camera=camera,
                           spec_resources=spec_resources, uber_buffers=uber_buffers, uber_resources=uber_resources,
-                          frame=frame, composed=composed)
+                          frame=frame, composed=composed, buf=buf, owned=owned,
+                          spirv=lambda tag, stage, lang: res[names[(tag, stage, lang)]].spirv)
     for obj in reversed(owned):
         obj.destroy()
 
@@ -450,3 +465,115 @@ def test_object_block_carries_the_inverse_transpose_so_normals_survive_non_unifo
     t = mesh.tangents[:, :3].astype(np.float64) @ m[:3, :3].T
     np.testing.assert_allclose(np.sum(n * t, 1), 0.0, atol=1e-6)  # still perpendicular to the surface
     assert np.abs(np.sum((mesh.normals @ m[:3, :3].T) * t, 1)).max() > 0.1  # mat3(model) would not be
+
+
+# ------------------------------------------------------------------ shadow matrices and the depth pass
+
+def _clip(m, pts):
+    p = np.c_[np.asarray(pts, np.float64), np.ones(len(pts))] @ np.asarray(m).T
+    return p[:, :3] / p[:, 3:]
+
+
+def test_a_directional_shadow_matrix_projects_along_the_light_into_vulkan_clip_space():
+    from generator.runtime import graphics as gx
+
+    rng = np.random.default_rng(3)
+    pts = rng.uniform(-3.0, 3.0, (50, 3))
+    for d in ([0.3, 0.9, 0.3], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [1.0, 0.2, -0.5]):
+        m = gx.directional_shadow_matrix(d, pts)
+        p = _clip(m, pts)
+        assert (np.abs(p[:, :2]) <= 1.0).all() and (p[:, 2] >= 0.0).all() and (p[:, 2] <= 1.0).all()
+        assert np.abs(p[:, :2]).max() > 0.9, "the bounds fill the map (a small margin)"
+        u = np.asarray(d, np.float64) / np.linalg.norm(d)
+        q = _clip(m, pts + 0.5 * u)  # toward the light: same texel, nearer (smaller depth)
+        np.testing.assert_allclose(q[:, :2], p[:, :2], atol=1e-12)
+        assert (q[:, 2] < p[:, 2]).all()
+        assert gx.column_major(m)[12:15] == list(m[:3, 3]), "column-major: the translation is the last column"
+    with pytest.raises(ValueError):
+        gx.directional_shadow_matrix([0.0, 0.0, 0.0], pts)
+
+
+def test_a_point_light_shadow_matrix_covers_the_points_from_the_light():
+    from generator.runtime import graphics as gx
+
+    rng = np.random.default_rng(4)
+    pts = rng.uniform(-2.0, 2.0, (50, 3))
+    pos = np.array([1.0, 6.0, 2.0])
+    m = gx.point_shadow_matrix(pos, pts)
+    p = _clip(m, pts)
+    assert (np.abs(p[:, :2]) <= 1.0).all() and (p[:, 2] >= 0.0).all() and (p[:, 2] <= 1.0).all()
+    q = _clip(m, pos + 0.7 * (pts - pos))  # along the ray from the light: same texel, nearer
+    np.testing.assert_allclose(q[:, :2], p[:, :2], atol=1e-9)
+    assert (q[:, 2] < p[:, 2]).all()
+
+
+@pytest.mark.lavapipe
+@pytest.mark.toolchain
+def test_a_depth_only_pass_stores_the_analytic_depth_and_is_sampled_as_a_shadow_map(device, gpu):
+    """A vertex-only pipeline renders the floor (y = −1.2, side 6) and a sphere into a DepthTarget with a
+    directional shadow matrix; the read-back depth equals the floor's analytic depth where only the floor is
+    seen, the sphere is nearer the light, and nothing drawn is the cleared 1.0."""
+    from generator.runtime import graphics as gx
+    from generator.runtime.compute import UNIFORM
+
+    vk = device.vk
+    U = vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
+    n = 64
+    dt = gx.DepthTarget(device, n, n)
+    gpu.owned.append(dt)
+    assert dt.sampled in ("depth", "r32_copy")
+    feats = vk.vkGetPhysicalDeviceFormatProperties(device.physical, vk.VK_FORMAT_D32_SFLOAT).optimalTilingFeatures
+    linear = bool(feats & vk.VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)
+    assert dt.sampled == ("depth" if linear else "r32_copy")  # lavapipe (Mesa 22.3): no linear D32 → the copy
+    c = gpu.composed[f"spec-{TEX}"]  # the vertex shader with every input
+    layouts = {0: {0: UNIFORM}, 2: {0: UNIFORM}}
+    with pytest.raises(ValueError, match="needs a fragment shader"):
+        gx.GraphicsPipeline(device, gpu.target, gpu.spirv(f"spec-{TEX}", "vert", "glsl"), None,
+                            c.interface.vertex_inputs, layouts)
+    floor_pts = np.array([(x, -1.2, z) for x in (-3.0, 3.0) for z in (-3.0, 3.0)])
+    light = np.array([0.4, 1.0, 0.2])
+    m = gx.directional_shadow_matrix(light, np.r_[floor_pts, [(-1, -1, -1), (1, 1, 1)]])
+    frame = gpu.buf(gx.frame_bytes(m, (0.0, 0.0, 0.0)), U)
+    with pytest.raises(RuntimeError, match="before any draw"):
+        dt.read()
+    for lang in LANGS:
+        pipe = gx.GraphicsPipeline(device, dt, gpu.spirv(f"spec-{TEX}", "vert", lang), None,
+                                   c.interface.vertex_inputs, layouts)
+        gpu.owned.append(pipe)
+        dt.draw([gx.DrawItem(pipe, gpu.floor, {(0, 0): frame, (2, 0): gpu.buf(gx.object_bytes(np.eye(4)), U)})])
+        floor_only = dt.read()
+        dt.draw([gx.DrawItem(pipe, gpu.floor, {(0, 0): frame, (2, 0): gpu.buf(gx.object_bytes(np.eye(4)), U)}),
+                 gx.DrawItem(pipe, gpu.sphere, {(0, 0): frame, (2, 0): gpu.buf(gx.object_bytes(np.eye(4)), U)})])
+        both = dt.read()
+        # analytic: texel centre (x, y) in clip space → the floor point there → its depth
+        xs = 2.0 * (np.arange(n) + 0.5) / n - 1.0
+        cx, cy = np.meshgrid(xs, xs)  # row 0 = clip y −1
+        a, b = m[:2, [0, 2]], m[:2, 1] * -1.2 + m[:2, 3]
+        xz = np.linalg.solve(a, np.stack([cx.ravel() - b[0], cy.ravel() - b[1]]))
+        depth = (m[2, 0] * xz[0] + m[2, 2] * xz[1] + m[2, 1] * -1.2 + m[2, 3]).reshape(n, n)
+        inside = (np.abs(xz[0]) < 2.9) & (np.abs(xz[1]) < 2.9)
+        outside = (np.abs(xz[0]) > 3.1) | (np.abs(xz[1]) > 3.1)
+        inside, outside = inside.reshape(n, n), outside.reshape(n, n)
+        assert inside.sum() > 1000 and outside.sum() > 50
+        np.testing.assert_allclose(floor_only[inside], depth[inside], atol=1e-5)
+        assert (floor_only[outside] == 1.0).all(), "cleared to the far plane where nothing was drawn"
+        # the sphere (r = 1 at the origin) is nearer the light where the texel's light ray passes within r
+        g = np.stack([xz[0], np.full(n * n, -1.2), xz[1]], -1)
+        u = light / np.linalg.norm(light)
+        dist = np.linalg.norm(g - (g @ u)[:, None] * u, axis=-1).reshape(n, n)
+        hit, miss = dist < 0.95, dist > 1.05
+        assert hit.sum() > 100
+        assert (both[hit] < floor_only[hit] - 1e-3).all(), "the sphere lies between the light and the floor"
+        assert np.array_equal(both[miss], floor_only[miss])
+    # sampled before its first draw: refused
+    fresh = gx.DepthTarget(device, 8, 8)
+    gpu.owned.append(fresh)
+    new_frame = gpu.camera((0.0, 0.0, 3.0))
+    res = gpu.spec_resources(TEX, new_frame(np.eye(4)))
+    key = (1, 1)  # the albedo texture's sampled image
+    assert gpu.pipeline(f"spec-{TEX}", "glsl").set_layouts[1][1] == "sampled_image"
+    res[key] = fresh
+    with pytest.raises(ValueError, match="before its first draw"):
+        gpu.target.draw([gx.DrawItem(gpu.pipeline(f"spec-{TEX}", "glsl"), gpu.sphere, res)])
+    res[key] = dt  # a drawn depth target is a sampled image like any texture
+    gpu.frame([gx.DrawItem(gpu.pipeline(f"spec-{TEX}", "glsl"), gpu.sphere, res)])

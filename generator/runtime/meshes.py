@@ -1,4 +1,4 @@
-"""Meshes for the offscreen renderer, generated in NumPy: a UV sphere and a plane.
+"""Meshes for the offscreen renderer, generated in NumPy: a UV sphere, a plane and a box.
 
 A :class:`Mesh` holds separate float32 arrays, one per vertex attribute, named as the
 vertex shaders' inputs (link/interface.VERTEX_INPUTS): ``a_position`` (vec3),
@@ -111,3 +111,42 @@ def plane(size: float = 2.0, divisions: int = 1, height: float = 0.0) -> Mesh:
             # a → b is +z, a → c is +x: (a, b, c) winds counter-clockwise seen from +y.
             idx += [(a, b, c), (c, b, d)]
     return _mesh(p, nrm, t, uv, np.array(idx))
+
+
+# Faces of box(): (normal, u direction, v direction), seen from outside u runs to the right and v down
+# (v = 0 is the top edge of the side faces, as an image's first row).
+_BOX_FACES = (((1, 0, 0), (0, 0, -1), (0, -1, 0)), ((-1, 0, 0), (0, 0, 1), (0, -1, 0)),
+              ((0, 1, 0), (1, 0, 0), (0, 0, 1)), ((0, -1, 0), (1, 0, 0), (0, 0, -1)),
+              ((0, 0, 1), (1, 0, 0), (0, -1, 0)), ((0, 0, -1), (-1, 0, 0), (0, -1, 0)))
+
+
+def box(size=2.0) -> Mesh:
+    """An axis-aligned box centred at the origin, sides `size` (a number, or (x, y, z)); default 2: the box
+    spans [−1, 1]³ like the unit sphere.
+
+    Six faces of 4 vertices each (24 vertices, 12 triangles), flat normals. Per face, uv = (0, 0) … (1, 1);
+    seen from outside, u runs to the right and v down (side faces: v = 0 at the top; the top face: v along
+    +z; the bottom face: v along −z). T = the u direction, w = ±1 such that cross(N, T) · w is the
+    v direction. Triangles counter-clockwise seen from outside.
+    """
+    half = np.broadcast_to(np.asarray(size, np.float64), (3,)) / 2.0
+    if (half <= 0).any():
+        raise ValueError(f"a box needs sides > 0, got {size}")
+    p, nrm, tan, uv, idx = [], [], [], [], []
+    for f, (n, t, b) in enumerate(_BOX_FACES):
+        n, t, b = (np.asarray(x, np.float64) for x in (n, t, b))
+        w = float(np.sign(np.cross(n, t) @ b))
+        base = 4 * f
+        for v in (0.0, 1.0):
+            for u in (0.0, 1.0):
+                p.append((n + (2 * u - 1) * t + (2 * v - 1) * b) * half)
+                nrm.append(n)
+                tan.append((*t, w))
+                uv.append((u, v))
+        a, c, d, e = base, base + 1, base + 2, base + 3  # (u, v) = (0, 0), (1, 0), (0, 1), (1, 1)
+        # a → c is +t, a → d is +b: (a, c, d) winds counter-clockwise seen from n when cross(t, b) = n.
+        if np.cross(t, b) @ n > 0:
+            idx += [(a, c, d), (d, c, e)]
+        else:
+            idx += [(a, d, c), (c, d, e)]
+    return _mesh(np.array(p), np.array(nrm), np.array(tan), np.array(uv), np.array(idx))

@@ -8,17 +8,30 @@ Hoffman & Baker 2006: "use Ubershader as fallback, shader matrix as a cache". Mo
   requested frames the queue is drained and one more frame is drawn (`steady`): it uses no
   ubershader.
 
-Placement (documented in NOTES.md, "Renderer"): each object is a unit UV sphere; objects
-stand in a row along x, 2.5 apart, in scene order; the camera looks at the row's centre
-from above and in front. Textures are generated: an sRGB albedo checker, a normal map of
-known bumps; shadow maps are cleared to the far plane (everything lit) until the depth
-pass exists. Pipelines are created through a persisted pipeline cache
-(runtime/pipeline_cache.py).
+Placement (documented in NOTES.md, "Renderer"): read from the placement file beside the scene,
+SCENE.placement.toml (:func:`placement_path`, schema in :func:`load_placement`: per object a mesh,
+translate, scale, rotate_y; an optional camera); without one, each object is a unit UV sphere,
+the objects stand in a row along x, 2.5 apart, in scene order, and the camera looks at the row's
+centre from above and in front (:func:`camera`, :func:`placement`).
+
+Shadows: for every light whose shadow filter samples a texture (shadow_map), a depth pass
+before the first frame renders every object's depth from the light into a
+:class:`~.graphics.DepthTarget` (``shadow_size`` square, vertex stage only: the compiled vertex
+shader with the most vertex inputs, its Frame.view_proj = the light's shadow matrix). A
+directional light's matrix is an orthographic projection along its direction fitted to the
+placed objects' bounds (:func:`~.graphics.directional_shadow_matrix`), a point light's a
+perspective one from its position (:func:`~.graphics.point_shadow_matrix`); the matrix is
+written into the light's shadow_matrix parameter of both paths (the specialized Lights
+blocks and the ubershader's LightEntry data), and the depth map is bound as the light's
+shadow map. Other textures are generated: an sRGB albedo checker, a normal map of known
+bumps. Pipelines are created through a persisted pipeline cache (runtime/pipeline_cache.py).
 """
 from __future__ import annotations
 
+import difflib
 import threading
 import time
+import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -26,6 +39,8 @@ import numpy as np
 
 MODES = ("specialized", "ubershader", "hybrid")
 SPACING = 2.5
+SHADOW_SIZE = 512
+MESHES = ("sphere", "plane", "box")  # every one spans [-1, 1] on its axes (the plane: y = 0)
 
 
 @dataclass
@@ -48,6 +63,11 @@ class Report:
     pipeline_create_ms: list[float] = field(default_factory=list)
     pipeline_cache_hits: int = 0
     cache_problem: str = ""
+    placement: str = ""  # the placement file read, or "row" (the fallback)
+    # per shadowed light: size, gpu_ms of its depth pass, how it is sampled ("depth" | "r32_copy"), its matrix
+    shadow_maps: dict = field(default_factory=dict)
+    validation: bool = False  # whether the Khronos validation layer was on
+    validation_messages: list[str] = field(default_factory=list)  # what the layer said during this render
 
     def as_dict(self) -> dict:
         from dataclasses import asdict
@@ -55,7 +75,8 @@ class Report:
 
 
 def _textures(device):
-    """A 16×16 sRGB checker albedo, a 32×32 normal map of bumps, a lit (depth 1) shadow map."""
+    """A 16×16 sRGB checker albedo, a 32×32 normal map of bumps, a lit (depth 1) stand-in shadow map (bound
+    where an ubershader shadow-map slot is unused by a draw's lights)."""
     j, i = np.meshgrid(np.arange(16), np.arange(16))
     albedo = np.where(((i // 4 + j // 4) % 2 == 0)[..., None], [230, 200, 120], [90, 140, 200]).astype(np.uint8)
     v, u = np.meshgrid((np.arange(32) + 0.5) / 32, (np.arange(32) + 0.5) / 32, indexing="ij")
@@ -67,8 +88,10 @@ def _textures(device):
             "shadow_map": device.image(shadow)}
 
 
+# ------------------------------------------------------------------ placement
+
 def camera(n: int, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    """(eye, view_proj) looking at a row of n objects (see the module docstring)."""
+    """(eye, view_proj) looking at a row of n objects (the fallback placement; see the module docstring)."""
     from . import graphics as gx
 
     eye = np.array([0.0, 2.5, 3.0 + 1.6 * n])
@@ -76,10 +99,260 @@ def camera(n: int, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def placement(i: int, n: int) -> np.ndarray:
-    """The model matrix of object i of n: a unit sphere in the row along x."""
+    """The model matrix of object i of n in the fallback row: a unit sphere along x."""
     model = np.eye(4)
     model[0, 3] = (i - (n - 1) / 2.0) * SPACING
     return model
+
+
+def make_mesh(kind: str):
+    """The mesh a placement names: a unit UV sphere (24 × 48), a plane of side 2 in y = 0, or a box [−1, 1]³."""
+    from .meshes import box, plane, uv_sphere
+
+    return {"sphere": lambda: uv_sphere(24, 48), "plane": lambda: plane(2.0), "box": lambda: box(2.0)}[kind]()
+
+
+@dataclass(frozen=True)
+class Placed:
+    """One object's placement: its mesh and model = translate · rotate_y · scale (scale: half-extents)."""
+
+    name: str
+    mesh: str = "sphere"
+    translate: tuple = (0.0, 0.0, 0.0)
+    scale: tuple = (1.0, 1.0, 1.0)
+    rotate_y: float = 0.0  # degrees, counter-clockwise seen from +y
+
+    @property
+    def model(self) -> np.ndarray:
+        c, s = np.cos(np.radians(self.rotate_y)), np.sin(np.radians(self.rotate_y))
+        m = np.eye(4)
+        m[:3, :3] = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]) @ np.diag(self.scale)
+        m[:3, 3] = self.translate
+        return m
+
+    def corners(self) -> np.ndarray:
+        """The world positions of the corners of the mesh's bounds, (8, 3) (a plane's are 4, given twice)."""
+        y = (0.0,) if self.mesh == "plane" else (-1.0, 1.0)
+        local = np.array([(x, yy, z, 1.0) for x in (-1.0, 1.0) for yy in y for z in (-1.0, 1.0)])
+        local = np.concatenate([local] * (8 // len(local)))
+        return (self.model @ local.T).T[:, :3]
+
+
+@dataclass
+class Placement:
+    """Every object of a scene placed, in scene order, and the camera.
+
+    `source`: the placement file, or None for the fallback row (whose camera is :func:`camera`). `eye` /
+    `target` None: the camera frames the objects' bounds from above and in front."""
+
+    objects: list[Placed]
+    source: Path | None = None
+    eye: tuple | None = None
+    target: tuple | None = None
+    fov_y: float = 40.0
+
+    def model(self, i: int) -> np.ndarray:
+        return self.objects[i].model
+
+    def points(self) -> np.ndarray:
+        """Corners of every object's bounds, (8 n, 3): what a light's shadow matrix must cover."""
+        return np.concatenate([o.corners() for o in self.objects]) if self.objects else np.zeros((1, 3))
+
+    def camera(self, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """(eye, view_proj) for a width × height image."""
+        from . import graphics as gx
+
+        if self.source is None:
+            return camera(len(self.objects), width, height)
+        pts = self.points()
+        lo, hi = pts.min(0), pts.max(0)
+        target = np.array(self.target if self.target is not None else 0.5 * (lo + hi), np.float64)
+        if self.eye is not None:
+            eye = np.array(self.eye, np.float64)
+        else:
+            r = 0.5 * float(np.linalg.norm(hi - lo)) + 1e-3
+            half = np.radians(self.fov_y) / 2.0 * min(1.0, width / height)
+            direction = np.array([0.0, 0.6, 1.0]) / np.linalg.norm([0.0, 0.6, 1.0])
+            eye = target + direction * r / np.sin(half)
+        far = max(100.0, 2.0 * float(np.linalg.norm(pts - eye, axis=1).max()))
+        return eye, gx.perspective(self.fov_y, width / height, 0.1, far) @ gx.look_at(eye, target)
+
+
+def row_placement(names) -> Placement:
+    """The fallback: unit spheres in a row along x (:func:`placement`), the camera of :func:`camera`."""
+    n = len(names)
+    return Placement([Placed(name, "sphere", tuple(placement(i, n)[:3, 3])) for i, name in enumerate(names)])
+
+
+def placement_path(scene_path) -> Path:
+    """Where a scene's placement file lives: beside it, SCENE.placement.toml (scenes/example.placement.toml)."""
+    p = Path(scene_path)
+    return p.with_name(p.stem + ".placement.toml")
+
+
+_OBJECT_KEYS = ("mesh", "translate", "scale", "rotate_y")
+_CAMERA_KEYS = ("eye", "target", "fov_y")
+
+
+def load_placement(scene, path=None) -> Placement:
+    """The placement of `scene`'s objects: from `path` (default :func:`placement_path` of the scene), or the
+    fallback row when that file does not exist (an explicit `path` must exist).
+
+    Schema (TOML)::
+
+        [objects.NAME]            # one table per object of the scene: every object, no others
+        mesh = "box"              # "sphere" | "plane" | "box"; each spans [-1, 1] (a plane: in y = 0)
+        translate = [x, y, z]     # default [0, 0, 0]
+        scale = [sx, sy, sz]      # or one number; > 0; half-extents (default 1)
+        rotate_y = 30.0           # degrees about +y, counter-clockwise seen from above (default 0)
+
+        [camera]                  # optional
+        eye = [x, y, z]           # default: framing the objects' bounds from above and in front
+        target = [x, y, z]        # default: the centre of the bounds
+        fov_y = 40.0              # vertical field of view in degrees (default 40)
+
+    model = translate · rotate_y · scale. Every mistake is a SourceError ``path:line:col: what — what to do``.
+    """
+    from ..lang import SourceError
+    from ..lang.errors import UserError, read_text
+    from ..matrix.scene import Locator
+
+    names = [o["name"] for o in scene.objects]
+    explicit = path is not None
+    path = Path(path) if explicit else placement_path(scene.path)
+    if not path.exists():
+        if explicit:
+            raise UserError(f"{path}: no such placement file — give an existing file, or none for the row")
+        return row_placement(names)
+    shown = str(path)
+    text = read_text(path, "placement file")
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        import re
+
+        m = re.search(r"\(at line (\d+), column (\d+)\)", str(e))
+        line, col = (int(m.group(1)), int(m.group(2))) if m else (1, 1)
+        msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(e))
+        raise SourceError(shown, line, col, f"TOML syntax error: {msg}", "fix the placement file's syntax") from None
+    loc = Locator(shown, text)
+
+    def top(key):
+        import re
+
+        for i, line in enumerate(loc.lines):
+            if re.match(r"^\s*\[\[?\s*" + re.escape(key) + r"\b", line) or re.match(r"^\s*" + re.escape(key) + r"\s*=",
+                                                                                   line):
+                return i + 1, line.index(key) + 1
+        return 1, 1
+
+    def unknown(what, key, known, where):
+        close = difflib.get_close_matches(key, known, 1)
+        hint = f"did you mean '{close[0]}'? " if close else ""
+        return loc.error(where, f"unknown {what} '{key}'", f"{hint}known: {', '.join(known)}")
+
+    for key in data:
+        if key not in ("objects", "camera"):
+            raise unknown("section", key, ["camera", "objects"], top(key))
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:
+        raise loc.error((1, 1), f"the scene {scene.path} names more than one object '{dupes[0]}': a placement "
+                                "cannot tell them apart", "give the scene's objects distinct names")
+    objects = data.get("objects", {})
+    if not isinstance(objects, dict):
+        raise loc.error(top("objects"), "'objects' must be a table of tables", "write [objects.NAME] sections")
+
+    def vec3(header, key, value, default):
+        if value is None:
+            return default
+        ok = (isinstance(value, list) and len(value) == 3
+              and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in value))
+        if not ok:
+            raise loc.error(loc.find(header, key), f"{key} must be three numbers, got {value!r}",
+                            f"write {key} = [x, y, z]")
+        return tuple(float(x) for x in value)
+
+    def number(header, key, value, default):
+        if value is None:
+            return default
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            raise loc.error(loc.find(header, key), f"{key} must be a number, got {value!r}", f"write {key} = 30.0")
+        return float(value)
+
+    placed = {}
+    for name, t in objects.items():
+        header = f"objects.{name}"
+        if name not in names:
+            close = difflib.get_close_matches(name, names, 1)
+            raise loc.error(loc.find(header), f"the scene has no object '{name}'",
+                            (f"did you mean '{close[0]}'? " if close else "") + f"objects: {', '.join(names)}")
+        if not isinstance(t, dict):
+            raise loc.error(top("objects"), f"objects.{name} must be a table", f"write [objects.{name}]")
+        for key in t:
+            if key not in _OBJECT_KEYS:
+                raise unknown(f"key of objects.{name}", key, list(_OBJECT_KEYS), loc.find(header, key))
+        mesh = t.get("mesh", "sphere")
+        if mesh not in MESHES:
+            raise loc.error(loc.find(header, "mesh"), f"unknown mesh {mesh!r}", f"use one of {', '.join(MESHES)}")
+        scale = t.get("scale")
+        if isinstance(scale, (int, float)) and not isinstance(scale, bool):
+            scale = [scale] * 3
+        scale = vec3(header, "scale", scale, (1.0, 1.0, 1.0))
+        if min(scale) <= 0:
+            raise loc.error(loc.find(header, "scale"), f"scale must be > 0 on every axis, got {list(scale)}",
+                            "give half-extents > 0 (a flat object: a plane, or a small scale)")
+        placed[name] = Placed(name, mesh, vec3(header, "translate", t.get("translate"), (0.0, 0.0, 0.0)), scale,
+                              number(header, "rotate_y", t.get("rotate_y"), 0.0))
+    missing = [n for n in names if n not in placed]
+    if missing:
+        raise loc.error((1, 1), f"object '{missing[0]}' of the scene has no placement",
+                        f"add [objects.{missing[0]}] with mesh, translate, scale, rotate_y")
+    cam = data.get("camera", {})
+    if not isinstance(cam, dict):
+        raise loc.error(top("camera"), "'camera' must be a table", "write [camera] with eye, target, fov_y")
+    for key in cam:
+        if key not in _CAMERA_KEYS:
+            raise unknown("key of camera", key, list(_CAMERA_KEYS), loc.find("camera", key))
+    fov = number("camera", "fov_y", cam.get("fov_y"), 40.0)
+    if not 0.0 < fov < 180.0:
+        raise loc.error(loc.find("camera", "fov_y"), f"fov_y {fov} is not between 0 and 180 degrees",
+                        "write e.g. fov_y = 40.0")
+    eye, target = vec3("camera", "eye", cam.get("eye"), None), vec3("camera", "target", cam.get("target"), None)
+    if eye is not None and target is not None and np.allclose(eye, target):
+        raise loc.error(loc.find("camera", "eye"), "the camera's eye and target coincide", "move the eye away")
+    return Placement([placed[n] for n in names], path, eye, target, fov)
+
+
+# ------------------------------------------------------------------ shadows
+
+def shadow_textures(lib, shadow: str) -> list[str]:
+    """The textures a shadow filter spec samples ([] for "none")."""
+    from ..matrix.permutation import parse_spec
+
+    node = parse_spec(shadow, lib, ("shadow",))[0]
+    return [t for n in node.walk() for t in n.brick.textures]
+
+
+def shadow_matrix(light, values: dict, points) -> np.ndarray:
+    """World → light clip space (row-major) of a scene light, fitted to `points`; `values` its parameters."""
+    from ..lang.errors import UserError
+    from . import graphics as gx
+
+    if light.type == "directional":
+        return gx.directional_shadow_matrix(values["direction"], points)
+    if light.type == "point":
+        return gx.point_shadow_matrix(values["position"], points)
+    raise UserError(f"light '{light.name}': the renderer has no shadow projection for light type '{light.type}' "
+                    "— use shadow = \"none\" for it")
+
+
+def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict) -> bytes:
+    """A specialized Lights block with each shadowed light's l<i>_shadow_matrix slot replaced."""
+    data = np.frombuffer(raw, np.float32).reshape(-1, 4).copy()
+    for s in slots:
+        if s.param == "shadow_matrix" and s.light is not None and lights[s.light] in matrices:
+            data[s.index:s.index + 4] = np.asarray(matrices[lights[s.light]], np.float32).reshape(4, 4)
+    return data.tobytes()
 
 
 def _entries(ids: np.ndarray, data: np.ndarray) -> np.ndarray:
@@ -92,12 +365,15 @@ def _entries(ids: np.ndarray, data: np.ndarray) -> np.ndarray:
 
 
 def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), language: str = "glsl",
-                 device=None, progress: bool = False, uber_ids: str = "buffer") -> Report:
+                 device=None, progress: bool = False, uber_ids: str = "buffer", shadow_size: int = SHADOW_SIZE,
+                 placement_file=None) -> Report:
     """Render `frames` frames of `scene` into out/frame_NNNN.png; returns the report (also out/report.json).
 
     uber_ids: "buffer" (the variant read from the material entry: one ubershader pipeline) or
     "specialization" (the variant as specialization constant 0: one ubershader pipeline per material
     variant from the one module; WGSL: naga resolves the override per pipeline).
+    shadow_size: the side of every light's shadow map (depth pass), in texels.
+    placement_file: the placement to use (default: the scene's SCENE.placement.toml if present, else the row).
     """
     from ..link.values import uploads
     from ..compose import compose_permutation
@@ -106,16 +382,19 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..lang.errors import UserError
     from ..toolchain import CompileJob, compile_many
     from . import graphics as gx
+    from .compute import UNIFORM
     from .device import Device, validation_requested
     from ..link.uber import SPEC_VARIANT
-    from .meshes import uv_sphere
     from .pipeline_cache import PipelineCacheFile
 
     if mode not in MODES:
         raise UserError(f"unknown mode {mode!r} — use one of {', '.join(MODES)}")
+    if not (isinstance(shadow_size, int) and 1 <= shadow_size <= 8192):
+        raise UserError(f"shadow map size {shadow_size!r} — use a whole number of texels from 1 to 8192")
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise UserError(f"{out} is a file — give --out a directory")
+    placed = load_placement(scene, placement_file)
     out.mkdir(parents=True, exist_ok=True)
     W, H = size
     perms = dict(sorted(scene.permutations.items()))
@@ -138,17 +417,33 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         raise UserError(f"{len(bad)} shader(s) do not compile: {bad[0]} — run `shadermatrix build` for all errors")
     spv = {k: results[j.key].spirv for k, j in jobs.items()}
 
+    # Shadowed lights (their filter samples a texture) and their matrices, fitted to the placed objects.
+    points = placed.points()
+    light_vals = {ln: {k: L.params.get(k, sp.default) for k, sp in _light_specs(lib, L).items()}
+                  for ln, L in scene.lights.items()}
+    used = {ln for o in scene.objects for ln in o["lights"]}
+    shadowed = [ln for ln, L in scene.lights.items() if ln in used and shadow_textures(lib, L.shadow)]
+    matrices = {ln: gx.column_major(shadow_matrix(scene.lights[ln], light_vals[ln], points)) for ln in shadowed}
+    for ln in shadowed:
+        light_vals[ln]["shadow_matrix"] = matrices[ln]
+
     own_device = device is None
     device = device or Device(validation=validation_requested())
+    first_message = len(device.messages)
     owned = []
+    report = Report(mode, language, (W, H), placement=str(placed.source) if placed.source else "row")
     try:
-        report = Report(mode, language, (W, H))
         cache = PipelineCacheFile(device, out / f"pipeline_cache.{language}.bin")
         report.cache_problem = cache.problem
         target = gx.OffscreenTarget(device, W, H)
-        sphere = gx.GpuMesh(device, uv_sphere(24, 48))
+        owned += [target, cache]
+        meshes = {}
+        for kind in dict.fromkeys(o.mesh for o in placed.objects):
+            meshes[kind] = gx.GpuMesh(device, make_mesh(kind))
+            owned.append(meshes[kind])
+        mesh_of = [meshes[o.mesh] for o in placed.objects]
         textures, sampler = _textures(device), device.sampler()
-        owned += [target, sphere, *textures.values(), sampler, cache]
+        owned += [*textures.values(), sampler]
         vk = device.vk
         U, S = vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
 
@@ -174,8 +469,35 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             report.pipeline_cache_hits += p.cache_hit  # the driver's creation feedback
             return p
 
-        n = len(scene.objects)
-        eye, vp = camera(n, W, H)
+        object_bufs = [buf(gx.object_bytes(o.model), U) for o in placed.objects]
+
+        # Depth passes: one DepthTarget per shadowed light, every object drawn by a vertex-only pipeline.
+        shadow_maps = {}
+        if shadowed:
+            ifaces = [(tag, composed[tag].interface) for tag in composed] + [("ubershader", uber.interface)]
+            vtag, viface = max(ifaces, key=lambda x: len(x[1].vertex_inputs))  # all read the same Frame / Object
+            fb, ob = viface.block("Frame"), viface.block("Object")
+            layouts = {fb.set: {fb.binding: UNIFORM}}
+            layouts.setdefault(ob.set, {})[ob.binding] = UNIFORM
+            for ln in shadowed:
+                dt = gx.DepthTarget(device, shadow_size, shadow_size)
+                owned.append(dt)
+                t0 = time.perf_counter()
+                pipe = gx.GraphicsPipeline(device, dt, spv[(vtag, "vert")], None, viface.vertex_inputs, layouts,
+                                           cache=cache)
+                owned.append(pipe)
+                pipe_ms = (time.perf_counter() - t0) * 1e3
+                m = np.asarray(matrices[ln], np.float64).reshape(4, 4).T  # back to row-major
+                frame_l = buf(gx.frame_bytes(m, np.append(points.mean(0), 1.0)), U)
+                gpu = dt.draw([gx.DrawItem(pipe, mesh_of[i], {(fb.set, fb.binding): frame_l,
+                                                               (ob.set, ob.binding): object_bufs[i]})
+                               for i in range(len(placed.objects))])
+                shadow_maps[ln] = dt
+                report.shadow_maps[ln] = {"size": [shadow_size, shadow_size], "gpu_ms": gpu, "sampled": dt.sampled,
+                                          "pipeline_ms": pipe_ms, "vertex_shader": vtag,
+                                          "shadow_matrix": matrices[ln]}
+
+        eye, vp = placed.camera(W, H)
         variant = {v.key: k for k, v in enumerate(u.variants)}
         draws = []
         materials = sorted({o["material"] for o in scene.objects})
@@ -192,46 +514,71 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             mat_ids.append((k, 0, 0, 0))
             mat_rows.append(data)
         material_buffer = buf(_entries(np.array(mat_ids), np.stack(mat_rows)), S)
-        light_buffers = {}
+        light_buffers, slot_lights = {}, {}
         for set_name, names in scene.light_sets.items():
             ids, rows, shadow_slot = [], [], 0
+            slot_lights[set_name] = []  # ubershader shadow-map slot j -> the light whose map it is
             for ln in names:
                 L = scene.lights[ln]
-                vals = {k: L.params.get(k, s.default) for k, s in _light_specs(lib, L).items()}
+                vals = light_vals[ln]
                 data = np.zeros((u.light_vec4s, 4), np.float32)
                 for pname, (j, ty) in u.light_layouts[(L.type, L.shadow)].items():
                     val = np.asarray(vals[pname], np.float32).reshape(-1)
                     for c in range(0, len(val), 4):
                         data[j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
-                textured = bool([t for t in lib.get("shadow", L.shadow.split("(")[0]).textures])
+                textured = bool(shadow_textures(lib, L.shadow))
                 ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), shadow_slot if textured else 0, 0))
+                if textured:
+                    slot_lights[set_name].append(ln)
                 shadow_slot += textured
                 rows.append(data)
-            light_buffers[set_name] = buf(_entries(np.array(ids), np.stack(rows)), S)
+            if rows:
+                light_buffers[set_name] = buf(_entries(np.array(ids), np.stack(rows)), S)
+
+        def empty_lights():  # a light set with no lights: one all-zero entry (a light of colour 0; a storage
+            # buffer range cannot be empty)
+            if "empty" not in light_buffers:
+                light_buffers["empty"] = buf(np.zeros((1, 1 + u.light_vec4s, 4), np.float32), S)
+            return light_buffers["empty"]
+
+        def light_texture(t, light_name):
+            """A light's texture: its depth pass's map, or the lit stand-in."""
+            return shadow_maps[light_name] if light_name in shadow_maps else textures[t.param]
+
         frame_buf = buf(gx.frame_bytes(vp, eye), U)
         for i, obj in enumerate(scene.objects):
             h = obj["permutation"]
             c = composed[h]
             frame = frame_buf
-            obj_buf = buf(gx.object_bytes(placement(i, n)), U)
+            obj_buf = object_bufs[i]
             up = next(x for x in uploads(scene, h, c) if x["material"] == obj["material"]
                       and x["light_set"] == obj["light_set"])
             spec = {(0, 0): frame, (2, 0): obj_buf}
-            if c.interface.block("Lights"):
-                spec[(0, 1)] = buf(bytes.fromhex(up["Lights"]), U)
+            lb = c.interface.block("Lights")
+            if lb:
+                spec[(lb.set, lb.binding)] = buf(_override_lights(bytes.fromhex(up["Lights"]), lb.slots, obj["lights"],
+                                                                  matrices), U)
             if c.interface.block("Material"):
                 spec[(1, 0)] = buf(bytes.fromhex(up["Material"]), U)
             for t in c.interface.textures:
-                spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = textures[t.param], sampler
-            ub = {(0, 0): frame, (2, 0): obj_buf, (0, 1): light_buffers[obj["light_set"]],
+                res = light_texture(t, obj["lights"][t.light]) if t.group == "light" else textures[t.param]
+                spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = res, sampler
+            ub = {(0, 0): frame, (2, 0): obj_buf,
                   (1, 0): buf(np.array([materials.index(obj["material"]), 0, 0, 0], np.int32), U),
                   (1, 1): material_buffer}
+            lbuf = uber.interface.block("LightBuffer")
+            if lbuf is not None:  # a scene without lights has an ubershader without a light buffer
+                ub[(lbuf.set, lbuf.binding)] = light_buffers.get(obj["light_set"]) or empty_lights()
             for t in uber.interface.textures:
-                ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = textures[t.param], sampler
-            draws.append((h, spec, ub))
+                res = textures[t.param]
+                if t.group == "light":
+                    slots = slot_lights[obj["light_set"]]
+                    res = light_texture(t, slots[t.light]) if t.light < len(slots) else textures[t.param]
+                ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, sampler
+            draws.append((h, spec, ub, mesh_of[i]))
 
         specialized: dict[str, object] = {}
-        order = list(dict.fromkeys(h for h, _, _ in draws))  # first use
+        order = list(dict.fromkeys(h for h, _, _, _ in draws))  # first use
         start = time.perf_counter()
         uber_pipes = {}
         if mode != "specialized":
@@ -254,13 +601,13 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         def draw_frame(index: int | None) -> Frame:
             t0 = time.perf_counter()
             items, nu, ns = [], 0, 0
-            for h, spec, ub in draws:
+            for h, spec, ub, mesh in draws:
                 pipe = specialized.get(h) if mode != "ubershader" else None
                 if pipe is not None:
-                    items.append(gx.DrawItem(pipe, sphere, spec))
+                    items.append(gx.DrawItem(pipe, mesh, spec))
                     ns += 1
                 else:
-                    items.append(gx.DrawItem(uber_pipes[uber_of[h]], sphere, ub))
+                    items.append(gx.DrawItem(uber_pipes[uber_of[h]], mesh, ub))
                     nu += 1
             gpu = target.draw(items, clear=(0.06, 0.07, 0.09, 1.0))
             image = target.read()
@@ -268,27 +615,31 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 gx.save_png(image, out / f"frame_{index:04d}.png")
             return Frame((time.perf_counter() - t0) * 1e3, gpu, nu, ns)
 
-        for f in range(frames):
-            report.frames.append(draw_frame(f))
-            if f == 0:
-                report.time_to_first_frame_ms = (time.perf_counter() - start) * 1e3
+        try:
+            for f in range(frames):
+                report.frames.append(draw_frame(f))
+                if f == 0:
+                    report.time_to_first_frame_ms = (time.perf_counter() - start) * 1e3
+                if progress:
+                    print(f"\rframe {f + 1}/{frames}", end="", flush=True)
             if progress:
-                print(f"\rframe {f + 1}/{frames}", end="", flush=True)
-        if progress:
-            print()
-        if worker is not None:
-            worker.join()
+                print()
+        finally:
+            if worker is not None:
+                worker.join()
+            owned += owned_pipelines()
         report.steady = draw_frame(None)
-        owned += owned_pipelines()
         cache.save()
-        import json
-        atomic_write(out / "report.json", (json.dumps(report.as_dict(), indent=2) + "\n").encode())
-        return report
     finally:
         for obj in reversed(owned):
             obj.destroy()
         if own_device:
             device.close()
+        report.validation = bool(device.validation)
+        report.validation_messages = [str(m) for m in device.messages[first_message:]]
+    import json
+    atomic_write(out / "report.json", (json.dumps(report.as_dict(), indent=2) + "\n").encode())
+    return report
 
 
 def _light_specs(lib, light) -> dict:
