@@ -41,7 +41,7 @@ from generator.build import build_scene  # noqa: E402
 from generator.library.bricks import load_library  # noqa: E402
 from generator.matrix.scene import load_scene  # noqa: E402
 from generator.runtime.device import Device  # noqa: E402
-from generator.runtime.renderer import camera, placement, render_scene  # noqa: E402
+from generator.runtime.renderer import load_placement, render_scene  # noqa: E402
 
 RESULTS = REPO / "benchmarks" / "results"
 EXAMPLE = REPO / "scenes" / "example.toml"
@@ -79,13 +79,14 @@ def contact_sheet(scene, images: dict, size, path: Path) -> None:
     W, H = size
     n = len(scene.objects)
     tile_w = W // n
+    pl = load_placement(scene)
+    _, vp = pl.camera(W, H)
     tiles, seen = [], set()
     for i, obj in enumerate(scene.objects):
         if obj["permutation"] in seen:
             continue
         seen.add(obj["permutation"])
-        _, vp = camera(n, W, H)
-        clip = vp @ placement(i, n) @ np.array([0.0, 0.0, 0.0, 1.0])
+        clip = vp @ pl.model(i) @ np.array([0.0, 0.0, 0.0, 1.0])
         cx = int(round((clip[0] / clip[3] + 1.0) / 2.0 * W))
         x0 = max(0, min(W - tile_w, cx - tile_w // 2))
         a = images["specialized"][:, x0:x0 + tile_w, :3]
@@ -110,6 +111,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=30)
     ap.add_argument("--size", default="320x160")
+    ap.add_argument("--pairs", type=int, default=7, help="paired short runs for the frame-time ratios")
     args = ap.parse_args()
     size = tuple(int(x) for x in args.size.split("x"))
     lib = load_library()
@@ -122,11 +124,25 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         runs = {}
+        # Warm the device first (lavapipe's first pipelines and draws pay one-time set-up), so the
+        # first-frame times below compare the modes, not the order they ran in.
+        render_scene(scene, lib, "hybrid", 2, tmp / "warm-up", size, device=device)
         for mode in ("specialized", "ubershader", "hybrid"):
             runs[mode] = render_scene(scene, lib, mode, args.frames, tmp / mode, size, device=device)
         runs["ubershader_spec"] = render_scene(scene, lib, "ubershader", args.frames, tmp / "spec", size,
                                                device=device, uber_ids="specialization")
+        # Frame-time ratios from paired short runs, alternating the modes (lavapipe shares 2 cores with
+        # everything else: a long run of one mode then another measures the machine's drift).
+        pairs = {"ubershader": [], "hybrid": [], "ubershader_spec": []}
+        for r in range(args.pairs):
+            base = render_scene(scene, lib, "specialized", 8, tmp / "pair", size, device=device)
+            for key, mode, ids in (("ubershader", "ubershader", "buffer"), ("hybrid", "hybrid", "buffer"),
+                                   ("ubershader_spec", "ubershader", "specialization")):
+                other = render_scene(scene, lib, mode, 8, tmp / "pair", size, device=device, uber_ids=ids)
+                value = steady_gpu(other) if key == "hybrid" else median_gpu(other)
+                pairs[key].append(value / median_gpu(base))
         warm = render_scene(scene, lib, "specialized", 2, tmp / "specialized", size, device=device)  # cache file there
+        warm_uber = render_scene(scene, lib, "ubershader", 2, tmp / "ubershader", size, device=device)
         images = {m: np.asarray(Image.open(tmp / m / "frame_0001.png")) for m in ("specialized", "ubershader")}
         contact_sheet(scene, images, size, RESULTS / "hybrid_contact_sheet.png")
         out["costs"] = costs(tmp, scene, lib)
@@ -135,14 +151,17 @@ def main() -> int:
     out["frame_gpu_ms"] = {"specialized": median_gpu(s), "ubershader": median_gpu(u), "hybrid_steady": steady_gpu(h),
                            "ubershader_spec": median_gpu(us)}
     f = out["frame_gpu_ms"]
-    out["ratios"] = {"ubershader/specialized": f["ubershader"] / f["specialized"],
-                     "hybrid_steady/specialized": f["hybrid_steady"] / f["specialized"],
-                     "ubershader_spec/ubershader": f["ubershader_spec"] / f["ubershader"]}
+    out["ratios"] = {"ubershader/specialized": statistics.median(pairs["ubershader"]),
+                     "hybrid_steady/specialized": statistics.median(pairs["hybrid"]),
+                     "ubershader_spec/ubershader": statistics.median(pairs["ubershader_spec"])
+                     / statistics.median(pairs["ubershader"])}
+    out["paired_ratios"] = pairs
     out["time_to_first_frame_ms"] = {"hybrid": h.time_to_first_frame_ms, "specialized_up_front": s.time_to_first_frame_ms,
                                      "ubershader_only": u.time_to_first_frame_ms}
     out["pipeline_create_ms"] = {"specialized_each_cold": s.pipeline_create_ms,
                                  "specialized_each_with_cache": warm.pipeline_create_ms,
                                  "ubershader": u.pipeline_create_ms[0],
+                                 "ubershader_with_cache": warm_uber.pipeline_create_ms[0],
                                  "ubershader_spec_each": us.pipeline_create_ms,
                                  "cache_hits_second_run": warm.pipeline_cache_hits}
     out["hybrid_draws_ubershader_per_frame"] = [fr.draws_ubershader for fr in h.frames]
@@ -152,8 +171,10 @@ def main() -> int:
     md = [f"# Hybrid ubershader / shader matrix on {out['device']}",
           "",
           f"Generated by `benchmarks/hybrid.py` ({out['generator']}): the example scene, {args.frames} frames of "
-          f"{size[0]}×{size[1]} per mode, GLSL, one device, one run. GPU time from timestamp queries, median "
-          "over the frames after the first.",
+          f"{size[0]}×{size[1]} per mode, GLSL, one device, one run, after a warm-up render. GPU time from "
+          f"timestamp queries, median over the frames after the first; the frame-time ratios are the median of {args.pairs} paired short runs "
+          "(specialized, then the other mode, alternating). \"Cold\" is a mode's first run with an "
+          "empty cache file, \"persisted cache\" a second run that loads the file the first one saved.",
           "",
           "| measure | value |", "|---|---|",
           f"| frame time, ubershader / specialized | {out['ratios']['ubershader/specialized']:.3f} |",
@@ -165,8 +186,10 @@ def main() -> int:
           f"{h.time_to_first_frame_ms:.1f} / {s.time_to_first_frame_ms:.1f} / {u.time_to_first_frame_ms:.1f} |",
           f"| pipeline creation, specialized (ms, median of {len(s.pipeline_create_ms)}), cold / persisted cache | "
           f"{statistics.median(s.pipeline_create_ms):.2f} / {statistics.median(warm.pipeline_create_ms):.2f} |",
-          f"| pipeline creation, ubershader (ms) / specialization-constant ubershader per variant (median ms) | "
-          f"{u.pipeline_create_ms[0]:.2f} / {statistics.median(us.pipeline_create_ms):.2f} |",
+          f"| pipeline creation, ubershader (ms), cold / persisted cache | "
+          f"{u.pipeline_create_ms[0]:.2f} / {warm_uber.pipeline_create_ms[0]:.2f} |",
+          f"| pipeline creation, specialization-constant ubershader per variant (median ms) | "
+          f"{statistics.median(us.pipeline_create_ms):.2f} |",
           f"| pipeline cache hits on the second run (driver feedback) | {warm.pipeline_cache_hits} |",
           f"| hybrid: draws with the ubershader per frame | {', '.join(map(str, out['hybrid_draws_ubershader_per_frame']))} |",
           f"| registers (estimate): ubershader / worst specialized | {c['ubershader']['registers']} / "
