@@ -84,8 +84,25 @@ def _textures(device):
     t /= np.linalg.norm(t, axis=-1, keepdims=True)
     nmap = np.round((t + 1.0) / 2.0 * 255.0).astype(np.uint8)
     shadow = np.ones((4, 4, 4), np.float32)
-    return {"albedo_map": device.image(albedo, srgb=True), "normal_map": device.image(nmap),
-            "shadow_map": device.image(shadow)}
+    grey = np.full((1, 1, 4), 0.5, np.float32)  # any other texture a brick samples (a lookup table, …)
+    return _TestTextures({"albedo_map": device.image(albedo, srgb=True), "normal_map": device.image(nmap),
+                          "shadow_map": device.image(shadow)}, lambda: device.image(grey))
+
+
+class _TestTextures(dict):
+    """The generated textures by brick texture name; a name without a test image gets a linear 0.5 grey."""
+
+    def __init__(self, known, make_grey):
+        super().__init__(known)
+        self._make_grey = make_grey
+
+    def __missing__(self, name):
+        self[name] = self._make_grey()
+        return self[name]
+
+    def destroy(self) -> None:
+        for image in self.values():
+            image.destroy()
 
 
 # ------------------------------------------------------------------ placement
@@ -443,7 +460,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             owned.append(meshes[kind])
         mesh_of = [meshes[o.mesh] for o in placed.objects]
         textures, sampler = _textures(device), device.sampler()
-        owned += [*textures.values(), sampler]
+        owned += [textures, sampler]
         vk = device.vk
         U, S = vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
 
@@ -524,6 +541,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 data = np.zeros((u.light_vec4s, 4), np.float32)
                 for pname, (j, ty) in u.light_layouts[(L.type, L.shadow)].items():
                     val = np.asarray(vals[pname], np.float32).reshape(-1)
+                    if ty.kind == "vector" and len(val) == 1:  # a scalar for a vector splats, as pack() does
+                        val = np.repeat(val, ty.components)
                     for c in range(0, len(val), 4):
                         data[j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
                 textured = bool(shadow_textures(lib, L.shadow))
@@ -591,9 +610,14 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for h in order:
                 specialized[h] = make_pipeline(h, composed[h].interface)
         elif mode == "hybrid":
+            failed: list[BaseException] = []
+
             def create():
-                for h in order:
-                    specialized[h] = make_pipeline(h, composed[h].interface)
+                try:
+                    for h in order:
+                        specialized[h] = make_pipeline(h, composed[h].interface)
+                except BaseException as e:  # re-raised on the main thread after join()
+                    failed.append(e)
             worker = threading.Thread(target=create, name="pipelines", daemon=True)
             worker.start()
         owned_pipelines = lambda: [*uber_pipes.values(), *specialized.values()]  # noqa: E731
@@ -628,6 +652,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             if worker is not None:
                 worker.join()
             owned += owned_pipelines()
+        if worker is not None and failed:
+            raise failed[0]
         report.steady = draw_frame(None)
         cache.save()
     finally:
