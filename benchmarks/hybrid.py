@@ -150,7 +150,6 @@ def main() -> int:
     s, u, h, us = (runs[m] for m in ("specialized", "ubershader", "hybrid", "ubershader_spec"))
     out["frame_gpu_ms"] = {"specialized": median_gpu(s), "ubershader": median_gpu(u), "hybrid_steady": steady_gpu(h),
                            "ubershader_spec": median_gpu(us)}
-    f = out["frame_gpu_ms"]
     out["ratios"] = {"ubershader/specialized": statistics.median(pairs["ubershader"]),
                      "hybrid_steady/specialized": statistics.median(pairs["hybrid"]),
                      "ubershader_spec/ubershader": statistics.median(pairs["ubershader_spec"])
