@@ -41,7 +41,8 @@ from generator.build import build_scene  # noqa: E402
 from generator.library.bricks import load_library  # noqa: E402
 from generator.matrix.scene import load_scene  # noqa: E402
 from generator.runtime.device import Device  # noqa: E402
-from generator.runtime.renderer import load_placement, render_scene  # noqa: E402
+from generator.runtime.placement import load_placement  # noqa: E402
+from generator.runtime.renderer import render_scene  # noqa: E402
 
 RESULTS = REPO / "benchmarks" / "results"
 EXAMPLE = REPO / "scenes" / "example.toml"

@@ -65,7 +65,7 @@ def test_model_is_translate_rotate_y_scale():
 
 def test_without_a_placement_file_the_objects_stand_in_a_row(lib, tmp_path):
     from generator.matrix.scene import load_scene
-    from generator.runtime.renderer import camera, load_placement, placement
+    from generator.runtime.placement import camera, load_placement, placement
 
     shutil.copy(EXAMPLE, tmp_path / "bare.toml")
     scene = load_scene(tmp_path / "bare.toml", lib)
