@@ -133,3 +133,21 @@ def test_the_render_command_reports_a_bad_placement_in_one_line(tmp_path):
     lines = r.stderr.strip().splitlines()
     assert r.returncode == 1 and len(lines) == 1, r.stderr
     assert lines[0].startswith(f"error: {tmp_path / 'yard.placement.toml'}:3:1: unknown key of objects.ground 'size'")
+
+
+def test_non_finite_placements_are_located_errors(tmp_path):
+    from generator.lang import SourceError
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+    from generator.runtime.placement import load_placement
+
+    lib = load_library()
+    scene = load_scene(Path(__file__).resolve().parent.parent / "scenes" / "example.toml", lib)
+    text = (Path(__file__).resolve().parent.parent / "scenes" / "example.placement.toml").read_text()
+    for old, new, what in [("translate = [0.0, 0.0, -0.8]", "translate = [0.0, inf, -0.8]", "not finite"),
+                           ("eye = [0.0, 3.4, 7.2]", "eye = [0.0, nan, 7.2]", "not finite")]:
+        assert old in text
+        bad = tmp_path / "p.toml"
+        bad.write_text(text.replace(old, new, 1))
+        with pytest.raises(SourceError, match=what):
+            load_placement(scene, bad)

@@ -28,6 +28,8 @@ def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
     f = target - eye
     f /= np.linalg.norm(f)
     s = np.cross(f, up)
+    if np.linalg.norm(s) < 1e-6:  # looking along `up`: any perpendicular up vector will do
+        s = np.cross(f, (1.0, 0.0, 0.0) if abs(f[0]) < 0.9 else (0.0, 0.0, 1.0))
     s /= np.linalg.norm(s)
     u = np.cross(s, f)
     m = np.eye(4)

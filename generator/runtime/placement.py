@@ -225,10 +225,14 @@ def load_placement(scene, path=None) -> Placement:
         if isinstance(scale, (int, float)) and not isinstance(scale, bool):
             scale = [scale] * 3
         scale = vec3(header, "scale", scale, (1.0, 1.0, 1.0))
-        if min(scale) <= 0:
+        if not all(np.isfinite(scale)) or min(scale) <= 0:
             raise loc.error(loc.find(header, "scale"), f"scale must be > 0 on every axis, got {list(scale)}",
                             "give half-extents > 0 (a flat object: a plane, or a small scale)")
-        placed[name] = Placed(name, mesh, vec3(header, "translate", t.get("translate"), (0.0, 0.0, 0.0)), scale,
+        translate = vec3(header, "translate", t.get("translate"), (0.0, 0.0, 0.0))
+        if not all(np.isfinite(translate)):
+            raise loc.error(loc.find(header, "translate"), f"translate {list(translate)} is not finite",
+                            "give three finite numbers")
+        placed[name] = Placed(name, mesh, translate, scale,
                               number(header, "rotate_y", t.get("rotate_y"), 0.0))
     missing = [n for n in names if n not in placed]
     if missing:
@@ -245,6 +249,9 @@ def load_placement(scene, path=None) -> Placement:
         raise loc.error(loc.find("camera", "fov_y"), f"fov_y {fov} is not between 0 and 180 degrees",
                         "write e.g. fov_y = 40.0")
     eye, target = vec3("camera", "eye", cam.get("eye"), None), vec3("camera", "target", cam.get("target"), None)
+    for key, v in (("eye", eye), ("target", target)):
+        if v is not None and not all(np.isfinite(v)):
+            raise loc.error(loc.find("camera", key), f"{key} {list(v)} is not finite", "give three finite numbers")
     if eye is not None and target is not None and np.allclose(eye, target):
         raise loc.error(loc.find("camera", "eye"), "the camera's eye and target coincide", "move the eye away")
     return Placement([placed[n] for n in names], path, eye, target, fov)

@@ -120,6 +120,9 @@ def shadow_matrix(light, values: dict, points) -> np.ndarray:
     from . import graphics as gx
 
     if light.type == "directional":
+        if not np.linalg.norm(np.asarray(values["direction"], np.float64)) > 0.0:
+            raise UserError(f"light '{light.name}': direction {list(values['direction'])} has no length, so its "
+                            "shadow map has no view — give the direction to the light, e.g. [0.3, 0.9, 0.3]")
         return gx.directional_shadow_matrix(values["direction"], points)
     if light.type == "point":
         return gx.point_shadow_matrix(values["position"], points)
@@ -223,6 +226,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             meshes[kind] = gx.GpuMesh(device, make_mesh(kind))
             owned.append(meshes[kind])
         mesh_of = [meshes[o.mesh] for o in placed.objects]
+        # One bilinear sampler for every texture, shadow maps included: the one tap of the shadow brick then
+        # compares against depth averaged over 2×2 texels, which with one bias is what keeps a point
+        # light's perspective map free of acne here (a nearest sampler acnes: NOTES.md, "Renderer").
         textures, sampler = _textures(device), device.sampler()
         owned += [textures, sampler]
         vk = device.vk
@@ -245,6 +251,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     spec = {SPEC_VARIANT: variant}
             p = gx.GraphicsPipeline(device, target, spv[(tag, "vert")], frag, iface.vertex_inputs,
                                     gx.layouts_from_interface(iface), cache=cache, specialization=spec)
+            owned.append(p)  # released whatever happens next (list.append is atomic: the worker may call this)
             report.pipeline_create_ms.append((time.perf_counter() - t0) * 1e3)
             report.pipelines_created += 1
             report.pipeline_cache_hits += p.cache_hit  # the driver's creation feedback
@@ -384,7 +391,6 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     failed.append(e)
             worker = threading.Thread(target=create, name="pipelines", daemon=True)
             worker.start()
-        owned_pipelines = lambda: [*uber_pipes.values(), *specialized.values()]  # noqa: E731
 
         def draw_frame(index: int | None) -> Frame:
             t0 = time.perf_counter()
@@ -399,6 +405,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     nu += 1
             gpu = target.draw(items, clear=(0.06, 0.07, 0.09, 1.0))
             image = target.read()
+            if index == 0:  # drawn and read back; writing the PNG is not part of it
+                report.time_to_first_frame_ms = (time.perf_counter() - start) * 1e3
             if index is not None:
                 gx.save_png(image, out / f"frame_{index:04d}.png")
             return Frame((time.perf_counter() - t0) * 1e3, gpu, nu, ns)
@@ -406,8 +414,6 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         try:
             for f in range(frames):
                 report.frames.append(draw_frame(f))
-                if f == 0:
-                    report.time_to_first_frame_ms = (time.perf_counter() - start) * 1e3
                 if progress:
                     print(f"\rframe {f + 1}/{frames}", end="", flush=True)
             if progress:
@@ -415,7 +421,6 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         finally:
             if worker is not None:
                 worker.join()
-            owned += owned_pipelines()
         if worker is not None and failed:
             raise failed[0]
         report.steady = draw_frame(None)
