@@ -29,7 +29,7 @@ def example(lib):
 
 
 def test_the_example_is_a_courtyard_every_object_standing_on_a_12_by_12_ground(example):
-    from generator.runtime.renderer import load_placement, placement_path
+    from generator.runtime.placement import load_placement, placement_path
 
     assert placement_path(EXAMPLE) == REPO / "scenes" / "example.placement.toml"
     pl = load_placement(example)
@@ -56,7 +56,7 @@ def test_the_example_is_a_courtyard_every_object_standing_on_a_12_by_12_ground(e
 
 
 def test_model_is_translate_rotate_y_scale():
-    from generator.runtime.renderer import Placed
+    from generator.runtime.placement import Placed
 
     o = Placed("x", "box", (1.0, 2.0, 3.0), (2.0, 1.0, 0.5), 90.0)
     np.testing.assert_allclose(o.model @ [1.0, 0.0, 0.0, 1.0], [1.0, 2.0, 1.0, 1.0], atol=1e-12)  # +x → −z
@@ -112,7 +112,7 @@ CASES = [  # (placement text, expected line:col, words of the message)
 @pytest.mark.parametrize("text,where,words", CASES, ids=[c[2][0][:40] for c in CASES])
 def test_placement_mistakes_are_path_line_col_errors_that_say_what_to_do(example, tmp_path, text, where, words):
     from generator.lang import SourceError
-    from generator.runtime.renderer import load_placement
+    from generator.runtime.placement import load_placement
 
     path = tmp_path / "example.placement.toml"
     path.write_text(text)

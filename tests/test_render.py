@@ -75,7 +75,7 @@ def test_modes_draw_every_object_and_hybrid_converges_to_the_matrix(renders):
 def test_the_example_is_the_courtyard_with_the_sun_s_shadow_map_from_a_depth_pass(renders):
     from generator.library.bricks import load_library
     from generator.matrix.scene import load_scene
-    from generator.runtime.renderer import load_placement
+    from generator.runtime.placement import load_placement
 
     for _, _, rep in renders.values():
         assert rep["placement"].endswith("example.placement.toml")

@@ -68,7 +68,7 @@ def _render(scene, lib, device, out, mode):
 
 def _footprint(scene, lib):
     """(inside, outside): floor pixels seen by the camera, well inside / well outside the ball's shadow."""
-    from generator.runtime.renderer import load_placement
+    from generator.runtime.placement import load_placement
 
     pl = load_placement(scene)
     floor, ball = pl.objects
@@ -119,7 +119,7 @@ def test_the_ball_shadows_its_analytic_footprint_on_the_floor_in_both_paths(devi
         assert np.ptp(lit, axis=0).max() <= 1, "a lit Lambert floor under a directional light is one colour"
         assert img[inside].max() == 0, f"{mode}: the floor inside the ball's footprint is in shadow"
         # the matrix maps every placed object's bounds into the light's clip volume
-        from generator.runtime.renderer import load_placement
+        from generator.runtime.placement import load_placement
         m = np.array(sm["shadow_matrix"]).reshape(4, 4).T
         p = np.c_[load_placement(scene).points(), np.ones(16)] @ m.T
         assert (np.abs(p[:, :2]) <= 1).all() and (p[:, 2] >= 0).all() and (p[:, 2] <= 1).all()

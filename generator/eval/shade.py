@@ -85,54 +85,83 @@ def _numpy(lp, P, Ng, V, T, uv, vals, fields, globs) -> np.ndarray:
     res = {globs[i].name: f for i, f in fields.items()}
     shade = t.load(t.emit(lp.program.structs, lp.program.functions, lp.program.globals), np.dtype("float64"),
                    resources=res)["shade"]
-    norm = lambda a: np.asarray(a, np.float64) / np.linalg.norm(a, axis=1, keepdims=True)  # noqa: E731
-    local = {"P": np.asarray(P, np.float64), "Ng": norm(Ng), "V": norm(V)}
-    if T is not None:
-        T4 = np.asarray(T, np.float64)
-        local["T"] = norm(T4[:, :3])
-        local["B"] = np.cross(local["Ng"], local["T"]) * T4[:, 3:4]
-    if uv is not None:
-        local["uv"] = np.asarray(uv, np.float64)
+    local = _surface(P, Ng, V, T, uv)
     args = [local[name] if name in local else vals[name] for name, _ in lp.glue.signature]
     return np.broadcast_to(np.asarray(shade(*args), np.float64), (len(P), 4)).copy()
 
 
 def _gpu(source, c, n, P, Ng, V, T, uv, vals, fields, globs) -> np.ndarray:
     from ..link.interface import pack
+    from ..runtime.compute import STORAGE, UNIFORM
+
+    rows = [P, Ng, V] + ([np.asarray(T)[:, :4]] if T is not None else []) + ([uv] if uv is not None else [])
+    blocks = [(UNIFORM, pack([s for ls in c.lights for s in ls], vals, c.interface.block("Lights").size // 16)),
+              (UNIFORM, pack(c.material, vals, c.interface.block("Material").size // 16))]
+    for i in sorted(globs):  # (n, fields, 4): one vec4 per LightData field
+        blocks.append((STORAGE, np.stack([fields[i][f] for f, _ in globs[i].ty.elem.fields], 1).astype(np.float32)))
+    return _run(source, _samples(rows, n), blocks, what="shade kernel")
+
+
+def _surface(P, Ng, V, T=None, uv=None) -> dict:
+    """shade()'s surface arguments in float64 as the kernels compute them (Ng, V, T normalized; B = Ng × T · w)."""
+    def unit(a):
+        a = np.asarray(a, np.float64)
+        return a / np.linalg.norm(a, axis=1, keepdims=True)
+
+    local = {"P": np.asarray(P, np.float64), "Ng": unit(Ng), "V": unit(V)}
+    if T is not None:
+        T4 = np.asarray(T, np.float64)
+        local["T"] = unit(T4[:, :3])
+        local["B"] = np.cross(local["Ng"], local["T"]) * T4[:, 3:4]
+    if uv is not None:
+        local["uv"] = np.asarray(uv, np.float64)
+    return local
+
+
+def _samples(rows, n: int) -> np.ndarray:
+    """The samples buffer of a shade kernel: one vec4 per row per sample (templates/*/shade)."""
+    sample = np.zeros((n, len(rows), 4), np.float32)
+    for j, r in enumerate(rows):
+        r = np.asarray(r)
+        sample[:, j, :r.shape[1]] = r
+    return sample
+
+
+_SPIRV: dict = {}  # (language, source, overrides) -> SPIR-V: each kernel compiled once per process
+
+
+def _run(source, sample: np.ndarray, blocks: list, spec: dict | None = None, what: str = "kernel") -> np.ndarray:
+    """Compile (once) and dispatch a shade-style kernel: set 0 = samples, result, Info, then `blocks`
+    ((STORAGE | UNIFORM, bytes or array) each); returns the (n, 4) results as float64."""
     from ..runtime.compute import STORAGE, UNIFORM, ComputePipeline
     from ..runtime.eval_kernel import KernelError, shared_device
     from ..toolchain import CompileJob, compile_many
 
-    job = CompileJob(f"shade-{c.hash}.comp.{source.language}", source.language, "comp", source.text,
-                     line_map=tuple(map(tuple, source.line_map)))
-    res = compile_many([job])[job.key]
-    if not res.ok:
-        raise KernelError(f"the {source.language} shade kernel does not compile: " + "; ".join(res.errors()))
+    # WebGPU keys an override declared with @id(N) by N; GLSL/HLSL keep the SpecId for the pipeline
+    over = tuple((str(i), v) for i, v in spec.items()) if spec and source.language == "wgsl" else ()
+    key = (source.language, source.text, over)
+    if key not in _SPIRV:
+        job = CompileJob(f"{what.replace(' ', '-')}.comp.{source.language}", source.language, "comp", source.text,
+                         line_map=tuple(map(tuple, source.line_map)), overrides=over)
+        res = compile_many([job])[job.key]
+        if not res.ok:
+            raise KernelError(f"the {source.language} {what} does not compile: " + "; ".join(res.errors()))
+        _SPIRV[key] = res.spirv
     device = shared_device()
     vk = device.vk
-    order = sorted(globs)
-    pipe = ComputePipeline(device, res.spirv, (STORAGE, STORAGE, UNIFORM, UNIFORM, UNIFORM) + (STORAGE,) * len(order))
-    rows = [np.asarray(P), np.asarray(Ng), np.asarray(V)] + ([np.asarray(T)[:, :4]] if T is not None else []) \
-        + ([np.asarray(uv)] if uv is not None else [])
-    k = len(rows)
-    sample = np.zeros((n, k, 4), np.float32)
-    for j, r in enumerate(rows):
-        sample[:, j, :r.shape[1]] = r
-    usage_s, usage_u = vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
-    lights_bytes = pack([s for ls in c.lights for s in ls], vals, c.interface.block("Lights").members[-1]["size"] // 16)
-    mat_bytes = pack(c.material, vals, c.interface.block("Material").members[-1]["size"] // 16)
-    bufs = [device.buffer(sample.nbytes, usage_s), device.buffer(16 * n, usage_s), device.buffer(16, usage_u),
-            device.buffer(len(lights_bytes), usage_u), device.buffer(len(mat_bytes), usage_u)]
-    for i in order:
-        arr = np.stack([fields[i][f] for f, _ in globs[i].ty.elem.fields], 1).astype(np.float32)  # (n, fields, 4)
-        b = device.buffer(max(arr.nbytes, 16), usage_s)
-        b.array(np.float32)[: arr.size] = arr.reshape(-1)
-        bufs.append(b)
+    n = len(sample)
+    pipe = ComputePipeline(device, _SPIRV[key], (STORAGE, STORAGE, UNIFORM) + tuple(k for k, _ in blocks),
+                           specialization=spec if source.language != "wgsl" else None)
+    usage = {STORAGE: vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, UNIFORM: vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT}
+    raw = [sample, np.zeros((n, 4), np.float32), np.array([n, 0, 0, 0], np.uint32)]
+    raw += [np.frombuffer(bytes(d), np.uint8) if isinstance(d, (bytes, bytearray)) else np.asarray(d) for _, d in blocks]
+    kinds = (STORAGE, STORAGE, UNIFORM) + tuple(k for k, _ in blocks)
+    bufs = []
     try:
-        bufs[0].array(np.float32)[: sample.size] = sample.reshape(-1)
-        bufs[2].array(np.uint32)[:4] = (n, 0, 0, 0)
-        bufs[3].write(lights_bytes)
-        bufs[4].write(mat_bytes)
+        for kind, data in zip(kinds, raw):
+            b = device.buffer(max(data.nbytes, 16), usage[kind])
+            bufs.append(b)
+            b.write(data)
         pipe.bind(bufs)
         pipe.dispatch(-(-n // 64))
         return bufs[1].array(np.float32)[: 4 * n].reshape(n, 4).astype(np.float64)
@@ -150,6 +179,7 @@ def uber_entries(u, materials: list[tuple[int, dict]], lights: list[tuple[str, s
     materials: (variant, {glue name: value}) per material; lights: (light type, shadow, {param: value}).
     """
     from ..link.interface import pack
+    from ..link.values import light_entry
 
     mids = np.zeros((len(materials), 4), np.int32)
     mdata = np.zeros((len(materials), u.material_vec4s, 4), np.float64)
@@ -162,12 +192,7 @@ def uber_entries(u, materials: list[tuple[int, dict]], lights: list[tuple[str, s
     ldata = np.zeros((max(len(lights), 1), u.light_vec4s, 4), np.float64)
     for i, (t, s, values) in enumerate(lights):
         lids[i] = (u.light_types.index(t), u.shadows.index(s), 0, 0)
-        for name, (j, ty) in u.light_layouts[(t, s)].items():
-            val = np.asarray(values[name], np.float64).reshape(-1)
-            if ty.kind == "vector" and len(val) == 1:  # a scalar for a vector parameter splats, as pack() does
-                val = np.repeat(val, ty.components)
-            for c in range(0, len(val), 4):
-                ldata[i, j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
+        ldata[i] = light_entry(u, t, s, values)
     return {"ids": mids, "data": mdata}, {"ids": lids[:len(lights)], "data": ldata[:len(lights)]}
 
 
@@ -207,64 +232,15 @@ def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "nu
             res["material_variant"] = np.int32(variant)
         shade = t.load(t.emit(u.program.structs, u.program.functions, u.program.globals), np.dtype("float64"),
                        resources=res)["shade"]
-        norm = lambda a: np.asarray(a, np.float64) / np.linalg.norm(a, axis=1, keepdims=True)  # noqa: E731
-        local = {"P": np.asarray(P, np.float64), "Ng": norm(Ng), "V": norm(V), "material": material}
-        if T is not None:
-            T4 = np.asarray(T, np.float64)
-            local["T"] = norm(T4[:, :3])
-            local["B"] = np.cross(local["Ng"], local["T"]) * T4[:, 3:4]
-        if uv is not None:
-            local["uv"] = np.asarray(uv, np.float64)
+        local = {**_surface(P, Ng, V, T, uv), "material": material}
         return np.broadcast_to(np.asarray(shade(*[local[name] for name, _ in u.signature]), np.float64),
                                (n, 4)).copy()
+    from ..link.values import entry_bytes
+    from ..runtime.compute import STORAGE
+
     spec = None if variant is None else {SPEC_VARIANT: int(variant)}
     rows = [P, Ng, V] + ([T] if "T" in u.surface else []) + ([uv] if "uv" in u.surface else [])
-    return _gpu_uber(c.sources[0], n, rows, material, mat, lts, spec)
-
-
-def _gpu_uber(source, n, rows, material, mat, lts, spec=None) -> np.ndarray:
-    from ..runtime.compute import STORAGE, UNIFORM, ComputePipeline
-    from ..runtime.eval_kernel import KernelError, shared_device
-    from ..toolchain import CompileJob, compile_many
-
-    # WebGPU keys an override declared with @id(N) by N
-    over = tuple((str(i), v) for i, v in spec.items()) if spec and source.language == "wgsl" else ()
-    job = CompileJob(f"uber-{len(source.text)}.comp.{source.language}", source.language, "comp", source.text,
-                     line_map=tuple(map(tuple, source.line_map)), overrides=over)
-    res = compile_many([job])[job.key]
-    if not res.ok:
-        raise KernelError(f"the {source.language} ubershader kernel does not compile: " + "; ".join(res.errors()))
-    device = shared_device()
-    vk = device.vk
-    pipe = ComputePipeline(device, res.spirv, (STORAGE, STORAGE, UNIFORM, STORAGE, STORAGE),
-                           specialization=spec if source.language != "wgsl" else None)
-    sample = np.zeros((n, len(rows), 4), np.float32)  # P (w: the material), Ng, V[, T][, uv]: templates/*/shade
-    for j, r in enumerate(rows):
-        r = np.asarray(r)
-        sample[:, j, :r.shape[1]] = r
-    sample[:, 0, 3] = material
-    usage_s, usage_u = vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
-
-    def entries(e):
-        k = e["data"].shape[1]
-        raw = np.zeros((len(e["ids"]), 1 + k, 4), np.float32)
-        raw[:, 1:, :] = e["data"]
-        raw = raw.view(np.uint32)
-        raw[:, 0, :] = e["ids"].astype(np.int32).view(np.uint32)
-        return raw
-
-    lraw, mraw = entries(lts), entries(mat)
-    bufs = [device.buffer(sample.nbytes, usage_s), device.buffer(16 * n, usage_s), device.buffer(16, usage_u),
-            device.buffer(max(lraw.nbytes, 16), usage_s), device.buffer(max(mraw.nbytes, 16), usage_s)]
-    try:
-        bufs[0].array(np.float32)[: sample.size] = sample.reshape(-1)
-        bufs[2].array(np.uint32)[:4] = (n, 0, 0, 0)
-        bufs[3].array(np.uint32)[: lraw.size] = lraw.reshape(-1)
-        bufs[4].array(np.uint32)[: mraw.size] = mraw.reshape(-1)
-        pipe.bind(bufs)
-        pipe.dispatch(-(-n // 64))
-        return bufs[1].array(np.float32)[: 4 * n].reshape(n, 4).astype(np.float64)
-    finally:
-        pipe.destroy()
-        for b in bufs:
-            b.destroy()
+    sample = _samples(rows, n)
+    sample[:, 0, 3] = material  # P.w: the material index (templates/*/shade with `uber`)
+    blocks = [(STORAGE, entry_bytes(lts["ids"], lts["data"])), (STORAGE, entry_bytes(mat["ids"], mat["data"]))]
+    return _run(c.sources[0], sample, blocks, spec, what="ubershader kernel")

@@ -2,7 +2,8 @@
 
 `uploads(scene, h, c)` gives, per (material, light set) drawn with permutation `h`, the
 Material and Lights blocks as float32 bytes (hex), laid out by `c`'s Interface; the
-manifest writes them and the renderer uploads them.
+manifest writes them and the renderer uploads them. `light_entry` and `entry_bytes` lay out the
+ubershader's LightEntry / MaterialEntry storage buffers (link/uber.py).
 """
 from __future__ import annotations
 
@@ -51,3 +52,30 @@ def uploads(scene: Scene, h: str, c) -> list[dict]:
 def _element(value, slot):
     """The value a slot holds: an array parameter's element, or the value itself."""
     return value if slot.element is None else value[slot.element]
+
+
+def light_entry(u, light_type: str, shadow: str, values: dict):
+    """LightEntry.data of one light, (light_vec4s, 4) float32: each parameter at its vec4 of
+    u.light_layouts (a scalar for a vector parameter splats, as pack() does; a mat4 spans four)."""
+    import numpy as np
+
+    data = np.zeros((u.light_vec4s, 4), np.float32)
+    for name, (j, ty) in u.light_layouts[(light_type, shadow)].items():
+        val = np.asarray(values[name], np.float32).reshape(-1)
+        if ty.kind == "vector" and len(val) == 1:
+            val = np.repeat(val, ty.components)
+        for c in range(0, len(val), 4):
+            data[j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
+    return data
+
+
+def entry_bytes(ids, data):
+    """Storage-buffer entries as uint32 words (n, 1 + k, 4): ids as int32 in the first vec4, then the data vec4s."""
+    import numpy as np
+
+    data = np.asarray(data)
+    raw = np.zeros((len(ids), 1 + data.shape[1], 4), np.float32)
+    raw[:, 1:, :] = data
+    raw = raw.view(np.uint32)
+    raw[:, 0, :] = np.asarray(ids).astype(np.int32).view(np.uint32)
+    return raw

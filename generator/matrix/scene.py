@@ -57,6 +57,13 @@ class Locator:
             i += 1
         return line_no, col
 
+    def top(self, key: str) -> tuple[int, int]:
+        """(line, col) of a top-level table [key] / [[key]] or a top-level `key =`."""
+        for i, line in enumerate(self.lines):
+            if re.match(r"^\s*\[\[?\s*" + re.escape(key) + r"\b", line) or re.match(r"^\s*" + re.escape(key) + r"\s*=", line):
+                return i + 1, line.index(key) + 1
+        return 1, 1
+
     def error(self, where: tuple[int, int], message: str, hint: str = "") -> SourceError:
         return SourceError(self.path, where[0], where[1], message, hint)
 
@@ -91,25 +98,31 @@ class Scene:
     users: dict[str, list[str]] = field(default_factory=dict)  # hash -> object names
 
 
-def load_scene(path, lib: Library) -> Scene:
-    """Read, validate and reduce a TOML scene to its permutations."""
-    path = Path(path)
+def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]:
+    """A TOML file's data and a Locator over its text; a syntax error is a located SourceError."""
     shown = str(path)
-    if path.is_dir():
-        raise SourceError(shown, 1, 1, "is a directory, not a scene file", "pass a .toml scene file")
-    text = read_text(path, "scene")
+    text = read_text(path, what)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         m = re.search(r"\(at line (\d+), column (\d+)\)", str(e))
         line, col = (int(m.group(1)), int(m.group(2))) if m else (1, 1)
         msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(e))
-        raise SourceError(shown, line, col, f"TOML syntax error: {msg}", "fix the scene file's syntax") from None
-    loc = Locator(shown, text)
+        raise SourceError(shown, line, col, f"TOML syntax error: {msg}", syntax_hint) from None
+    return data, Locator(shown, text)
+
+
+def load_scene(path, lib: Library) -> Scene:
+    """Read, validate and reduce a TOML scene to its permutations."""
+    path = Path(path)
+    shown = str(path)
+    if path.is_dir():
+        raise SourceError(shown, 1, 1, "is a directory, not a scene file", "pass a .toml scene file")
+    data, loc = read_toml(path, "scene", "fix the scene file's syntax")
     known = {"scene", "materials", "lights", "light_sets", "objects"}
     for key in data:
         if key not in known:
-            raise loc.error(_top(loc, key), f"unknown section '{key}'",
+            raise loc.error(loc.top(key), f"unknown section '{key}'",
                             f"sections: {', '.join(sorted(known))}")
     head = data.get("scene", {})
     output = head.get("output", "linear")
@@ -201,17 +214,10 @@ def load_scene(path, lib: Library) -> Scene:
     return scene
 
 
-def _top(loc: Locator, key: str) -> tuple[int, int]:
-    for i, line in enumerate(loc.lines):
-        if re.match(r"^\s*\[\[?\s*" + re.escape(key) + r"\b", line) or re.match(r"^\s*" + re.escape(key) + r"\s*=", line):
-            return i + 1, line.index(key) + 1
-    return 1, 1
-
-
 def _table(loc: Locator, data: dict, key: str) -> dict:
     t = data.get(key, {})
     if not isinstance(t, dict):
-        raise loc.error(_top(loc, key), f"'{key}' must be a table", f"write [{key}.NAME] sections")
+        raise loc.error(loc.top(key), f"'{key}' must be a table", f"write [{key}.NAME] sections")
     return t
 
 

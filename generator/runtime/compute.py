@@ -25,6 +25,25 @@ SAMPLER = "sampler"
 _RESOURCE = {STORAGE: Buffer, UNIFORM: Buffer, SAMPLED_IMAGE: Image, SAMPLER: Sampler}
 
 
+def descriptor_write(vk, dst_set, binding: int, kind: str, descriptor_type, res):
+    """(info, VkWriteDescriptorSet) pointing `binding` of `dst_set` at `res`: a Buffer (or (buffer, offset,
+    size)), an image with .view and .layout, or a Sampler. Keep `info` alive until vkUpdateDescriptorSets."""
+    write = dict(dstSet=dst_set, dstBinding=binding, dstArrayElement=0, descriptorCount=1,
+                 descriptorType=descriptor_type)
+    if kind in (STORAGE, UNIFORM):
+        buf, off, size = res if isinstance(res, tuple) else (res, 0, res.size)
+        # range = the byte size: VK_WHOLE_SIZE overflows the binding's conversion (TOOLCHAIN.md).
+        info = vk.VkDescriptorBufferInfo(buffer=buf.handle, offset=int(off), range=int(size))
+        write["pBufferInfo"] = [info]
+    elif kind == SAMPLED_IMAGE:
+        info = vk.VkDescriptorImageInfo(sampler=None, imageView=res.view, imageLayout=res.layout)
+        write["pImageInfo"] = [info]
+    else:
+        info = vk.VkDescriptorImageInfo(sampler=res.handle, imageView=None, imageLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED)
+        write["pImageInfo"] = [info]
+    return info, vk.VkWriteDescriptorSet(**write)
+
+
 class ComputePipeline:
     """A compute pipeline whose set 0 holds `bindings` (STORAGE / UNIFORM / SAMPLED_IMAGE / SAMPLER at 0, 1, ...)."""
 
@@ -102,21 +121,9 @@ class ComputePipeline:
                 dead = " (destroyed)" if getattr(res, "handle", 0) is None else ""
                 raise TypeError(f"binding {i} is {kind}: it takes a live {_RESOURCE[kind].__name__}, "
                                 f"got {type(res).__name__}{dead}")
-            t = self._types[i]
-            write = dict(dstSet=self.set, dstBinding=i, dstArrayElement=0, descriptorCount=1, descriptorType=t)
-            if kind in (STORAGE, UNIFORM):
-                # range = the byte size: VK_WHOLE_SIZE overflows the binding's conversion (TOOLCHAIN.md).
-                info = vk.VkDescriptorBufferInfo(buffer=res.handle, offset=0, range=res.size)
-                write["pBufferInfo"] = [info]
-            elif kind == SAMPLED_IMAGE:
-                info = vk.VkDescriptorImageInfo(sampler=None, imageView=res.view, imageLayout=res.layout)
-                write["pImageInfo"] = [info]
-            else:
-                info = vk.VkDescriptorImageInfo(sampler=res.handle, imageView=None,
-                                                imageLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED)
-                write["pImageInfo"] = [info]
+            info, write = descriptor_write(vk, self.set, i, kind, self._types[i], res)
             infos.append(info)
-            writes.append(vk.VkWriteDescriptorSet(**write))
+            writes.append(write)
         if writes:
             vk.vkUpdateDescriptorSets(self.device.handle, len(writes), writes, 0, None)
 

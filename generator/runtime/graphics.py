@@ -44,10 +44,8 @@ import numpy as np
 from .camera import (column_major, directional_shadow_matrix, frame_bytes, look_at, object_bytes,  # noqa: F401
                      orthographic, perspective, point_shadow_matrix)
 from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM
-from .device import Buffer, Device, VulkanUnavailable
-from .images import Image, Sampler
-from .rendertarget import (COLOR_FORMAT, DEPTH_FORMAT, _TYPES, DepthTarget, DrawItem, OffscreenTarget,  # noqa: F401
-                           _format, resource_keys)
+from .device import Buffer, Device
+from .rendertarget import _TYPES, DepthTarget, DrawItem, OffscreenTarget, _format, resource_keys  # noqa: F401
 
 if TYPE_CHECKING:
     from ..link.interface import Interface

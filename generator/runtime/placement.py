@@ -8,7 +8,6 @@ row along x, SPACING apart, and camera() looks at them from above and in front.
 from __future__ import annotations
 
 import difflib
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -140,9 +139,8 @@ def load_placement(scene, path=None) -> Placement:
 
     model = translate · rotate_y · scale. Every mistake is a SourceError ``path:line:col: what — what to do``.
     """
-    from ..lang import SourceError
-    from ..lang.errors import UserError, read_text
-    from ..matrix.scene import Locator
+    from ..lang.errors import UserError
+    from ..matrix.scene import read_toml
 
     names = [o["name"] for o in scene.objects]
     explicit = path is not None
@@ -151,27 +149,8 @@ def load_placement(scene, path=None) -> Placement:
         if explicit:
             raise UserError(f"{path}: no such placement file — give an existing file, or none for the row")
         return row_placement(names)
-    shown = str(path)
-    text = read_text(path, "placement file")
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        import re
-
-        m = re.search(r"\(at line (\d+), column (\d+)\)", str(e))
-        line, col = (int(m.group(1)), int(m.group(2))) if m else (1, 1)
-        msg = re.sub(r"\s*\(at line \d+, column \d+\)", "", str(e))
-        raise SourceError(shown, line, col, f"TOML syntax error: {msg}", "fix the placement file's syntax") from None
-    loc = Locator(shown, text)
-
-    def top(key):
-        import re
-
-        for i, line in enumerate(loc.lines):
-            if re.match(r"^\s*\[\[?\s*" + re.escape(key) + r"\b", line) or re.match(r"^\s*" + re.escape(key) + r"\s*=",
-                                                                                   line):
-                return i + 1, line.index(key) + 1
-        return 1, 1
+    data, loc = read_toml(path, "placement file", "fix the placement file's syntax")
+    top = loc.top
 
     def unknown(what, key, known, where):
         close = difflib.get_close_matches(key, known, 1)

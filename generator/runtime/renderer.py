@@ -35,8 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .placement import (SPACING, Placed, Placement, camera, load_placement, make_mesh,  # noqa: F401
-                        placement_path, row_placement)
+from .placement import load_placement, make_mesh
 
 MODES = ("specialized", "ubershader", "hybrid")
 SHADOW_SIZE = 512
@@ -139,15 +138,6 @@ def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict) -> by
     return data.tobytes()
 
 
-def _entries(ids: np.ndarray, data: np.ndarray) -> np.ndarray:
-    """Storage-buffer entries: ids as int32 in the first vec4, then the data vec4s (link/uber.py)."""
-    raw = np.zeros((len(ids), 1 + data.shape[1], 4), np.float32)
-    raw[:, 1:, :] = data
-    raw = raw.view(np.uint32)
-    raw[:, 0, :] = ids.astype(np.int32).view(np.uint32)
-    return raw
-
-
 def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), language: str = "glsl",
                  device=None, progress: bool = False, uber_ids: str = "buffer", shadow_size: int = SHADOW_SIZE,
                  placement_file=None) -> Report:
@@ -159,7 +149,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     shadow_size: the side of every light's shadow map (depth pass), in texels.
     placement_file: the placement to use (default: the scene's SCENE.placement.toml if present, else the row).
     """
-    from ..link.values import uploads
+    from ..link.values import entry_bytes, light_entry, uploads
     from ..compose import compose_permutation
     from ..compose.uber import compose_ubershader
     from ..io import atomic_write
@@ -301,21 +291,14 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             k = variant[(p.brdf, p.packing, p.output)]
             mat_ids.append((k, 0, 0, 0))
             mat_rows.append(data)
-        material_buffer = buf(_entries(np.array(mat_ids), np.stack(mat_rows)), S)
+        material_buffer = buf(entry_bytes(np.array(mat_ids), np.stack(mat_rows)), S)
         light_buffers, slot_lights = {}, {}
         for set_name, names in scene.light_sets.items():
             ids, rows, shadow_slot = [], [], 0
             slot_lights[set_name] = []  # ubershader shadow-map slot j -> the light whose map it is
             for ln in names:
                 L = scene.lights[ln]
-                vals = light_vals[ln]
-                data = np.zeros((u.light_vec4s, 4), np.float32)
-                for pname, (j, ty) in u.light_layouts[(L.type, L.shadow)].items():
-                    val = np.asarray(vals[pname], np.float32).reshape(-1)
-                    if ty.kind == "vector" and len(val) == 1:  # a scalar for a vector splats, as pack() does
-                        val = np.repeat(val, ty.components)
-                    for c in range(0, len(val), 4):
-                        data[j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
+                data = light_entry(u, L.type, L.shadow, light_vals[ln])
                 textured = bool(shadow_textures(lib, L.shadow))
                 ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), shadow_slot if textured else 0, 0))
                 if textured:
@@ -323,7 +306,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 shadow_slot += textured
                 rows.append(data)
             if rows:
-                light_buffers[set_name] = buf(_entries(np.array(ids), np.stack(rows)), S)
+                light_buffers[set_name] = buf(entry_bytes(np.array(ids), np.stack(rows)), S)
 
         def empty_lights():  # a light set with no lights: one all-zero entry (a light of colour 0; a storage
             # buffer range cannot be empty)

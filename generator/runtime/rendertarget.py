@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM
+from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM, descriptor_write
 from .device import Buffer, Device, VulkanUnavailable
 from .images import Image, Sampler
 
@@ -215,23 +215,9 @@ class _Target:
                 infos, writes = [], []  # the infos must outlive vkUpdateDescriptorSets
                 for s, ds in mine:
                     for b, kind in p.set_layouts[s].items():
-                        res = it.resources[(s, b)]
-                        w = dict(dstSet=ds, dstBinding=b, dstArrayElement=0, descriptorCount=1,
-                                 descriptorType=_TYPES[kind](vk))
-                        if kind in (UNIFORM, STORAGE):
-                            buf, off, size = res if isinstance(res, tuple) else (res, 0, res.size)
-                            # range = the byte size: VK_WHOLE_SIZE overflows the binding (TOOLCHAIN.md)
-                            info = vk.VkDescriptorBufferInfo(buffer=buf.handle, offset=int(off), range=int(size))
-                            w["pBufferInfo"] = [info]
-                        elif kind == SAMPLED_IMAGE:
-                            info = vk.VkDescriptorImageInfo(sampler=None, imageView=res.view, imageLayout=res.layout)
-                            w["pImageInfo"] = [info]
-                        else:
-                            info = vk.VkDescriptorImageInfo(sampler=res.handle, imageView=None,
-                                                            imageLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED)
-                            w["pImageInfo"] = [info]
+                        info, write = descriptor_write(vk, ds, b, kind, _TYPES[kind](vk), it.resources[(s, b)])
                         infos.append(info)
-                        writes.append(vk.VkWriteDescriptorSet(**w))
+                        writes.append(write)
                 if writes:
                     vk.vkUpdateDescriptorSets(dev, len(writes), writes, 0, None)
                 out.append(mine)
@@ -248,10 +234,35 @@ class _Target:
         mask = (1 << dev.timestamp_bits) - 1 if dev.timestamp_bits < 64 else (1 << 64) - 1
         return ((int(data[1]) - int(data[0])) & mask) * dev.timestamp_period_ns * 1e-6
 
+    ATTACHMENTS: tuple[str, ...] = ()  # the images a subclass owns, destroyed in this order
+
+    def destroy(self) -> None:
+        vk, dev = self.vk, self.device.handle
+        if dev is None:
+            return
+        if self in self.device._owned:
+            self.device._owned.remove(self)
+        if self.queries is not None:
+            vk.vkDestroyQueryPool(dev, self.queries, None)
+        if self.readback is not None:
+            self.readback.destroy()
+        if self.framebuffer is not None:
+            vk.vkDestroyFramebuffer(dev, self.framebuffer, None)
+        if self.render_pass is not None:
+            vk.vkDestroyRenderPass(dev, self.render_pass, None)
+        for name in self.ATTACHMENTS:
+            a = getattr(self, name)
+            if a is not None:
+                a.destroy()
+            setattr(self, name, None)
+        self.queries = self.readback = self.framebuffer = self.render_pass = None
+
 
 class OffscreenTarget(_Target):
     """A W×H R8G8B8A8_UNORM colour image and D32_SFLOAT depth, their render pass and framebuffer, a readback
     buffer and two timestamp queries. Draw frames with :meth:`draw`, read the last one with :meth:`read`."""
+
+    ATTACHMENTS = ("depth", "color")
 
     def _clear_values(self, clear):
         vk = self.vk
@@ -362,24 +373,6 @@ class OffscreenTarget(_Target):
         n = 4 * self.width * self.height
         return self.readback.array(np.uint8)[:n].reshape(self.height, self.width, 4).copy()
 
-    def destroy(self) -> None:
-        vk, dev = self.vk, self.device.handle
-        if dev is None:
-            return
-        if self in self.device._owned:
-            self.device._owned.remove(self)
-        if self.queries is not None:
-            vk.vkDestroyQueryPool(dev, self.queries, None)
-        if self.readback is not None:
-            self.readback.destroy()
-        if self.framebuffer is not None:
-            vk.vkDestroyFramebuffer(dev, self.framebuffer, None)
-        if self.render_pass is not None:
-            vk.vkDestroyRenderPass(dev, self.render_pass, None)
-        for a in (self.depth, self.color):
-            if a is not None:
-                a.destroy()
-        self.queries = self.readback = self.framebuffer = self.render_pass = self.depth = self.color = None
 
 
 class DepthTarget(_Target):
@@ -399,6 +392,8 @@ class DepthTarget(_Target):
 
     Depth is cleared to 1.0 (the far plane: lit everywhere nothing was drawn).
     """
+
+    ATTACHMENTS = ("copy", "depth")
 
     has_color = False
 
@@ -555,24 +550,6 @@ class DepthTarget(_Target):
         n = self.width * self.height
         return self.readback.array(np.float32)[:n].reshape(self.height, self.width).copy()
 
-    def destroy(self) -> None:
-        vk, dev = self.vk, self.device.handle
-        if dev is None:
-            return
-        if self in self.device._owned:
-            self.device._owned.remove(self)
-        if self.queries is not None:
-            vk.vkDestroyQueryPool(dev, self.queries, None)
-        if self.readback is not None:
-            self.readback.destroy()
-        if self.framebuffer is not None:
-            vk.vkDestroyFramebuffer(dev, self.framebuffer, None)
-        if self.render_pass is not None:
-            vk.vkDestroyRenderPass(dev, self.render_pass, None)
-        for a in (self.copy, self.depth):
-            if a is not None:
-                a.destroy()
-        self.queries = self.readback = self.framebuffer = self.render_pass = self.copy = self.depth = None
 
 
 _RESOURCE[SAMPLED_IMAGE] = (Image, DepthTarget)
