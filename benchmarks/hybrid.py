@@ -112,7 +112,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=30)
     ap.add_argument("--size", default="320x160")
-    ap.add_argument("--pairs", type=int, default=7, help="paired short runs for the frame-time ratios")
+    ap.add_argument("--pairs", type=int, default=15, help="paired short runs for the frame-time ratios")
     args = ap.parse_args()
     size = tuple(int(x) for x in args.size.split("x"))
     lib = load_library()
