@@ -12,6 +12,11 @@ import sys
 import tempfile
 from pathlib import Path
 
+# The process's umask, read once at import (os.umask both sets and returns it): mkstemp creates
+# files 0600, and an artifact must get the ordinary permissions every other file gets.
+_UMASK = os.umask(0o022)
+os.umask(_UMASK)
+
 
 def sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
@@ -28,6 +33,7 @@ def atomic_write(path: Path, data: bytes) -> bool:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        os.fchmod(fd, 0o666 & ~_UMASK)
         with os.fdopen(fd, "wb") as f:
             f.write(data)
             f.flush()

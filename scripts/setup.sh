@@ -6,27 +6,49 @@ cd "$(dirname "$0")/.."
 
 # Debian 12 (bookworm) packages, pinned to the versions in bookworm + security.
 APT_PKGS=(
-  "mesa-vulkan-drivers=22.3.6-1+deb12u2"   # lavapipe (software Vulkan 1.3) and RADV
   "libvulkan1=1.3.239.0-1"                 # Vulkan loader
   "vulkan-validationlayers=1.3.239.0-2"    # VK_LAYER_KHRONOS_validation for tests
   "glslc=2023.2-1"                         # shaderc: batches many GLSL/HLSL compiles in one process
   "glslang-tools=12.0.0-2"                 # glslangValidator (HLSL front end, version reporting)
   "spirv-tools=2023.1-2"                   # spirv-val, spirv-opt, spirv-as, spirv-dis
 )
+# Mesa from bookworm-backports, pinned: lavapipe 25 keeps pipelines in its VkPipelineCache
+# (Mesa 22.3's lavapipe stores only the 32-byte header, so a persisted cache was never hit)
+# and RADV's null device. The libdrm and gallium versions are the ones that Mesa needs.
+BPO_PKGS=(
+  "mesa-vulkan-drivers=25.0.7-2~bpo12+1"   # lavapipe (software Vulkan 1.4) and RADV
+  "mesa-libgallium=25.0.7-2~bpo12+1"
+  "libdrm2=2.4.123-1~bpo12+1"
+  "libdrm-amdgpu1=2.4.123-1~bpo12+1"
+  "libdrm-common=2.4.123-1~bpo12+1"
+)
 NAGA_VERSION=30.0.1
 RUST_TOOLCHAIN=1.95.0   # only used when cargo is missing; naga 30 needs rust >= 1.87
+BPO_SOURCES=/etc/apt/sources.list.d/shadermatrix-bookworm-backports.sources
 
-missing=()
-for spec in "${APT_PKGS[@]}"; do
-  pkg=${spec%%=*}; want=${spec#*=}
-  have=$(dpkg-query -W -f='${Status} ${Version}' "$pkg" 2>/dev/null || true)
-  [[ "$have" == "install ok installed $want" ]] || missing+=("$spec")
-done
-if ((${#missing[@]})); then
-  echo "setup: installing ${missing[*]}"
+missing_of() {  # the specs of "$@" whose package is not installed at exactly that version
+  local spec pkg want have
+  for spec in "$@"; do
+    pkg=${spec%%=*}; want=${spec#*=}
+    have=$(dpkg-query -W -f='${Status} ${Version}' "$pkg" 2>/dev/null || true)
+    [[ "$have" == "install ok installed $want" ]] || echo "$spec"
+  done
+}
+mapfile -t missing < <(missing_of "${APT_PKGS[@]}")
+mapfile -t missing_bpo < <(missing_of "${BPO_PKGS[@]}")
+if ((${#missing_bpo[@]})) && ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+  echo "setup: adding bookworm-backports to apt's sources ($BPO_SOURCES)"
+  printf '%s\n' "Types: deb" "URIs: http://deb.debian.org/debian" "Suites: bookworm-backports" \
+    "Components: main" "Signed-By: /usr/share/keyrings/debian-archive-keyring.gpg" > "$BPO_SOURCES.tmp"
+  mv "$BPO_SOURCES.tmp" "$BPO_SOURCES"
+fi
+if ((${#missing[@]} + ${#missing_bpo[@]})); then
+  echo "setup: installing ${missing[*]} ${missing_bpo[*]}"
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  ((${#missing[@]} == 0)) || apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  ((${#missing_bpo[@]} == 0)) ||
+    apt-get install -y -qq --no-install-recommends --allow-downgrades -t bookworm-backports "${missing_bpo[@]}" >/dev/null
 fi
 
 # naga (WGSL front end + validator), pinned, from crates.io into .tools/bin

@@ -7,7 +7,7 @@ nothing.
 
 Tolerance: 1 LSB of 8-bit output on at most 1 % of channels (the specialized and ubershader shaders agree to
 2 float32 ulp in the compute proofs, which can cross an 8-bit rounding boundary). Measured with shadows on
-(lavapipe, Mesa 22.3.6, 96 × 48, shadow map 512²): identical images (max difference 0) between the three modes,
+(lavapipe, Mesa 25.0.7, 96 × 48, shadow map 512²): identical images (max difference 0) between the three modes,
 between GLSL, HLSL and WGSL, and for the specialization-constant ubershader.
 """
 from __future__ import annotations
@@ -134,6 +134,36 @@ def test_a_corrupt_pipeline_cache_is_reported_in_one_line_ignored_and_replaced(r
     warnings = [line for line in r.stderr.splitlines() if line.startswith("warning:")]
     assert len(warnings) == 1 and "truncated" in warnings[0] and "ignored" in warnings[0]
     assert cache.read_bytes() == good  # replaced by what this device writes
+
+
+def test_a_second_run_hits_the_persisted_shader_cache_and_a_damaged_one_only_misses(tmp_path):
+    """lavapipe's VkPipelineCache holds nothing (its data is the header, creation feedback reports no hit);
+    what it does keep is Mesa's shader disk cache, which the renderer puts in out/shader_cache. The counts
+    are the driver's own (MESA_SHADER_CACHE_SHOW_STATS), read from what Mesa prints at tear-down."""
+    from tests.conftest import require
+    from generator.runtime.probe import lavapipe_present
+
+    require(lavapipe_present(), "no lavapipe Vulkan device")
+    out = tmp_path / "cached"
+    r, cold = _render(out, "specialized", frames=1)
+    assert "disk shader cache" not in r.stdout  # Mesa's line is taken into the report, not printed
+    assert cold["shader_cache_misses"] > 0, cold  # an empty cache: the shaders are compiled
+    assert cold["pipeline_cache_hits"] == 0  # lavapipe: no VkPipelineCache hits, ever
+    image = _image(out / "frame_0000.png")
+    _, warm = _render(out, "specialized", frames=1)
+    assert warm["shader_cache_misses"] == 0 and warm["shader_cache_hits"] >= cold["shader_cache_misses"], warm
+    assert (_image(out / "frame_0000.png") == image).all()
+    damaged = 0
+    for f in sorted((out / "shader_cache").rglob("*")):
+        if f.is_file() and f.stat().st_size > 64:
+            data = bytearray(f.read_bytes())
+            data[len(data) // 2:] = bytes(len(data) - len(data) // 2)  # zero the second half
+            f.write_bytes(bytes(data))
+            damaged += 1
+    assert damaged
+    _, again = _render(out, "specialized", frames=1)
+    assert again["shader_cache_misses"] > 0, again  # damaged entries are misses, recompiled, never trusted
+    assert (_image(out / "frame_0000.png") == image).all()
 
 
 def test_bad_arguments_are_one_line_errors(tmp_path):

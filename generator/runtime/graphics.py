@@ -34,13 +34,13 @@ names and nested structs are kept alive across the calls; buffer ranges are byte
 """
 from __future__ import annotations
 
-import os
-import tempfile
+import io
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..io import atomic_write
 from .camera import (column_major, directional_shadow_matrix, frame_bytes, look_at, object_bytes,  # noqa: F401
                      orthographic, perspective, point_shadow_matrix)
 from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM
@@ -84,7 +84,7 @@ def layouts_from_interface(iface: "Interface", sets: tuple[int, ...] = (0, 1)) -
 
 def save_png(array, path) -> Path:
     """Write an (H, W), (H, W, 3) or (H, W, 4) uint8 array as a PNG, atomically (a temporary file in the same
-    directory, then os.replace): a reader never sees a half-written file. Returns the path."""
+    directory, then renamed: io.atomic_write): a reader never sees a half-written file. Returns the path."""
     from PIL import Image as PILImage
 
     a = np.asarray(array)
@@ -95,15 +95,9 @@ def save_png(array, path) -> Path:
     if a.ndim == 3 and a.shape[2] == 1:
         a = a[..., 0]
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            PILImage.fromarray(np.ascontiguousarray(a)).save(fh, format="PNG")
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    png = io.BytesIO()
+    PILImage.fromarray(np.ascontiguousarray(a)).save(png, format="PNG")
+    atomic_write(path, png.getvalue())
     return path
 
 

@@ -24,7 +24,9 @@ perspective one from its position (:func:`~.graphics.point_shadow_matrix`); the 
 written into the light's shadow_matrix parameter of both paths (the specialized Lights
 blocks and the ubershader's LightEntry data), and the depth map is bound as the light's
 shadow map. Other textures are generated: an sRGB albedo checker, a normal map of known
-bumps. Pipelines are created through a persisted pipeline cache (runtime/pipeline_cache.py).
+bumps. Pipelines are created through a persisted pipeline cache (runtime/pipeline_cache.py), and
+when the render opens its own device, Mesa's shader disk cache lives in out/shader_cache and
+the driver's hit and miss counts go into the report (runtime/shader_cache.py).
 """
 from __future__ import annotations
 
@@ -59,7 +61,11 @@ class Report:
     time_to_first_frame_ms: float = 0.0
     pipelines_created: int = 0
     pipeline_create_ms: list[float] = field(default_factory=list)
-    pipeline_cache_hits: int = 0
+    pipeline_cache_hits: int = 0  # the driver's creation feedback (VkPipelineCache; 0 on lavapipe)
+    # Mesa's shader disk cache under out/shader_cache, as the driver counts it (runtime/shader_cache.py);
+    # None when this render did not open the device or the driver reports no statistics
+    shader_cache_hits: int | None = None
+    shader_cache_misses: int | None = None
     cache_problem: str = ""
     placement: str = ""  # the placement file read, or "row" (the fallback)
     # per shadowed light: size, gpu_ms of its depth pass, how it is sampled ("depth" | "r32_copy"), its matrix
@@ -160,6 +166,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from .device import Device, validation_requested
     from ..link.uber import SPEC_VARIANT
     from .pipeline_cache import PipelineCacheFile
+    from . import shader_cache
 
     if mode not in MODES:
         raise UserError(f"unknown mode {mode!r} — use one of {', '.join(MODES)}")
@@ -202,7 +209,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         light_vals[ln]["shadow_matrix"] = matrices[ln]
 
     own_device = device is None
-    device = device or Device(validation=validation_requested())
+    if own_device:  # lavapipe's compiled shaders persist under out/, and the driver counts its hits
+        with shader_cache.opened(out / "shader_cache"):
+            device = Device(validation=validation_requested())
     first_message = len(device.messages)
     owned = []
     report = Report(mode, language, (W, H), placement=str(placed.source) if placed.source else "row")
@@ -412,7 +421,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         for obj in reversed(owned):
             obj.destroy()
         if own_device:
-            device.close()
+            stats = shader_cache.closed(device.close)
+            if stats is not None:
+                report.shader_cache_hits, report.shader_cache_misses = stats
         report.validation = bool(device.validation)
         report.validation_messages = [str(m) for m in device.messages[first_message:]]
     import json

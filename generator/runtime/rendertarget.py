@@ -517,6 +517,7 @@ class DepthTarget(_Target):
             srcQueueFamilyIndex=ignored, dstQueueFamilyIndex=ignored, buffer=self.readback.handle, offset=0,
             size=self.readback.size)
         if self.sampled == "depth":
+            written.dstAccessMask = vk.VK_ACCESS_HOST_READ_BIT  # only the host reads the buffer on this path
             to_read = vk.VkImageMemoryBarrier(
                 srcAccessMask=0, dstAccessMask=vk.VK_ACCESS_SHADER_READ_BIT,
                 oldLayout=vk.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, newLayout=self.layout,
