@@ -385,8 +385,8 @@ class DepthTarget(_Target):
     sampleable in SHADER_READ_ONLY_OPTIMAL, one of two ways (:attr:`sampled`):
 
     - ``"depth"``: the depth image itself, when the device can sample D32_SFLOAT with linear filtering
-      (the project's one sampler is bilinear, no compare): sampling returns depth in .x;
-    - ``"r32_copy"``: otherwise (Mesa 22.3 lavapipe: D32_SFLOAT is sampleable but not linearly filterable),
+      (the project's one sampler is bilinear, no compare): sampling returns depth in .x (lavapipe, Mesa 25.0);
+    - ``"r32_copy"``: otherwise (lavapipe in Mesa 22.3: D32_SFLOAT is sampleable but not linearly filterable),
       the buffer is copied into an R32_SFLOAT colour image of the same size, which is sampled instead:
       depth in .x (g, b = 0, a = 1 as Vulkan expands R32).
 
