@@ -4,7 +4,7 @@ The generator's own vertex and fragment shaders (compose_permutation) and its fr
 ubershader (compose_ubershader) are compiled by the real toolchain and drawn through
 generator/runtime/graphics.py under the validation layer, 64×64.
 
-Agreement measured on lavapipe (Mesa 22.3.6, LLVM 15), R8G8B8A8_UNORM, every pixel of
+Agreement measured on lavapipe (Mesa 25.0.7, LLVM 15.0.6), R8G8B8A8_UNORM, every pixel of
 every channel (scenes below: a Blinn-Phong sphere under a point light; two spheres, one
 with an sRGB albedo texture and a tangent-space normal map, one with constants):
 
@@ -524,7 +524,8 @@ def test_a_depth_only_pass_stores_the_analytic_depth_and_is_sampled_as_a_shadow_
     assert dt.sampled in ("depth", "r32_copy")
     feats = vk.vkGetPhysicalDeviceFormatProperties(device.physical, vk.VK_FORMAT_D32_SFLOAT).optimalTilingFeatures
     linear = bool(feats & vk.VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)
-    assert dt.sampled == ("depth" if linear else "r32_copy")  # lavapipe (Mesa 22.3): no linear D32 → the copy
+    # lavapipe: Mesa 25.0 filters D32_SFLOAT linearly → the depth image itself; Mesa 22.3 did not → the R32 copy
+    assert dt.sampled == ("depth" if linear else "r32_copy")
     c = gpu.composed[f"spec-{TEX}"]  # the vertex shader with every input
     layouts = {0: {0: UNIFORM}, 2: {0: UNIFORM}}
     with pytest.raises(ValueError, match="needs a fragment shader"):

@@ -7,23 +7,27 @@ cube images through :class:`generator.runtime.eval_kernel.EvalKernel`: set 0 is
 written here (texel centres at (i + 0.5) / W, level 0), the filter that
 generator/targets/numpy_resources.py reproduces.
 
-Agreement measured on lavapipe (Mesa 22.3.6, LLVM 15), 200 000 random uv in
-[-0.2, 1.2]² per case, max abs difference GPU - float64 reference:
+Agreement measured on lavapipe (Mesa 25.0.7, LLVM 15.0.6), 200 000 random uv in
+[-0.2, 1.2]² per case, max abs difference GPU - float64 reference (Mesa 22.3.6 gives the
+same figures on the same inputs):
 
-- R32G32B32A32_SFLOAT: 4.1e-7 on 5x7 textures with texel values in [0, 1]
-  (random and a 0/1 checkerboard), 9.7e-8 at 256x128, 4.6e-5 at 1000x1000:
+- R32G32B32A32_SFLOAT: 2.9e-7 (random) and up to 4.3e-7 (a 0/1 checkerboard) on 5x7
+  textures with texel values in [0, 1], 9.6e-8 at 256x128, 4.6e-5 at 1000x1000:
   lavapipe filters float formats in float32 with no visible sub-texel weight
   quantization; the error is float32 rounding of uv * W - 0.5, which grows with
   the texture size, so the tolerance is ``FLOAT_TOL(W, H)``
   = 1e-6 + 2 * max(W, H) * 2^-24 per unit of texel contrast.
-  Cube maps (8x8 faces, directions of any length) agree to 5.0e-7 away from face
+  Cube maps (8x8 faces, directions of any length) agree to 5.5e-7 away from face
   edges; within half a texel of an edge Vulkan filters seamlessly across faces
-  and the per-face NumPy reference does not (differences up to 0.48 there).
+  and the per-face NumPy reference does not (differences up to 0.60 there).
 - R8G8B8A8_UNORM: the filtered value comes back requantized to multiples of
-  1/255 (8-bit weights and result): max 1.40/255 (0.0055) on random texels,
-  0.96/255 on a 0-to-255 ramp; texel centres exact (7.4e-8). Tolerance 1.5/255.
+  1/255 (weights in steps of 1/256 per axis, 8-bit result): max 1.49/255 (0.0058)
+  on the test's random texels, 0.50/255 on a 256x1 0-to-255 ramp; texel centres
+  exact (7.4e-8). Tolerance 1.5/255: it holds for the test's fixed inputs with only
+  0.01/255 to spare and is not a bound of the filter (other random 5x7 textures at
+  10^6 uv: 1.43-1.60/255; 0|255 texels: up to 1.70/255; the same on Mesa 22.3.6).
 - R8G8B8A8_SRGB: rgb is decoded before filtering, and filtering is float (a 0|255
-  checkerboard: 4.1e-7); lavapipe's decode approximates the sRGB EOTF to within
+  checkerboard: 4.0e-7); lavapipe's decode approximates the sRGB EOTF to within
   1.19e-3 absolute (worst near code 218, 0.70 linear); alpha stays linear (7.4e-8).
   Tolerance 1.5e-3.
 """
@@ -38,13 +42,13 @@ from tests.lavapipe import device, no_validation_messages, open_device  # noqa: 
 
 pytestmark = [pytest.mark.lavapipe, pytest.mark.toolchain]
 
-UNORM_TOL = 1.5 / 255   # measured 1.40 / 255
+UNORM_TOL = 1.5 / 255   # measured 1.49 / 255 on the test's inputs (not a bound: see above)
 SRGB_TOL = 1.5e-3       # measured 1.19e-3 (the decode's error)
-CUBE_TOL = 2e-6         # measured 5.0e-7 (8x8 faces, away from face edges)
+CUBE_TOL = 2e-6         # measured 5.5e-7 (8x8 faces, away from face edges)
 
 
 def FLOAT_TOL(w: int, h: int) -> float:  # noqa: N802 (reads as the constant it is per size)
-    """Tolerance for float textures of W x H with texel contrast ≤ 1 (measured: 4.1e-7 at 5x7)."""
+    """Tolerance for float textures of W x H with texel contrast ≤ 1 (measured: 4.3e-7 at 5x7)."""
     return 1e-6 + 2.0 * max(w, h) * 2.0 ** -24
 
 
@@ -239,7 +243,7 @@ def test_float_texture_is_bilinear_clamp_to_edge(device, call, w, h):
 
 
 def test_float_filter_agreement_on_contrast(device):
-    """A 0/1 checkerboard (maximal texel contrast) at 200 000 uv: measured max 4.1e-7."""
+    """A 0/1 checkerboard (maximal texel contrast) at 200 000 uv: measured max 4.2e-7."""
     rng = np.random.default_rng(7)
     k = kernel_2d(device, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     img = np.repeat((np.indices((5, 7)).sum(0) % 2)[..., None], 4, -1).astype(np.float32)

@@ -9,8 +9,9 @@ G + t·d (t > 0, d toward the light) passes within r of the ball's centre. Pixel
 light variant (a perspective shadow matrix) shadows its own footprint (rays toward the light's position). Rendered
 in-process on the validated `device` (tests/lavapipe.py): no validation messages.
 
-Measured on lavapipe (Mesa 22.3.6), 96 × 64, shadow map 256²: inside pixels exactly 0, outside pixels one
-colour; specialized and ubershader images identical.
+Measured on lavapipe (Mesa 25.0.7, LLVM 15.0.6), 96 × 64, shadow map 256² (sampled as the D32 depth image
+itself; Mesa 22.3.6 sampled its R32_SFLOAT copy and gave the same images): inside pixels exactly 0, outside pixels
+one colour (124 in every channel); specialized and ubershader images identical.
 """
 from __future__ import annotations
 
