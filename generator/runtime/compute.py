@@ -48,9 +48,9 @@ class ComputePipeline:
     """A compute pipeline whose set 0 holds `bindings` (STORAGE / UNIFORM / SAMPLED_IMAGE / SAMPLER at 0, 1, ...)."""
 
     def __init__(self, device: Device, spirv: bytes, bindings: tuple[str, ...], entry: str = "main",
-                 specialization: dict[int, int] | None = None, cache=None):
+                 specialization: dict[int, int] | None = None, cache=None, flags: int = 0):
         vk = self.vk = device.vk
-        self.device, self.bindings = device, tuple(bindings)
+        self.device, self.bindings = device, tuple(bindings)  # flags: VkPipelineCreateFlags
         self.handle = self.module = self.layout = self.set_layout = self.pool = self.queries = None
         dev = device.handle
         try:
@@ -79,7 +79,7 @@ class ComputePipeline:
                 spec = vk.VkSpecializationInfo(pMapEntries=entries, dataSize=4 * len(ids), pData=data)
             stage = vk.VkPipelineShaderStageCreateInfo(stage=vk.VK_SHADER_STAGE_COMPUTE_BIT,
                                                        module=self.module, pName=name, pSpecializationInfo=spec)
-            info = vk.VkComputePipelineCreateInfo(stage=stage, layout=self.layout)
+            info = vk.VkComputePipelineCreateInfo(flags=flags, stage=stage, layout=self.layout)
             # cache: a runtime.pipeline_cache.PipelineCacheFile (its VkPipelineCache), or None
             self.handle = vk.vkCreateComputePipelines(dev, cache.handle if cache else None, 1, [info], None)[0]
             counts = {}

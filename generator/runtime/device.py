@@ -32,6 +32,7 @@ import numpy as np
 if TYPE_CHECKING:
     from .images import Image, Sampler
 
+STATISTICS_EXTENSION = "VK_KHR_pipeline_executable_properties"
 VALIDATION_LAYER = "VK_LAYER_KHRONOS_validation"
 
 
@@ -122,11 +123,15 @@ class Buffer:
 class Device:
     """Instance + lavapipe logical device + one queue and command pool; collects validation messages."""
 
-    def __init__(self, validation: bool = False, prefer: str = "llvmpipe"):
+    def __init__(self, validation: bool = False, prefer: str = "llvmpipe", compile_only: bool = False):
         if os.environ.get("SHADERMATRIX_FORBID_DEVICE"):  # the test tiers: only lavapipe tests open a device
             raise RuntimeError(f"a Vulkan device opened where none may ({os.environ['SHADERMATRIX_FORBID_DEVICE']})")
         vk = self.vk = _vk()
         self.validation = validation
+        # compile_only: a device that creates pipelines and reads the compiler's own figures
+        # (VK_KHR_pipeline_executable_properties; an error where the device lacks it) and runs nothing:
+        # no command pool, no fence (RADV's null device, runtime/gpu_stats.py, has no hardware to run on)
+        self.compile_only = compile_only
         self.messages: list[ValidationMessage] = []
         self.handle = self.instance = self._messenger = self.command_pool = self.fence = None
         self._owned: list = []  # objects with destroy(), released in reverse order by close()
@@ -195,9 +200,19 @@ class Device:
         # VK_EXT_pipeline_creation_feedback (when the driver has it): pipelines report cache hits.
         have = {e.extensionName for e in vk.vkEnumerateDeviceExtensionProperties(self.physical, None)}
         self.extensions = [e for e in ("VK_EXT_pipeline_creation_feedback",) if e in have]
+        features = None
+        if self.compile_only:
+            if STATISTICS_EXTENSION not in have:
+                raise VulkanUnavailable(f"{self.name} has no {STATISTICS_EXTENSION}: it cannot report compiler "
+                                        "statistics")
+            self.extensions.append(STATISTICS_EXTENSION)
+            features = vk.VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR(pipelineExecutableInfo=vk.VK_TRUE)
         self.handle = vk.vkCreateDevice(self.physical, vk.VkDeviceCreateInfo(
-            pQueueCreateInfos=[queue_info], pEnabledFeatures=vk.VkPhysicalDeviceFeatures(),
+            pNext=features, pQueueCreateInfos=[queue_info], pEnabledFeatures=vk.VkPhysicalDeviceFeatures(),
             ppEnabledExtensionNames=self.extensions), None)
+        del features  # alive across the call
+        if self.compile_only:
+            return
         self.queue = vk.vkGetDeviceQueue(self.handle, self.queue_family, 0)
         self.command_pool = vk.vkCreateCommandPool(self.handle, vk.VkCommandPoolCreateInfo(
             flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, queueFamilyIndex=self.queue_family), None)
@@ -270,7 +285,8 @@ class Device:
         """Destroy everything this device created; validation messages of the tear-down are still collected."""
         vk = self.vk
         if self.handle is not None:
-            vk.vkDeviceWaitIdle(self.handle)
+            if not self.compile_only:
+                vk.vkDeviceWaitIdle(self.handle)
             for obj in reversed(list(self._owned)):
                 obj.destroy()
             self._owned.clear()

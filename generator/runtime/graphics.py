@@ -117,8 +117,9 @@ class GraphicsPipeline:
     def __init__(self, device: Device, target: "OffscreenTarget | DepthTarget", vert_spirv: bytes,
                  frag_spirv: bytes | None,
                  vertex_inputs, set_layouts: dict[int, dict[int, str]], specialization: dict[int, int] | None = None,
-                 vert_entry: str = "main", frag_entry: str = "main", cache=None):
+                 vert_entry: str = "main", frag_entry: str = "main", cache=None, flags: int = 0):
         vk = self.vk = device.vk
+        self.flags = flags  # VkPipelineCreateFlags (e.g. capture statistics: runtime/gpu_stats.py)
         self.cache = cache  # a runtime.pipeline_cache.PipelineCacheFile, or None
         self.device, self.target = device, target
         self.vertex_inputs = tuple(vertex_inputs)
@@ -221,7 +222,7 @@ class GraphicsPipeline:
             feedback_info = vk.VkPipelineCreationFeedbackCreateInfo(pPipelineCreationFeedback=feedback,
                                                                     pipelineStageCreationFeedbackCount=0)
         info = vk.VkGraphicsPipelineCreateInfo(
-            pNext=feedback_info, pStages=stages, pVertexInputState=vertex_input, pInputAssemblyState=assembly,
+            pNext=feedback_info, flags=self.flags, pStages=stages, pVertexInputState=vertex_input, pInputAssemblyState=assembly,
             pViewportState=viewport_state, pRasterizationState=raster, pMultisampleState=multisample,
             pDepthStencilState=depth, pColorBlendState=blend, layout=self.layout, renderPass=t.render_pass,
             subpass=0, basePipelineIndex=-1)

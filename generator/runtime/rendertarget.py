@@ -258,6 +258,66 @@ class _Target:
         self.queries = self.readback = self.framebuffer = self.render_pass = None
 
 
+def color_depth_render_pass(vk, dev, color_format, depth_format):
+    """The render pass of an :class:`OffscreenTarget`: colour (cleared, stored, left TRANSFER_SRC for the
+    readback) and depth (cleared, not stored), one subpass, the dependencies between frames."""
+    color = vk.VkAttachmentDescription(
+        format=color_format, samples=vk.VK_SAMPLE_COUNT_1_BIT, loadOp=vk.VK_ATTACHMENT_LOAD_OP_CLEAR,
+        storeOp=vk.VK_ATTACHMENT_STORE_OP_STORE, stencilLoadOp=vk.VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+        stencilStoreOp=vk.VK_ATTACHMENT_STORE_OP_DONT_CARE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED,
+        finalLayout=vk.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL)
+    depth = vk.VkAttachmentDescription(
+        format=depth_format, samples=vk.VK_SAMPLE_COUNT_1_BIT, loadOp=vk.VK_ATTACHMENT_LOAD_OP_CLEAR,
+        storeOp=vk.VK_ATTACHMENT_STORE_OP_DONT_CARE, stencilLoadOp=vk.VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+        stencilStoreOp=vk.VK_ATTACHMENT_STORE_OP_DONT_CARE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED,
+        finalLayout=vk.VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+    color_ref = vk.VkAttachmentReference(attachment=0, layout=vk.VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL)
+    depth_ref = vk.VkAttachmentReference(attachment=1, layout=vk.VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+    subpass = vk.VkSubpassDescription(pipelineBindPoint=vk.VK_PIPELINE_BIND_POINT_GRAPHICS,
+                                      pColorAttachments=[color_ref], pDepthStencilAttachment=depth_ref)
+    frag_tests = vk.VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | vk.VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT
+    attach_stages = vk.VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | frag_tests
+    attach_access = (vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | vk.VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT
+                     | vk.VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT)
+    deps = [
+        # The previous frame's attachment writes and readback copy before this frame's clears.
+        vk.VkSubpassDependency(
+            srcSubpass=vk.VK_SUBPASS_EXTERNAL, dstSubpass=0,
+            srcStageMask=attach_stages | vk.VK_PIPELINE_STAGE_TRANSFER_BIT, dstStageMask=attach_stages,
+            srcAccessMask=vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | vk.VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+            dstAccessMask=attach_access),
+        # The colour writes before the readback copy (read(), a later submission).
+        vk.VkSubpassDependency(
+            srcSubpass=0, dstSubpass=vk.VK_SUBPASS_EXTERNAL,
+            srcStageMask=vk.VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+            dstStageMask=vk.VK_PIPELINE_STAGE_TRANSFER_BIT,
+            srcAccessMask=vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, dstAccessMask=vk.VK_ACCESS_TRANSFER_READ_BIT)]
+    attachments = [color, depth]
+    return vk.vkCreateRenderPass(dev, vk.VkRenderPassCreateInfo(
+        pAttachments=attachments, pSubpasses=[subpass], pDependencies=deps), None)
+
+
+class RenderPassOnly:
+    """An :class:`OffscreenTarget`'s render pass without its images: what a graphics pipeline is created
+    against on a compile-only device (runtime/gpu_stats.py: RADV's null device creates pipelines, not images).
+    Draws nothing; `width` × `height` is the pipeline's viewport."""
+
+    has_color = True
+
+    def __init__(self, device: Device, width: int = 256, height: int = 256):
+        self.vk, self.device, self.width, self.height = device.vk, device, int(width), int(height)
+        self.render_pass = color_depth_render_pass(self.vk, device.handle, _format(self.vk, COLOR_FORMAT),
+                                                   _format(self.vk, DEPTH_FORMAT))
+        device.own(self)
+
+    def destroy(self) -> None:
+        if self.render_pass is not None and self.device.handle is not None:
+            if self in self.device._owned:
+                self.device._owned.remove(self)
+            self.vk.vkDestroyRenderPass(self.device.handle, self.render_pass, None)
+        self.render_pass = None
+
+
 class OffscreenTarget(_Target):
     """A W×H R8G8B8A8_UNORM colour image and D32_SFLOAT depth, their render pass and framebuffer, a readback
     buffer and two timestamp queries. Draw frames with :meth:`draw`, read the last one with :meth:`read`."""
@@ -311,41 +371,7 @@ class OffscreenTarget(_Target):
         device.own(self)
 
     def _create_render_pass(self) -> None:
-        vk = self.vk
-        color = vk.VkAttachmentDescription(
-            format=self.color_format, samples=vk.VK_SAMPLE_COUNT_1_BIT, loadOp=vk.VK_ATTACHMENT_LOAD_OP_CLEAR,
-            storeOp=vk.VK_ATTACHMENT_STORE_OP_STORE, stencilLoadOp=vk.VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-            stencilStoreOp=vk.VK_ATTACHMENT_STORE_OP_DONT_CARE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED,
-            finalLayout=vk.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL)
-        depth = vk.VkAttachmentDescription(
-            format=self.depth_format, samples=vk.VK_SAMPLE_COUNT_1_BIT, loadOp=vk.VK_ATTACHMENT_LOAD_OP_CLEAR,
-            storeOp=vk.VK_ATTACHMENT_STORE_OP_DONT_CARE, stencilLoadOp=vk.VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-            stencilStoreOp=vk.VK_ATTACHMENT_STORE_OP_DONT_CARE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED,
-            finalLayout=vk.VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-        color_ref = vk.VkAttachmentReference(attachment=0, layout=vk.VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL)
-        depth_ref = vk.VkAttachmentReference(attachment=1, layout=vk.VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-        subpass = vk.VkSubpassDescription(pipelineBindPoint=vk.VK_PIPELINE_BIND_POINT_GRAPHICS,
-                                          pColorAttachments=[color_ref], pDepthStencilAttachment=depth_ref)
-        frag_tests = vk.VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | vk.VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT
-        attach_stages = vk.VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | frag_tests
-        attach_access = (vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | vk.VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT
-                         | vk.VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT)
-        deps = [
-            # The previous frame's attachment writes and readback copy before this frame's clears.
-            vk.VkSubpassDependency(
-                srcSubpass=vk.VK_SUBPASS_EXTERNAL, dstSubpass=0,
-                srcStageMask=attach_stages | vk.VK_PIPELINE_STAGE_TRANSFER_BIT, dstStageMask=attach_stages,
-                srcAccessMask=vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | vk.VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                dstAccessMask=attach_access),
-            # The colour writes before the readback copy (read(), a later submission).
-            vk.VkSubpassDependency(
-                srcSubpass=0, dstSubpass=vk.VK_SUBPASS_EXTERNAL,
-                srcStageMask=vk.VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                dstStageMask=vk.VK_PIPELINE_STAGE_TRANSFER_BIT,
-                srcAccessMask=vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, dstAccessMask=vk.VK_ACCESS_TRANSFER_READ_BIT)]
-        attachments = [color, depth]
-        self.render_pass = vk.vkCreateRenderPass(self.device.handle, vk.VkRenderPassCreateInfo(
-            pAttachments=attachments, pSubpasses=[subpass], pDependencies=deps), None)
+        self.render_pass = color_depth_render_pass(self.vk, self.device.handle, self.color_format, self.depth_format)
 
     def read(self) -> np.ndarray:
         """The last frame's colour image, (H, W, 4) uint8 RGBA (a copy), row 0 at the top."""
