@@ -250,12 +250,14 @@ def scene_json():
 def test_scene_costs_json_rows_and_stability(scene_json):
     doc = json.loads(scene_json)
     rows = doc["rows"]
-    assert len(rows) == 5 * 2 * 3  # permutations x stages x languages
+    assert len(rows) == (5 + 1) * 2 * 3  # (permutations + the ubershader) x stages x languages
+    assert sum(r["table"] == "ubershader" for r in rows) == 2 * 3
     for r in rows:
         for key in ("subject", "language", "alu", "transcendental", "texture", "branches", "registers",
                     "instructions", "loads", "stores", "alu_scalar"):
             assert r[key] is not None, key
     course = {(r["subject"], r["course_model"], r["course_table"]) for r in rows if r["course_model"]}
+    rows = [r for r in rows if r["table"] == "permutation"]
     ids = {r["subject"]: r["measured"] for r in rows}
     for subject, model, table in course:
         assert model in ("Blinn-Phong", "Cook-Torrance")
@@ -276,7 +278,7 @@ def test_scene_costs_markdown_and_csv(scene_json):
     assert csv_out.returncode == 0
     lines = csv_out.stdout.splitlines()
     assert lines[0].startswith("table,subject,kind,stage,language,instructions,alu,transcendental,texture")
-    assert len(lines) == 1 + 30
+    assert len(lines) == 1 + 36
 
 
 @pytest.mark.toolchain

@@ -116,6 +116,7 @@ class Row:
     error: str = ""
     objects: tuple = ()  # permutation rows: the scene objects using it
     lights: int = 0      # permutation rows: light count (the course's figures are per light)
+    gpu: dict | None = None  # {AMD family: {RADV statistic: value}} with --gpu (measure/gpu.py)
 
 
 # ------------------------------------------------------------------ compiling
@@ -123,8 +124,9 @@ class Row:
 class _Batch:
     """Shaders to compile once each (eval kernels and permutation fragment shaders), then their costs."""
 
-    def __init__(self, lib: Library, languages):
+    def __init__(self, lib: Library, languages, vert: bool = False):
         self.lib, self.languages = lib, tuple(languages)
+        self.vert = vert  # compile the vertex shaders of permutation units too (graphics pipelines for --gpu)
         self.units: dict[str, Composed | str] = {}  # unit key -> composed, or an error message
         self.results: dict = {}
 
@@ -147,10 +149,21 @@ class _Batch:
                 continue
             for src in c.sources:
                 k = job_key(c.hash, src.stage, src.language)
-                if src.stage in ("comp", "frag") and k not in seen:
+                if (src.stage in ("comp", "frag") or (self.vert and src.stage == "vert")) and k not in seen:
                     seen.add(k)
                     jobs.append(CompileJob(k, src.language, src.stage, src.text, line_map=tuple(src.line_map)))
         self.results = compile_many(jobs, progress=show_progress())
+
+    def spirv(self, unit: str, language: str) -> tuple[str, dict[str, bytes]] | None:
+        """(job key, {stage: SPIR-V}) of a unit in one language, None when it did not build."""
+        c = self.units[unit]
+        if isinstance(c, str):
+            return None
+        stages = ("comp",) if unit.startswith("eval:") else ("vert", "frag")
+        got = {st: self.results.get(job_key(c.hash, st, language)) for st in stages}
+        if not all(r is not None and r.ok for r in got.values()):
+            return None
+        return f"{c.hash}.{language}", {st: r.spirv for st, r in got.items()}
 
     def fail(self, name: str, message: str) -> str:
         """A unit that cannot be built: its rows carry `message`."""
@@ -222,9 +235,11 @@ class _Plan:
     course: CourseFigure | None = None
 
 
-def brick_rows(lib: Library, languages=REPORT_LANGUAGES) -> list[Row]:
-    """Per-brick and per-model rows; `lib` must include the stand-ins (see load_cost_library)."""
-    batch = _Batch(lib, languages)
+def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None) -> list[Row]:
+    """Per-brick and per-model rows; `lib` must include the stand-ins (see load_cost_library).
+
+    gpu: a measure.gpu.GpuRequest, to add RADV's statistics (with minus without) to every row."""
+    batch = _Batch(lib, languages, vert=gpu is not None)
     sd, ss = standin(lib, "diffuse").id, standin(lib, "specular").id
 
     def pair(kind: str, spec: str) -> str:
@@ -292,7 +307,7 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES) -> list[Row]:
                       baseline=replace(base, brdf=stand))
 
     batch.run()
-    rows = []
+    rows, pairs = [], []
     for p in plans:
         for lang in languages:
             with_, without = batch.cost(p.with_unit, lang), batch.cost(p.without_unit, lang)
@@ -304,30 +319,76 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES) -> list[Row]:
             else:
                 row.cost = with_ - without
             rows.append(row)
+            if gpu is not None and not row.error:
+                pairs.append((row, batch.spirv(p.with_unit, lang), batch.spirv(p.without_unit, lang)))
+    if gpu is not None:
+        _attach_gpu(gpu, pairs)
     return rows
+
+
+def _attach_gpu(gpu, pairs) -> None:
+    """RADV's statistics for rows given as (row, (key, stages) of what was measured, of the baseline or None)."""
+    from .gpu import attach
+
+    units, triples = {}, []
+    for row, with_, without in pairs:
+        if with_ is None:
+            continue
+        units[with_[0]] = with_[1]
+        if without is not None:
+            units[without[0]] = without[1]
+        triples.append((row, with_[0], without[0] if without is not None else None))
+    attach(gpu, triples, units)
 
 
 # ------------------------------------------------------------------ per permutation
 
-def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES) -> list[Row]:
-    """Fragment and vertex shader cost of every permutation of a scene, per language."""
+def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None) -> list[Row]:
+    """Fragment and vertex shader cost of every permutation of a scene and of its ubershader, per language.
+
+    gpu: a measure.gpu.GpuRequest, to add RADV's statistics to every row."""
+    from ..compose.uber import compose_ubershader
+
     composed, errors, results = compile_scene(scene, lib, languages)
-    rows = []
+    rows, pairs = [], []
+
+    def row_of(table, subject, perm_key, stage, lang, c_hash, course=None, objects=(), lights=0, error=None):
+        row = Row(table, subject, stage, lang, stage, perm_key, course=course, objects=objects, lights=lights)
+        r = results.get(job_key(c_hash, stage, lang)) if error is None else None
+        if error is not None:
+            row.error = error
+        elif r.ok:
+            row.cost = entry_cost(r.spirv)
+        else:
+            row.error = "; ".join(r.errors())
+        rows.append(row)
+        if gpu is not None and not row.error:
+            both = {st: results.get(job_key(c_hash, st, lang)) for st in ("vert", "frag")}
+            if all(x is not None and x.ok for x in both.values()):
+                pairs.append((row, (f"{c_hash}.{lang}", {st: x.spirv for st, x in both.items()}), None))
+
     for h, perm in sorted(scene.permutations.items()):
         course = course_figure(perm, lib)
         for stage in ("frag", "vert"):
             for lang in languages:
-                row = Row("permutation", h, stage, lang, stage, perm.canonical(), course=course,
-                          objects=tuple(scene.users.get(h, [])), lights=len(perm.lights))
-                if h in errors:
-                    row.error = "; ".join(errors[h])
-                else:
-                    r = results[job_key(h, stage, lang)]
-                    if r.ok:
-                        row.cost = entry_cost(r.spirv)
-                    else:
-                        row.error = "; ".join(r.errors())
-                rows.append(row)
+                row_of("permutation", h, perm.canonical(), stage, lang, h, course, tuple(scene.users.get(h, [])),
+                       len(perm.lights), "; ".join(errors[h]) if h in errors else None)
+    perms = [scene.permutations[h] for h in sorted(scene.permutations) if h not in errors]
+    if perms:  # the scene's ubershader: one shader for every permutation (NOTES.md, "Ubershader")
+        try:
+            uber, _ = compose_ubershader(perms, lib, languages)
+            jobs = [CompileJob(job_key("ubershader", src.stage, src.language), src.language, src.stage, src.text,
+                               line_map=tuple(src.line_map)) for src in uber.sources]
+            results.update(compile_many(jobs, optimize=True, validate=True, progress=show_progress()))
+            failed = None
+        except (SourceError, SpecError) as e:
+            failed = str(e)
+        key = f"ubershader of {len(perms)} permutations"
+        for stage in ("frag", "vert"):
+            for lang in languages:
+                row_of("ubershader", "ubershader", key, stage, lang, "ubershader", error=failed)
+    if gpu is not None:
+        _attach_gpu(gpu, pairs)
     return rows
 
 

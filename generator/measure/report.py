@@ -156,8 +156,11 @@ LEGEND = [
 ]
 
 
-def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = None) -> str:
-    """The report as Markdown (per-permutation rows, or per-brick and model rows)."""
+def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = None, gpu=None) -> str:
+    """The report as Markdown (per-permutation rows, or per-brick and model rows); gpu: the
+    measure.gpu.GpuRequest that added RADV's figures, or None."""
+    from . import gpu as radv
+
     out = [f"# {title}", "", *LEGEND, ""]
     groups = group(rows)
     head = [h for h, _ in MD_COLUMNS]
@@ -170,6 +173,10 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
             lines.append([f"`{subject}`", ", ".join(r.objects), stage, *_metric_cells(by_lang),
                           _course_cell(r, per_light=True) if stage == "frag" else ""])
         out += _md_table(["permutation", "objects", "stage", *head, "course tex / ALU"], lines)
+        uber = [(k, v) for k, v in groups.items() if k[0] == "ubershader"]
+        if uber:
+            out += ["", "The scene's ubershader (every permutation in one shader; NOTES.md, \"Ubershader\"):", ""]
+            out += _md_table(["shader", "stage", *head], [[f"`{k[1]}`", k[2], *_metric_cells(v)] for k, v in uber])
         out += ["", "Permutation keys:", ""]
         seen = []
         for (_, subject, _, measured), _ in perm:
@@ -200,6 +207,7 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
                 lines.append([m.name, m.form, fig.table, f"`{m.spec}`" if m.spec and match else "",
                               str(fig.texture), fig.alu, *ours])
         out += _md_table(["model", "form", "table", "measured", "course tex", "course ALU", *head], lines) + [""]
+    out += radv.markdown(rows, groups, gpu)
     diffs = differences(rows)
     if diffs:
         out += ["## Where the languages differ", ""]
@@ -233,22 +241,26 @@ def _flat(r: Row) -> dict:
 
 
 def to_csv(rows: list[Row]) -> str:
-    """One line per subject and language."""
+    """One line per subject and language (and RADV's figures as gpu_<family>_<statistic> columns)."""
+    from . import gpu as radv
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=CSV_FIELDS, lineterminator="\n")
+    w = csv.DictWriter(buf, fieldnames=CSV_FIELDS + radv.csv_fields(rows), lineterminator="\n")
     w.writeheader()
     for r in rows:
-        d = _flat(r)
+        d = _flat(r) | radv.csv_values(r)
         d["objects"] = " ".join(d["objects"] or [])
         w.writerow({k: ("" if v is None else v) for k, v in d.items()})
     return buf.getvalue()
 
 
-def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = None) -> str:
-    """Rows (with opcode histograms), the language differences and their explanations."""
+def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = None, gpu=None) -> str:
+    """Rows (with opcode histograms and RADV's figures), the language differences and their explanations."""
+    from . import gpu as radv
     out_rows = []
     for r in rows:
         d = _flat(r)
+        if r.gpu:
+            d["gpu"] = r.gpu
         if r.cost is not None:
             d["opcodes"] = r.cost.as_dict()["opcodes"]
             d["loads_by_storage"] = r.cost.as_dict()["loads_by_storage"]
@@ -256,6 +268,12 @@ def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = No
     doc = {"generator": f"shadermatrix {__version__}", "tools": tool_versions(), "subject": subject,
            "languages": list(REPORT_LANGUAGES), "rows": out_rows, "differences": differences(rows),
            "explanations": _explanation_texts()}
+    if gpu is not None:
+        groups = group(rows)
+        families = radv.families_of(rows)
+        doc["gpu"] = {"families": list(gpu.families), "devices": gpu.devices or {}, "note": gpu.note or None,
+                      "errors": gpu.errors or {}, "ubershader_load": radv.uber_load(groups, families),
+                      "estimate_check": radv.estimate_check(rows, families)}
     if models is not None:
         doc["course"] = [{"model": m.name, "form": m.form, "spec": m.spec or None, "requires": list(m.requires),
                           "tables": {f.table: {"texture": f.texture, "alu": f.alu} for f in (m.invariant, m.variant)}}

@@ -75,6 +75,7 @@ class Result:
 
     stats: dict[str, dict[str, dict[str, dict[str, float]]]] = field(default_factory=dict)
     errors: dict[str, str] = field(default_factory=dict)
+    devices: dict[str, str] = field(default_factory=dict)  # family -> "Null hardware (RADV NAVI21), Mesa 25.0.7"
 
     def of(self, family: str, key: str, stage: str) -> dict[str, float] | None:
         return self.stats.get(family, {}).get(key, {}).get(stage)
@@ -149,11 +150,11 @@ def statistics(jobs, families=DEFAULT_FAMILIES, ir_dir=None) -> Result:
 
         result = Result()
         with ThreadPoolExecutor(max_workers=max(1, min(len(families), os.cpu_count() or 1))) as pool:
-            for family, stats, error in pool.map(one, families):
+            for family, got, error in pool.map(one, families):
                 if error:
                     result.errors[family] = error
                 else:
-                    result.stats[family] = stats
+                    result.stats[family], result.devices[family] = got["stats"], got["device"]
     return result
 
 
@@ -245,8 +246,8 @@ def _worker(request: Path, out: Path, ir_dir: Path | None) -> int:
     from ..io import atomic_write
 
     device = Device(prefer="Null hardware", compile_only=True)
-    flags = CAPTURE_STATISTICS | (CAPTURE_IR if ir_dir is not None else 0)
     results = {}
+    flags = CAPTURE_STATISTICS | (CAPTURE_IR if ir_dir is not None else 0)
     try:
         target = RenderPassOnly(device)
         for job in json.loads(request.read_text()):
@@ -268,7 +269,9 @@ def _worker(request: Path, out: Path, ir_dir: Path | None) -> int:
                 atomic_write(Path(ir_dir) / f"{job['key']}.{stage}.txt", text.encode())
     finally:
         device.close()
-    atomic_write(out, json.dumps(results, sort_keys=True).encode())
+    v = int(device.properties.driverVersion)  # Mesa encodes its version as VK_MAKE_VERSION
+    name = f"{device.name}, Mesa {v >> 22}.{(v >> 12) & 0x3FF}.{v & 0xFFF}"
+    atomic_write(out, json.dumps({"device": name, "stats": results}, sort_keys=True).encode())
     return 0
 
 

@@ -13,6 +13,11 @@ def add_arguments(p) -> None:
     p.add_argument("--brick-dir", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
     p.add_argument("--format", choices=("md", "csv", "json"), default="md", help="output format (default md)")
+    p.add_argument("--gpu", nargs="?", const="default", metavar="FAMILIES",
+                   help="add AMD compiler statistics from Mesa RADV's null device (no GPU needed) for these "
+                        "comma-separated families; alone: polaris10,navi21,vangogh,navi31")
+    p.add_argument("--gpu-ir", metavar="DIR",
+                   help="with --gpu: save each shader's NIR, ACO IR and disassembly as DIR/<family>/<key>.<stage>.txt")
 
 
 def run(args) -> int:
@@ -23,24 +28,41 @@ def run(args) -> int:
     from ...measure.plans import brick_rows, course_models, load_cost_library, scene_rows
     from ...measure.report import markdown, to_csv, to_json
 
+    gpu = None
+    if args.gpu is not None:
+        from ...measure.gpu import GpuRequest
+        from ...runtime.gpu_stats import DEFAULT_FAMILIES, check_families
+        try:
+            families = check_families(DEFAULT_FAMILIES if args.gpu == "default" else args.gpu.split(","))
+        except ValueError as e:
+            print(f"error: --gpu {args.gpu}: {e}", file=sys.stderr)
+            return 2
+        gpu = GpuRequest(families, args.gpu_ir)
+    elif args.gpu_ir:
+        print("error: --gpu-ir needs --gpu — e.g. `--gpu navi21 --gpu-ir out/isa`", file=sys.stderr)
+        return 2
     models = None
     if args.bricks:
-        rows = brick_rows(load_cost_library(args.brick_dir))
+        rows = brick_rows(load_cost_library(args.brick_dir), gpu=gpu)
         subject, title, models = "bricks", "Costs per brick", course_models()[0]
     else:
         from ...library.bricks import load_library
         from ...matrix.scene import load_scene
         lib = load_library(args.brick_dir)
         scene = load_scene(args.scene, lib)
-        rows = scene_rows(scene, lib)
+        rows = scene_rows(scene, lib, gpu=gpu)
         subject, title = scene.name, f"Costs of scene {scene.name}"
     if args.format == "md":
-        sys.stdout.write(markdown(rows, title, models))
+        sys.stdout.write(markdown(rows, title, models, gpu))
     elif args.format == "csv":
         sys.stdout.write(to_csv(rows))
     else:
-        sys.stdout.write(to_json(rows, subject, models))
+        sys.stdout.write(to_json(rows, subject, models, gpu))
+    if gpu is not None and gpu.note:  # the columns are absent: say why, in one line
+        print(f"note: {gpu.note}", file=sys.stderr)
+    for why in sorted((gpu.errors or {}).values()) if gpu is not None else ():
+        print(f"error: {why}", file=sys.stderr)
     failed = sorted({f"{r.subject} ({r.language}): {r.error}" for r in rows if r.error})
     for f in failed:
         print(f"error: {f}", file=sys.stderr)
-    return 1 if failed else 0
+    return 1 if failed or (gpu is not None and gpu.errors) else 0
