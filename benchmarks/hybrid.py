@@ -80,6 +80,8 @@ def cold_and_persisted(scene, lib, size, tmp: Path, repeats: int) -> dict:
             d = tmp / f"cold-{key(mode, ids)}-{r}"
             runs[key(mode, ids)]["cold"].append(render_scene(scene, lib, mode, 1, d, size, uber_ids=ids))
             runs[key(mode, ids)]["persisted"].append(render_scene(scene, lib, mode, 1, d, size, uber_ids=ids))
+    missing = [k for k, v in runs.items() for reps in v.values() for x in reps if x.shader_cache_misses is None]
+    assert not missing, f"Mesa printed no shader-cache statistics for {missing} (MESA_SHADER_CACHE_SHOW_STATS)"
     out = {}
     for k, v in runs.items():
         out[k] = {}
@@ -87,8 +89,8 @@ def cold_and_persisted(scene, lib, size, tmp: Path, repeats: int) -> dict:
             out[k][when] = {
                 "time_to_first_frame_ms": statistics.median(x.time_to_first_frame_ms for x in reps),
                 "pipeline_create_ms": statistics.median(statistics.median(x.pipeline_create_ms) for x in reps),
-                "shader_cache_hits": statistics.median(x.shader_cache_hits or 0 for x in reps),
-                "shader_cache_misses": statistics.median(x.shader_cache_misses or 0 for x in reps),
+                "shader_cache_hits": statistics.median(x.shader_cache_hits for x in reps),
+                "shader_cache_misses": statistics.median(x.shader_cache_misses for x in reps),
                 "pipeline_cache_hits": max(x.pipeline_cache_hits for x in reps)}
     return out
 

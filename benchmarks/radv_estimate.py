@@ -9,8 +9,9 @@ and the worst misprediction; a scatter plot per family.
 
     .venv/bin/python benchmarks/radv_estimate.py
 
-writes benchmarks/results/radv_estimate.md, radv_estimate.json and radv_estimate.png. Counts, not
-times: the figures are the same on every run.
+writes benchmarks/results/radv_estimate.md, radv_estimate.json and radv_estimate.png, and the
+example scene's `shadermatrix costs --gpu` report as costs_example_gpu.md (the source of README's
+ubershader table). Counts, not times: the figures are the same on every run.
 """
 from __future__ import annotations
 
@@ -31,8 +32,9 @@ from generator.compose import compose_eval  # noqa: E402
 from generator.library.bricks import load_library  # noqa: E402
 from generator.library.kinds import BRDF_KINDS  # noqa: E402
 from generator.matrix.scene import load_scene  # noqa: E402
-from generator.measure.gpu import GpuRequest, estimate_check, spearman  # noqa: E402
+from generator.measure.gpu import GpuRequest, estimate_check, spearman, uber_load  # noqa: E402
 from generator.measure.plans import scene_rows  # noqa: E402
+from generator.measure.report import group, markdown  # noqa: E402
 from generator.runtime.gpu_stats import DEFAULT_FAMILIES, Job, statistics  # noqa: E402
 from generator.toolchain import CompileJob, compile_many  # noqa: E402
 
@@ -102,9 +104,12 @@ def main() -> int:
     lib = load_library()
     families = DEFAULT_FAMILIES
     request = GpuRequest(families)
-    scene = [r for r in scene_rows(load_scene(REPO / "scenes" / "example.toml", lib), lib, gpu=request)
-             if r.gpu and not r.error]
+    example = load_scene(REPO / "scenes" / "example.toml", lib)
+    all_scene = scene_rows(example, lib, gpu=request)
     assert not request.note and not request.errors, (request.note, request.errors)
+    (RESULTS / "costs_example_gpu.md").write_text(markdown(all_scene, f"Costs of scene {example.name}", None,
+                                                           request))
+    scene = [r for r in all_scene if r.gpu and not r.error]
     kernels = kernel_rows(lib, families)
     rows = scene + kernels
     check = estimate_check(rows, families)
@@ -118,7 +123,17 @@ def main() -> int:
                           for f in families},
            "estimate_range": [min(r.cost.registers for r in rows), max(r.cost.registers for r in rows)],
            "instructions_spearman": {f: spearman([r.cost.instructions for r in rows],
-                                                 [r.gpu[f]["Instructions"] for r in rows]) for f in families}}
+                                                 [r.gpu[f]["Instructions"] for r in rows]) for f in families},
+           # per kind of shader: the estimate's range and RADV's VGPR range over the families
+           "by_stage": {st: {"estimate": [min(r.cost.registers for r in rs), max(r.cost.registers for r in rs)],
+                             "vgprs": [min(r.gpu[f]["VGPRs"] for r in rs for f in families),
+                                       max(r.gpu[f]["VGPRs"] for r in rs for f in families)]}
+                        for st in ("comp", "frag", "vert") if (rs := [r for r in rows if r.stage == st])},
+           "ubershader": uber_load(group(all_scene), families),
+           "ubershader_latency_ratio": {
+               f: max(r.gpu[f]["Latency"] for r in scene if r.table == "ubershader" and r.stage == "frag")
+               / max(r.gpu[f]["Latency"] for r in scene if r.table == "permutation" and r.stage == "frag")
+               for f in families}}
     (RESULTS / "radv_estimate.json").write_text(json.dumps(out, indent=2, sort_keys=True) + "\n")
     plot(rows, families, RESULTS / "radv_estimate.png")
     md = [f"# The SPIR-V register estimate against RADV's VGPRs ({len(rows)} shaders)", "",
@@ -136,8 +151,14 @@ def main() -> int:
                   f"{c['intercept']:.1f} | {out['vgpr_range'][f][0]}–{out['vgpr_range'][f][1]} | "
                   f"`{w['subject']}` {w['stage']} {w['language']}: estimate {w['estimate']}, {w['vgprs']} VGPRs, "
                   f"line {w['predicted']:.0f} | {out['instructions_spearman'][f]:.2f} |")
+    kinds = {"comp": "eval kernels", "frag": "fragment shaders", "vert": "vertex shaders"}
     md += ["", f"Estimates range over {out['estimate_range'][0]}–{out['estimate_range'][1]} live scalars; "
-           f"spilled registers in all {len(rows) * len(families)} compiles: {spills}.", "",
+           f"spilled registers in all {len(rows) * len(families)} compiles: {spills}. By kind: "
+           + "; ".join(f"{kinds[st]}: estimate {v['estimate'][0]}–{v['estimate'][1]}, "
+                       f"{v['vgprs'][0]}–{v['vgprs'][1]} VGPRs" for st, v in out["by_stage"].items()) + ". "
+           "The scene's ubershader fragment shader against its worst specialized one, in ACO's latency "
+           "estimate: " + ", ".join(f"{f} {x:.1f}×" for f, x in out["ubershader_latency_ratio"].items())
+           + " (the whole report: [costs_example_gpu.md](costs_example_gpu.md)).", "",
            "![estimate against RADV VGPRs](radv_estimate.png)", ""]
     (RESULTS / "radv_estimate.md").write_text("\n".join(md))
     print("\n".join(md))

@@ -12,10 +12,19 @@ import sys
 import tempfile
 from pathlib import Path
 
-# The process's umask, read once at import (os.umask both sets and returns it): mkstemp creates
-# files 0600, and an artifact must get the ordinary permissions every other file gets.
-_UMASK = os.umask(0o022)
-os.umask(_UMASK)
+def _umask() -> int:
+    """The process's umask now: Linux reports it in /proc/self/status; elsewhere os.umask sets and
+    returns it (restored at once). mkstemp creates files 0600; an artifact gets what open() would give."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def sha256(data: bytes) -> str:
@@ -33,7 +42,7 @@ def atomic_write(path: Path, data: bytes) -> bool:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        os.fchmod(fd, 0o666 & ~_UMASK)
+        os.fchmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as f:
             f.write(data)
             f.flush()

@@ -12,9 +12,12 @@ APT_PKGS=(
   "glslang-tools=12.0.0-2"                 # glslangValidator (HLSL front end, version reporting)
   "spirv-tools=2023.1-2"                   # spirv-val, spirv-opt, spirv-as, spirv-dis
 )
-# Mesa from bookworm-backports, pinned: lavapipe 25 keeps pipelines in its VkPipelineCache
-# (Mesa 22.3's lavapipe stores only the 32-byte header, so a persisted cache was never hit)
-# and RADV's null device. The libdrm and gallium versions are the ones that Mesa needs.
+# Mesa from bookworm-backports, pinned: its shader disk cache reports hits and misses
+# (MESA_SHADER_CACHE_SHOW_STATS; Mesa 22.3 cannot), which is how a render shows that it was served
+# from its persisted cache (lavapipe's VkPipelineCache stays empty in both). The libdrm and
+# gallium versions are the ones this Mesa needs. bookworm-backports keeps only its latest upload:
+# when these versions are gone, set-up says so; bump them to what `apt-cache policy
+# mesa-vulkan-drivers` offers from bookworm-backports (and the versions in pyproject.toml, README).
 BPO_PKGS=(
   "mesa-vulkan-drivers=25.0.7-2~bpo12+1"   # lavapipe (software Vulkan 1.4) and RADV
   "mesa-libgallium=25.0.7-2~bpo12+1"
@@ -47,8 +50,13 @@ if ((${#missing[@]} + ${#missing_bpo[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   ((${#missing[@]} == 0)) || apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-  ((${#missing_bpo[@]} == 0)) ||
-    apt-get install -y -qq --no-install-recommends --allow-downgrades -t bookworm-backports "${missing_bpo[@]}" >/dev/null
+  if ((${#missing_bpo[@]})) &&
+     ! apt-get install -y -qq --no-install-recommends --allow-downgrades -t bookworm-backports \
+       "${missing_bpo[@]}" >/dev/null; then
+    echo "setup: could not install ${missing_bpo[*]} from bookworm-backports — if a newer upload replaced" \
+         "them, bump BPO_PKGS in scripts/setup.sh to what \`apt-cache policy mesa-vulkan-drivers\` lists" >&2
+    exit 1
+  fi
 fi
 
 # naga (WGSL front end + validator), pinned, from crates.io into .tools/bin

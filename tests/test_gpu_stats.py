@@ -53,10 +53,16 @@ def _spirv(text):
     return r.spirv
 
 
-def test_a_fixed_kernel_has_plausible_statistics_and_a_bigger_one_needs_more_registers(radv, tmp_path):
-    jobs = [radv.Job("small", (("comp", _spirv(SMALL)),)), radv.Job("big", (("comp", _spirv(BIG)),))]
-    res = radv.statistics(jobs, ("polaris10", "navi21"), ir_dir=tmp_path)
+def test_a_fixed_kernel_has_plausible_statistics_and_a_bigger_one_needs_more_registers(radv, tmp_path,
+                                                                                      monkeypatch):
+    odd = SMALL.replace("set = 0, binding = 1", "set = 1, binding = 0")  # not a layout a compute job binds
+    jobs = [radv.Job("small", (("comp", _spirv(SMALL)),)), radv.Job("big", (("comp", _spirv(BIG)),)),
+            radv.Job("odd", (("comp", _spirv(odd)),))]
+    monkeypatch.chdir(tmp_path)
+    res = radv.statistics(jobs, ("polaris10", "navi21"), ir_dir="isa")  # relative to here, not to the worker
     assert res.errors == {}
+    assert set(res.failed["odd"]) == {"polaris10", "navi21"} and "set 0" in res.failed["odd"]["navi21"]
+    tmp_path = tmp_path / "isa"
     for family in ("polaris10", "navi21"):
         assert res.devices[family].startswith(f"Null hardware (RADV {family.upper()})")
         small, big = res.of(family, "small", "comp"), res.of(family, "big", "comp")

@@ -40,7 +40,7 @@ def attach(request: GpuRequest, rows, units: dict[str, dict[str, bytes]], subtra
 
     rows: (row, with_key, without_key or None) triples; a row gets the statistics of its stage for
     with_key, minus those of without_key when it has one. Leaves ``gpu`` unset and sets
-    ``request.note`` when RADV cannot be used.
+    ``request.note`` when RADV cannot be used; a shader RADV cannot take is in ``request.errors``.
     """
     jobs = [Job(key, tuple(sorted(stages.items(), key=lambda s: ("vert", "frag", "comp").index(s[0]))))
             for key, stages in sorted(units.items())]
@@ -50,6 +50,9 @@ def attach(request: GpuRequest, rows, units: dict[str, dict[str, bytes]], subtra
         request.note = f"no AMD compiler statistics: {e}"
         return
     request.errors, request.devices = dict(result.errors), dict(result.devices)
+    for key, by_family in sorted(result.failed.items()):  # a shader RADV could not take: its rows say so
+        for family, why in sorted(by_family.items()):
+            request.errors[f"{family}/{key}"] = f"RADV {family}: {key}: {why}"
     for row, with_key, without_key in rows:
         gpu = {}
         for family in request.families:
@@ -76,11 +79,12 @@ def _ranks(x: np.ndarray) -> np.ndarray:
     return ranks
 
 
-def spearman(x, y) -> float:
+def spearman(x, y) -> float | None:
+    """Spearman's rank correlation; None when either side is constant (no ranking to compare)."""
     x, y = np.asarray(x, float), np.asarray(y, float)
     rx, ry = _ranks(x), _ranks(y)
     if rx.std() == 0 or ry.std() == 0:
-        return float("nan")
+        return None
     return float(np.corrcoef(rx, ry)[0, 1])
 
 
@@ -236,7 +240,7 @@ def _estimate_section(rows, families) -> list[str]:
     check = estimate_check(rows, families)
     if not check:
         return []
-    lines = [[f, str(c["n"]), f"{c['spearman']:.2f}", f"{c['slope']:.2f} × estimate + {c['intercept']:.1f}",
+    lines = [[f, str(c["n"]), "–" if c["spearman"] is None else f"{c['spearman']:.2f}", f"{c['slope']:.2f} × estimate + {c['intercept']:.1f}",
               f"`{c['worst']['subject']}` {c['worst']['stage']} {c['worst']['language']}: estimate "
               f"{c['worst']['estimate']}, RADV {c['worst']['vgprs']} VGPRs, line says {c['worst']['predicted']:.0f}"]
              for f, c in check.items()]

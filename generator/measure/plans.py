@@ -320,7 +320,9 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None) -> list[Row]:
                 row.cost = with_ - without
             rows.append(row)
             if gpu is not None and not row.error:
-                pairs.append((row, batch.spirv(p.with_unit, lang), batch.spirv(p.without_unit, lang)))
+                measured, baseline = batch.spirv(p.with_unit, lang), batch.spirv(p.without_unit, lang)
+                if measured is not None and baseline is not None:  # a difference needs both; never a raw value
+                    pairs.append((row, measured, baseline))
     if gpu is not None:
         _attach_gpu(gpu, pairs)
     return rows
@@ -332,8 +334,6 @@ def _attach_gpu(gpu, pairs) -> None:
 
     units, triples = {}, []
     for row, with_, without in pairs:
-        if with_ is None:
-            continue
         units[with_[0]] = with_[1]
         if without is not None:
             units[without[0]] = without[1]

@@ -278,4 +278,4 @@ def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = No
         doc["course"] = [{"model": m.name, "form": m.form, "spec": m.spec or None, "requires": list(m.requires),
                           "tables": {f.table: {"texture": f.texture, "alu": f.alu} for f in (m.invariant, m.variant)}}
                          for m in models]
-    return json.dumps(doc, indent=2) + "\n"
+    return json.dumps(doc, indent=2, allow_nan=False) + "\n"

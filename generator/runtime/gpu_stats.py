@@ -20,7 +20,8 @@ pipelines their set 0. Statistics are keyed by the stage each executable compile
 The families (Mesa 25.0 names; `KNOWN_FAMILIES` were each tried here): DEFAULT_FAMILIES are what
 engines ship to — polaris10 (GCN4: the generation of PS4 Pro and Xbox One X), navi21 (RDNA2: the
 generation of PS5 and Xbox Series), vangogh (RDNA2: Steam Deck), navi31 (RDNA3: current PC parts
-and, as phoenix, ROG Ally-class handhelds). Mesa 22.3 called RDNA3 "gfx1100"; 25.0 does not.
+and, as phoenix, ROG Ally-class handhelds). Mesa 22.3 called RDNA3 "gfx1100"; 25.0 does not
+(the null device itself is older than both).
 """
 from __future__ import annotations
 
@@ -76,6 +77,7 @@ class Result:
     stats: dict[str, dict[str, dict[str, dict[str, float]]]] = field(default_factory=dict)
     errors: dict[str, str] = field(default_factory=dict)
     devices: dict[str, str] = field(default_factory=dict)  # family -> "Null hardware (RADV NAVI21), Mesa 25.0.7"
+    failed: dict[str, dict[str, str]] = field(default_factory=dict)  # job key -> {family: why it did not compile}
 
     def of(self, family: str, key: str, stage: str) -> dict[str, float] | None:
         return self.stats.get(family, {}).get(key, {}).get(stage)
@@ -127,6 +129,7 @@ def statistics(jobs, families=DEFAULT_FAMILIES, ir_dir=None) -> Result:
         raise GpuStatsUnavailable(why)
     families = check_families(families)
     jobs = list(jobs)
+    ir_dir = None if ir_dir is None else Path(ir_dir).resolve()  # the worker runs in the repository
     with tempfile.TemporaryDirectory(prefix="shadermatrix-radv-") as tmp:
         request = Path(tmp) / "jobs.json"
         request.write_text(json.dumps([j.as_json() for j in jobs]))
@@ -134,7 +137,9 @@ def statistics(jobs, families=DEFAULT_FAMILIES, ir_dir=None) -> Result:
         def one(family):
             out = Path(tmp) / f"{family}.json"
             env = {k: v for k, v in os.environ.items() if not k.startswith(("VK_", "RADV_", "MESA_"))}
-            env.update(VK_ICD_FILENAMES=radv_icd(), RADV_FORCE_FAMILY=family)
+            # RADV's own shader cache stays off: nothing is written to the user's ~/.cache, and every
+            # figure comes from a compile of this run
+            env.update(VK_ICD_FILENAMES=radv_icd(), RADV_FORCE_FAMILY=family, MESA_SHADER_CACHE_DISABLE="true")
             argv = [sys.executable, "-m", "generator.runtime.gpu_stats", str(request), str(out)]
             if ir_dir is not None:
                 argv.append(str(Path(ir_dir) / family))
@@ -155,6 +160,8 @@ def statistics(jobs, families=DEFAULT_FAMILIES, ir_dir=None) -> Result:
                     result.errors[family] = error
                 else:
                     result.stats[family], result.devices[family] = got["stats"], got["device"]
+                    for key, why in got["errors"].items():
+                        result.failed.setdefault(key, {})[family] = why
     return result
 
 
@@ -183,6 +190,9 @@ def _vertex_inputs(vert: bytes):
     from ..analysis.reflect import reflect
 
     ep = reflect(vert).entry("vert")
+    bad = [f"{v.name or v.location}: {v.type}" for v in ep.inputs if v.type not in _VERTEX_FORMATS]
+    if bad:
+        raise ValueError(f"vertex inputs of a type the renderer does not bind ({', '.join(bad)}): float vectors only")
     return [SimpleNamespace(location=v.location, name=v.name or f"in{v.location}", format=_VERTEX_FORMATS[v.type])
             for v in ep.inputs]
 
@@ -238,40 +248,52 @@ def _internal_representations(device, pipeline, index: int) -> str:
     return "\n".join(parts)
 
 
-def _worker(request: Path, out: Path, ir_dir: Path | None) -> int:
+def _one(device, target, job: dict, flags: int) -> tuple[dict, dict]:
+    """Create one job's pipeline with statistics captured; ({stage: statistics}, {stage: IR text})."""
     from .compute import ComputePipeline
-    from .device import Device
     from .graphics import GraphicsPipeline
+
+    stages = {s: base64.b64decode(b) for s, b in job["stages"]}
+    spec = {int(k): int(v) for k, v in job["specialization"]} or None
+    if "comp" in stages:
+        sets = _layouts([stages["comp"]])
+        binding = sets.get(0, {})
+        if set(sets) - {0} or sorted(binding) != list(range(len(binding))):
+            raise ValueError(f"a compute job binds set 0, bindings 0 … n-1 (got {sets})")
+        p = ComputePipeline(device, stages["comp"], tuple(binding[b] for b in sorted(binding)),
+                            specialization=spec, flags=flags)
+    else:
+        p = GraphicsPipeline(device, target, stages["vert"], stages["frag"], _vertex_inputs(stages["vert"]),
+                             _layouts([stages["vert"], stages["frag"]]), specialization=spec, flags=flags)
+    try:
+        return _read(device, p.handle, bool(flags & CAPTURE_IR))
+    finally:
+        p.destroy()
+
+
+def _worker(request: Path, out: Path, ir_dir: Path | None) -> int:
+    from .device import Device
     from .rendertarget import RenderPassOnly
     from ..io import atomic_write
 
     device = Device(prefer="Null hardware", compile_only=True)
-    results = {}
+    results, errors = {}, {}
     flags = CAPTURE_STATISTICS | (CAPTURE_IR if ir_dir is not None else 0)
     try:
         target = RenderPassOnly(device)
         for job in json.loads(request.read_text()):
-            stages = {s: base64.b64decode(b) for s, b in job["stages"]}
-            spec = {int(k): int(v) for k, v in job["specialization"]} or None
-            if "comp" in stages:
-                sets = _layouts([stages["comp"]])
-                binding = sets.get(0, {})
-                if set(sets) - {0} or sorted(binding) != list(range(len(binding))):
-                    raise ValueError(f"{job['key']}: a compute job binds set 0, bindings 0 … n-1 (got {sets})")
-                p = ComputePipeline(device, stages["comp"], tuple(binding[b] for b in sorted(binding)),
-                                    specialization=spec, flags=flags)
-            else:
-                p = GraphicsPipeline(device, target, stages["vert"], stages["frag"], _vertex_inputs(stages["vert"]),
-                                     _layouts([stages["vert"], stages["frag"]]), specialization=spec, flags=flags)
-            results[job["key"]], ir = _read(device, p.handle, ir_dir is not None)
-            p.destroy()
+            try:  # one shader that cannot be made into a pipeline costs its own figures, not the family's
+                results[job["key"]], ir = _one(device, target, job, flags)
+            except Exception as e:  # noqa: BLE001 — reported per job, in one line
+                errors[job["key"]] = f"{type(e).__name__}: {e}".splitlines()[0]
+                continue
             for stage, text in ir.items():
                 atomic_write(Path(ir_dir) / f"{job['key']}.{stage}.txt", text.encode())
     finally:
         device.close()
     v = int(device.properties.driverVersion)  # Mesa encodes its version as VK_MAKE_VERSION
     name = f"{device.name}, Mesa {v >> 22}.{(v >> 12) & 0x3FF}.{v & 0xFFF}"
-    atomic_write(out, json.dumps({"device": name, "stats": results}, sort_keys=True).encode())
+    atomic_write(out, json.dumps({"device": name, "stats": results, "errors": errors}, sort_keys=True).encode())
     return 0
 
 

@@ -27,7 +27,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 STATS = re.compile(rb"disk shader cache:\s+hits = (\d+), misses = (\d+)\s*\n?")
-ENV = ("MESA_SHADER_CACHE_DIR", "MESA_SHADER_CACHE_SHOW_STATS")
+ENV = ("MESA_SHADER_CACHE_DIR", "MESA_SHADER_CACHE_SHOW_STATS", "MESA_SHADER_CACHE_DISABLE")
 
 
 @contextmanager
@@ -42,6 +42,7 @@ def opened(directory):
     saved = {k: os.environ.get(k) for k in ENV}
     os.environ["MESA_SHADER_CACHE_DIR"] = str(directory.resolve())
     os.environ["MESA_SHADER_CACHE_SHOW_STATS"] = "true"
+    os.environ["MESA_SHADER_CACHE_DISABLE"] = "false"  # a user's "disable" would make every count vanish
     try:
         yield
     finally:
@@ -61,7 +62,12 @@ def closed(close) -> tuple[int, int] | None:
     libc = ctypes.CDLL(None)
     sys.stdout.flush()
     libc.fflush(None)
-    saved = os.dup(1)
+    try:
+        saved = os.dup(1)
+    except OSError:  # no standard output to borrow (closed): tear down without counting
+        close()
+        return None
+    text = b""
     with tempfile.TemporaryFile() as tmp:
         os.dup2(tmp.fileno(), 1)
         try:
@@ -70,12 +76,12 @@ def closed(close) -> tuple[int, int] | None:
             libc.fflush(None)
             os.dup2(saved, 1)
             os.close(saved)
-        tmp.seek(0)
-        text = tmp.read()
+            tmp.seek(0)
+            text = tmp.read()
+            rest = STATS.sub(b"", text)
+            if rest:  # whatever else was printed meanwhile is not ours to swallow, even when close() failed
+                out = getattr(sys.stdout, "buffer", None)
+                out.write(rest) if out is not None else sys.stdout.write(rest.decode(errors="replace"))
+                sys.stdout.flush()
     found = STATS.search(text)
-    rest = STATS.sub(b"", text)
-    if rest:  # whatever else was printed meanwhile is not ours to swallow
-        out = getattr(sys.stdout, "buffer", None)
-        out.write(rest) if out is not None else sys.stdout.write(rest.decode(errors="replace"))
-        sys.stdout.flush()
     return (int(found[1]), int(found[2])) if found else None

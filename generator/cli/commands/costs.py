@@ -32,6 +32,10 @@ def run(args) -> int:
     if args.gpu is not None:
         from ...measure.gpu import GpuRequest
         from ...runtime.gpu_stats import DEFAULT_FAMILIES, check_families
+        if "/" in args.gpu or args.gpu.endswith(".toml"):  # `costs --gpu SCENE`: the scene taken for families
+            print(f"error: --gpu {args.gpu}: that is a file, not AMD families — put the scene first "
+                  f"(`costs SCENE --gpu`) or write `--gpu=navi21,...`", file=sys.stderr)
+            return 2
         try:
             families = check_families(DEFAULT_FAMILIES if args.gpu == "default" else args.gpu.split(","))
         except ValueError as e:
