@@ -117,6 +117,10 @@ def test_costs_shows_radv_figures_for_the_example_beside_the_spirv_counts(radv):
     assert "### The ubershader's register load" in md and "### The SPIR-V register estimate against RADV" in md
     again = _costs(EXAMPLE, "--gpu")
     assert again.stdout == md  # ACO's figures are deterministic
+    ip = _costs(EXAMPLE, "--gpu", "polaris10,navi21,vangogh,gfx1100", "--format", "json")  # the spelling
+    assert ip.returncode == 0, ip.stderr
+    import json
+    assert json.loads(ip.stdout)["gpu"]["families"] == ["polaris10", "navi21", "vangogh", "navi31"]
     csv = _costs(EXAMPLE, "--gpu", "navi21,vangogh", "--format", "csv")
     head = csv.stdout.splitlines()[0].split(",")
     assert "gpu_navi21_vgprs" in head and "gpu_vangogh_waves_per_simd" in head and "gpu_polaris10_vgprs" not in head

@@ -20,7 +20,8 @@ pipelines their set 0. Statistics are keyed by the stage each executable compile
 The families (Mesa 25.0 names; `KNOWN_FAMILIES` were each tried here): DEFAULT_FAMILIES are what
 engines ship to — polaris10 (GCN4: the generation of PS4 Pro and Xbox One X), navi21 (RDNA2: the
 generation of PS5 and Xbox Series), vangogh (RDNA2: Steam Deck), navi31 (RDNA3: current PC parts
-and, as phoenix, ROG Ally-class handhelds). Mesa 22.3 called RDNA3 "gfx1100"; 25.0 does not
+and, as phoenix, ROG Ally-class handhelds). Mesa 22.3 called RDNA3 "gfx1100"; 25.0 does not, so
+gfx IP names are accepted as ALIASES of their family
 (the null device itself is older than both).
 """
 from __future__ import annotations
@@ -41,6 +42,9 @@ from types import SimpleNamespace
 DEFAULT_FAMILIES = ("polaris10", "navi21", "vangogh", "navi31")
 KNOWN_FAMILIES = ("bonaire", "hawaii", "polaris10", "vega10", "navi10", "navi21", "vangogh", "navi31", "navi33",
                   "phoenix", "gfx1150", "gfx1201")
+# AMD's gfx IP names (what LLVM, RGA and Mesa 22.3 used) -> the RADV family compiled for.
+ALIASES = {"gfx803": "polaris10", "gfx900": "vega10", "gfx1010": "navi10", "gfx1030": "navi21",
+           "gfx1033": "vangogh", "gfx1100": "navi31", "gfx1102": "navi33", "gfx1103": "phoenix", "gfx1200": "gfx1201"}
 ICD_GLOB = ("/usr/share/vulkan/icd.d/radeon_icd*.json", "/etc/vulkan/icd.d/radeon_icd*.json")
 CAPTURE_STATISTICS = 0x40  # VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR
 CAPTURE_IR = 0x80  # VK_PIPELINE_CREATE_CAPTURE_INTERNAL_REPRESENTATIONS_BIT_KHR
@@ -103,12 +107,14 @@ def unavailable() -> str:
 
 
 def check_families(families) -> tuple[str, ...]:
-    """The families, each a name RADV knows here; a ValueError naming the closest one otherwise."""
+    """The families, each a name RADV knows here (a gfx IP name is taken for its family: gfx1100 is navi31);
+    a ValueError naming the closest one otherwise."""
     out = []
     for f in families:
         f = f.strip().lower()
+        f = ALIASES.get(f, f)
         if f not in KNOWN_FAMILIES:
-            near = difflib.get_close_matches(f, KNOWN_FAMILIES, n=1)
+            near = difflib.get_close_matches(f, KNOWN_FAMILIES + tuple(ALIASES), n=1)
             hint = f"did you mean '{near[0]}'? " if near else ""
             raise ValueError(f"unknown AMD family '{f}' — {hint}known: {', '.join(KNOWN_FAMILIES)}")
         if f not in out:
