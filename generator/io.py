@@ -1,4 +1,4 @@
-"""Atomic, change-only file writes (the start of the content-addressed store), and progress policy.
+"""Atomic, change-only file writes, the content-addressed store (Store), and progress policy.
 
 Every artifact is written to a temporary name in its directory and renamed, so
 an interrupted or failed build never leaves a half-written file and never
@@ -7,9 +7,11 @@ damages what an earlier build produced.
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import sys
 import tempfile
+import threading
 from pathlib import Path
 
 def _umask() -> int:
@@ -60,3 +62,87 @@ def atomic_write(path: Path, data: bytes) -> bool:
 def show_progress() -> bool:
     """Progress bars on a terminal, quiet in CI and in pipes."""
     return sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")
+
+
+# ------------------------------------------------------------------ the content-addressed store
+
+def content_key(*parts) -> str:
+    """sha256 of everything that determines an artifact (JSON-able parts, in order)."""
+    return sha256(json.dumps(parts, sort_keys=True, separators=(",", ":")).encode())
+
+
+def default_cache_dir() -> Path:
+    """$SHADERMATRIX_CACHE_DIR, else $XDG_CACHE_HOME/shadermatrix, else ~/.cache/shadermatrix (a per-user
+    directory, never the source tree)."""
+    if os.environ.get("SHADERMATRIX_CACHE_DIR"):
+        return Path(os.environ["SHADERMATRIX_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "shadermatrix"
+
+
+class Store:
+    """A content-addressed cache: an entry is named by the sha256 of everything that determines it.
+
+    Layout: ``<root>/<namespace>/<key[:2]>/<key>``; an entry holds its payload followed by the payload's
+    sha256 (32 bytes). Entries are written atomically (a temporary name, then a rename) and verified on
+    every read: a short or damaged entry is counted as corrupt, removed and reported as a miss, so it is
+    rebuilt, never served. Safe to share between threads and between concurrent processes (a rename
+    replaces an entry whole; two writers of one key write the same bytes).
+    """
+
+    def __init__(self, root):
+        self.root = Path(root)
+        self.hits = self.misses = self.corrupt = self.written = 0
+        self._lock = threading.Lock()
+
+    def _path(self, namespace: str, key: str) -> Path:
+        return self.root / namespace / key[:2] / key
+
+    def _count(self, what: str) -> None:
+        with self._lock:
+            setattr(self, what, getattr(self, what) + 1)
+
+    def get(self, namespace: str, key: str) -> bytes | None:
+        path = self._path(namespace, key)
+        try:
+            data = path.read_bytes()
+        except OSError:
+            self._count("misses")
+            return None
+        payload, digest = data[:-32], data[-32:]
+        if len(data) < 32 or hashlib.sha256(payload).digest() != digest:
+            self._count("corrupt")
+            self._count("misses")
+            try:
+                path.unlink()
+            except OSError:
+                pass
+            return None
+        self._count("hits")
+        return payload
+
+    def put(self, namespace: str, key: str, payload: bytes) -> None:
+        if atomic_write(self._path(namespace, key), payload + hashlib.sha256(payload).digest()):
+            self._count("written")
+
+    def entries(self) -> dict[str, tuple[int, int]]:
+        """{namespace: (entries, bytes)} of what is stored now."""
+        out = {}
+        if not self.root.is_dir():
+            return out
+        for ns in sorted(p for p in self.root.iterdir() if p.is_dir()):
+            files = [f for f in ns.glob("*/*") if f.is_file() and not f.name.startswith(".")]
+            out[ns.name] = (len(files), sum(f.stat().st_size for f in files))
+        return out
+
+    def clear(self) -> int:
+        """Remove every entry (and leftover temporary file); returns how many files went."""
+        gone = 0
+        if not self.root.is_dir():
+            return gone
+        for ns in (p for p in self.root.iterdir() if p.is_dir()):
+            for f in ns.glob("*/*"):
+                if f.is_file():
+                    f.unlink()
+                    gone += 1
+        return gone

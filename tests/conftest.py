@@ -38,6 +38,13 @@ def _require_tool_fixture():
     return require_tool
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _own_compile_cache(tmp_path_factory):
+    """Every test session starts with an empty compile cache of its own (never the user's ~/.cache):
+    `shadermatrix build` run by a test, in this process or a child, reads and fills only this one."""
+    os.environ["SHADERMATRIX_CACHE_DIR"] = str(tmp_path_factory.mktemp("compile-cache"))
+
+
 @pytest.fixture(autouse=True)
 def _test_tier(request, monkeypatch):
     """Tiers do not leak: only `toolchain` tests run external tools, only `lavapipe` ones open a device.

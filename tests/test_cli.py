@@ -255,7 +255,11 @@ def test_missing_tool_is_one_line_error(tmp_path, monkeypatch, capsys, command):
 
     np.save(tmp_path / "s.npy", np.tile([0.0, 0.0, 1.0], (4, 3)))
     monkeypatch.setattr(generator.toolchain, "find_tool", lambda name: None)
-    assert main([a.format(tmp=tmp_path) for a in command]) == 1
+    generator.toolchain.tool_versions.cache_clear()  # the versions are part of every cache key: "missing" now
+    try:
+        assert main([a.format(tmp=tmp_path) for a in command]) == 1
+    finally:
+        generator.toolchain.tool_versions.cache_clear()
     err = capsys.readouterr().err
     assert err.startswith("error: glslc not found — run `make setup`") and err.count("\n") == 1, err
 

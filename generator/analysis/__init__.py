@@ -9,14 +9,16 @@ branch count; a loop body counts once). Classes and the scalar rules are in
 """
 from __future__ import annotations
 
+import hashlib
 from collections import Counter
+from pathlib import Path
 from dataclasses import dataclass, field, fields
 
 from .classify import NOT_EXECUTED, classify, storage_class
 from .liveness import analyze_function
 from .spirv import Module, SpirvError, read
 
-__all__ = ["Cost", "analyze", "entry_cost", "SpirvError", "read"]
+__all__ = ["Cost", "analyze", "entry_cost", "cost_dict", "SpirvError", "read"]
 
 # Cost fields in report order; "alu" etc. are instruction counts, "*_scalar" scalarized counts.
 COUNT_FIELDS = ("instructions", "alu", "transcendental", "texture", "branches", "loads", "stores", "other",
@@ -131,3 +133,29 @@ def entry_cost(spirv: bytes, entry: str | None = None) -> Cost:
     if entry not in costs:
         raise SpirvError(f"no entry point '{entry}' (found: {', '.join(costs) or 'none'})")
     return costs[entry]
+
+
+# Every analysis source file: a change to a rule changes every cached figure's key.
+_RULES_HASH = hashlib.sha256(b"".join(
+    p.read_bytes() for p in sorted(Path(__file__).resolve().parent.glob("*.py")))).hexdigest()
+COST_NAMESPACE = "cost-v2"
+
+
+def cost_dict(spirv: bytes, store=None) -> dict:
+    """``entry_cost(spirv).as_dict(histograms=False)``, served from an io.Store when it holds it (keyed by the
+    SPIR-V's sha256 and the analysis rules' sources) and put there when it did not."""
+    import json
+
+    from ..io import content_key
+    key = content_key(COST_NAMESPACE, hashlib.sha256(spirv).hexdigest(), _RULES_HASH)
+    if store is not None:
+        data = store.get(COST_NAMESPACE, key)
+        if data is not None:
+            try:
+                return json.loads(data)
+            except ValueError:
+                pass
+    d = entry_cost(spirv).as_dict(histograms=False)
+    if store is not None:
+        store.put(COST_NAMESPACE, key, json.dumps(d).encode())  # in as_dict order: the manifest keeps it
+    return d

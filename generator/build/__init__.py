@@ -14,13 +14,13 @@ from pathlib import Path
 from .. import __version__
 from ..library.bricks import Library
 from ..io import atomic_write, sha256
-from ..analysis import entry_cost
+from ..analysis import cost_dict
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
 from ..compose.uber import compose_ubershader
 from ..lang import SourceError
 from ..link.uber import coverage
-from ..toolchain import CompileJob, compile_many, tool_versions
+from ..toolchain import CompileJob, CompileStats, compile_many, tool_versions
 from ..toolchain.scenes import compile_scene, job_key
 from ..link.values import uploads
 from .reflection import scene_tables
@@ -32,18 +32,23 @@ class BuildResult:
     failures: list[str] = field(default_factory=list)
     written: int = 0
     unchanged: int = 0
+    compile: CompileStats = field(default_factory=CompileStats)  # shaders: jobs, distinct, cached, compiled
+    store: object = None  # the io.Store used, or None
 
     @property
     def ok(self) -> bool:
         return not self.failures
 
 
-def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES) -> BuildResult:
-    """Build every permutation of `scene` into `out`; see the module docstring."""
-    out = Path(out)
-    composed, errors, results = compile_scene(scene, lib, languages)
+def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None) -> BuildResult:
+    """Build every permutation of `scene` into `out`; see the module docstring.
 
-    res = BuildResult(manifest={})
+    store: an io.Store (the content-addressed cache): compiled shaders and their costs are served from it
+    and put into it; None compiles everything."""
+    out = Path(out)
+    res = BuildResult(manifest={}, store=store)
+    composed, errors, results = compile_scene(scene, lib, languages, store=store, stats=res.compile)
+
     entries = []
     for h, perm in sorted(scene.permutations.items()):
         entry = {"id": perm.canonical(), "hash": h, "objects": scene.users.get(h, []), "languages": {}}
@@ -85,7 +90,7 @@ def _write(res: BuildResult, out: Path, name: str, src, r) -> tuple[dict, list[s
         _count(res, atomic_write(out / rel_src, data))
         _count(res, atomic_write(out / rel_spv, r.spirv))
         return {"source": rel_src, "source_sha256": sha256(data), "spirv": rel_spv,
-                "spirv_sha256": sha256(r.spirv), "cost": entry_cost(r.spirv).as_dict(histograms=False)}, []
+                "spirv_sha256": sha256(r.spirv), "cost": cost_dict(r.spirv, res.store)}, []
     # A source that does not compile goes beside, under its own name: an earlier
     # build's source and SPIR-V stay a matching pair.
     rel_src = f"{src.language}/{name}.{src.stage}.failed.{src.language}"
@@ -109,7 +114,7 @@ def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, languag
     problems = coverage(u, perms, lib)
     jobs = [CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
                        line_map=tuple(s.line_map)) for s in c.sources]
-    results = compile_many(jobs, optimize=True, validate=True)
+    results = compile_many(jobs, optimize=True, validate=True, store=res.store, stats=res.compile)
     entry = {"hash": c.hash, "languages": {}, "tables": u.tables(), "interface": c.interface.as_dict()}
     errs = [f"coverage: {p}" for p in problems]
     for src in c.sources:

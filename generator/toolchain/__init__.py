@@ -52,23 +52,27 @@ reports ``bricks/x.py:N: error: ...`` (no column: col 0). Lines outside any
 """
 from __future__ import annotations
 
+import base64
 import bisect
 import functools
+import hashlib
+import json
 import os
 import re
 import shutil
 import subprocess
 import tempfile
 from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Iterable
 
+from ..io import content_key
 from ..lang.errors import UserError
 from ..targets import LANGUAGES
 
-__all__ = ["Diagnostic", "CompileJob", "CompileResult", "ToolMissing",
-           "compile_many", "tool_versions", "find_tool",
+__all__ = ["Diagnostic", "CompileJob", "CompileResult", "CompileStats", "ToolMissing",
+           "compile_many", "cache_key", "tool_versions", "find_tool",
            "TARGET_ENV", "SPIRV_VERSION", "SPIRV_MAGIC"]
 
 TARGET_ENV = "vulkan1.1"      # every tool gets this target environment
@@ -391,9 +395,67 @@ def _spirv_steps(tools: dict, tmp: str, idx: int, job: CompileJob, spv: bytes,
 
 # ---------------------------------------------------------------- driver
 
+_SELF_HASH = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()  # how the tools are invoked
+COMPILE_NAMESPACE = "compile-v1"
+
+
+def _normalized(source: str) -> str:
+    """The source without its whole-line ``//`` comments (the provenance header): comments never reach
+    SPIR-V (no debug info is emitted), so shaders that differ only there compile to the same module."""
+    return "\n".join(line for line in source.split("\n") if not line.lstrip().startswith("//"))
+
+
+def cache_key(job: CompileJob, optimize: bool = True, validate: bool = True) -> str:
+    """sha256 of everything that determines a job's SPIR-V: source (comments aside), language, stage, entry
+    point, overrides, target environment, SPIR-V version, flags, generator version, the tools' exact
+    versions and this module (how they are invoked). A tool upgrade changes every key."""
+    from .. import __version__
+    return content_key(COMPILE_NAMESPACE, _normalized(job.source), job.language, job.stage, job.entry,
+                       [list(o) for o in job.overrides], TARGET_ENV, SPIRV_VERSION, optimize, validate,
+                       __version__, tool_versions(), _SELF_HASH)
+
+
+def _encode(r: CompileResult) -> bytes:
+    return json.dumps({"spirv": base64.b64encode(r.spirv).decode(),
+                       "spirv_unopt": base64.b64encode(r.spirv_unopt or b"").decode(),
+                       "diagnostics": [asdict(d) for d in r.diagnostics], "key": r.key}).encode()
+
+
+def _decode(data: bytes, key: str) -> CompileResult | None:
+    try:
+        d = json.loads(data)
+        diags = [Diagnostic(**x) for x in d["diagnostics"]]
+        spirv, unopt = base64.b64decode(d["spirv"]), base64.b64decode(d["spirv_unopt"])
+    except (ValueError, KeyError, TypeError):
+        return None
+    return _renamed(CompileResult(d["key"], True, spirv, unopt or None, diags), key)
+
+
+def _renamed(r: CompileResult, key: str) -> CompileResult:
+    """A result for another job with the same cache key: diagnostics that named the first job name this one."""
+    diags = [replace(d, path=key) if d.path == r.key else d for d in r.diagnostics]
+    return CompileResult(key, r.ok, r.spirv, r.spirv_unopt, diags)
+
+
+@dataclass
+class CompileStats:
+    """What a compile_many call did: jobs, distinct shaders, served by the store, compiled."""
+
+    jobs: int = 0
+    distinct: int = 0
+    cached: int = 0
+    compiled: int = 0
+
+
 def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate: bool = True,
-                 progress: bool = False) -> dict[str, CompileResult]:
+                 progress: bool = False, store=None, stats: CompileStats | None = None) -> dict[str, CompileResult]:
     """Compile and validate every job; returns {key: CompileResult} in input order.
+
+    Jobs with the same :func:`cache_key` are compiled once (identical shaders, e.g. vertex shaders whose
+    sources differ only in their provenance header). store: an io.Store; a job whose key is there is
+    served from it (no tool runs) and every successful compile is put there. Failures are not stored
+    (their diagnostics name each job's own lines), and a job whose twin failed is compiled on its own.
+    stats: a CompileStats to fill in.
 
     Raises ToolMissing if a tool the jobs need is absent, ValueError on a
     malformed job (duplicate key, unknown language or stage).
@@ -406,6 +468,48 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
         if job.language not in LANGUAGES or job.stage not in STAGES:
             raise ValueError(f"{job.key}: unknown language/stage {job.language!r}/{job.stage!r}")
         seen.add(job.key)
+    stats = stats if stats is not None else CompileStats()
+    stats.jobs += len(jobs)
+    if not jobs:
+        return {}
+    keys = {job.key: cache_key(job, optimize, validate) for job in jobs}
+    groups: dict[str, list[CompileJob]] = {}
+    for job in jobs:
+        groups.setdefault(keys[job.key], []).append(job)
+    stats.distinct += len(groups)
+    results: dict[str, CompileResult] = {}
+    todo = []
+    for ck, members in groups.items():
+        data = store.get(COMPILE_NAMESPACE, ck) if store is not None else None
+        hit = _decode(data, members[0].key) if data is not None else None
+        if hit is not None:
+            stats.cached += 1
+            for job in members:
+                results[job.key] = _renamed(hit, job.key)
+        else:
+            todo.append(members[0])
+    fresh = _compile_all(todo, optimize, validate, progress)
+    stats.compiled += len(todo)
+    again = []
+    for first in todo:
+        r = fresh[first.key]
+        members = groups[keys[first.key]]
+        if r.ok:
+            if store is not None:
+                store.put(COMPILE_NAMESPACE, keys[first.key], _encode(r))
+            for job in members:
+                results[job.key] = _renamed(r, job.key)
+        else:
+            results[first.key] = r
+            again += members[1:]
+    if again:  # a failed shader's twins: each reports its own lines
+        stats.compiled += len(again)
+        results.update(_compile_all(again, optimize, validate, progress))
+    return {job.key: results[job.key] for job in jobs}
+
+
+def _compile_all(jobs: list[CompileJob], optimize: bool, validate: bool, progress: bool) -> dict[str, CompileResult]:
+    """Run the tools on every job (no store, no deduplication)."""
     if not jobs:
         return {}
     tools: dict[str, str] = {}

@@ -14,9 +14,11 @@ def job_key(h: str, stage: str, lang: str) -> str:
     return f"{h}.{stage}.{lang}"
 
 
-def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES
+def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, stats=None
                   ) -> tuple[dict[str, Composed], dict[str, list[str]], dict[str, CompileResult]]:
-    """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key)."""
+    """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key).
+
+    store, stats: as compile_many takes them (the content-addressed cache; what the compile did)."""
     composed: dict[str, Composed] = {}
     errors: dict[str, list[str]] = {}
     jobs: list[CompileJob] = []
@@ -30,5 +32,5 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES
         for src in c.sources:
             jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
                                    line_map=tuple(src.line_map)))
-    results = compile_many(jobs, optimize=True, validate=True, progress=show_progress())
+    results = compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store, stats=stats)
     return composed, errors, results

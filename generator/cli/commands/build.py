@@ -12,15 +12,24 @@ def add_arguments(p) -> None:
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--bricks", "--brick-dir", dest="bricks", action="append", metavar="DIR",
                    help="an extra brick directory (repeatable)")
+    p.add_argument("--cache-dir", metavar="DIR",
+                   help="the content-addressed compile cache (default: $SHADERMATRIX_CACHE_DIR, else "
+                        "$XDG_CACHE_HOME/shadermatrix, else ~/.cache/shadermatrix)")
+    p.add_argument("--no-cache", action="store_true", help="compile everything; read and write no cache")
 
 
 def run(args) -> int:
     from ...library.bricks import load_library
     from ...build import build_scene
     from ...matrix.scene import load_scene
+    from ...io import Store, default_cache_dir
+    if args.no_cache and args.cache_dir:
+        print("error: --no-cache and --cache-dir contradict each other — give one", file=sys.stderr)
+        return 2
     lib = load_library(args.bricks or ())
     scene = load_scene(args.scene, lib)
-    res = build_scene(scene, lib, Path(args.out))
+    store = None if args.no_cache else Store(args.cache_dir or default_cache_dir())
+    res = build_scene(scene, lib, Path(args.out), store=store)
     perms = res.manifest["permutations"]
     ok = sum(1 for p in perms if p["status"] == "ok")
     print(f"{scene.name}: {len(scene.objects)} objects, {len(scene.materials)} materials, "
@@ -33,7 +42,9 @@ def run(args) -> int:
         print(f"  {uber['status']:<6} ubershader    {len(t.get('variants', []))} material variants, light types "
               f"{', '.join(t.get('light_types', []))}, shadows {', '.join(t.get('shadows', []))}: every permutation reachable"
               if uber["status"] == "ok" else f"  {uber['status']:<6} ubershader")
-    print(f"{ok}/{len(perms)} permutations valid SPIR-V in every language; "
+    c = res.compile
+    print(f"{ok}/{len(perms)} permutations valid SPIR-V in every language; {c.jobs} shaders, {c.distinct} distinct "
+          f"({c.jobs - c.distinct} merged), {c.cached} from the cache, {c.compiled} compiled; "
           f"{res.written} files written, {res.unchanged} unchanged → {args.out}/manifest.json")
     for f in res.failures:
         print(f"error: {f}", file=sys.stderr)
