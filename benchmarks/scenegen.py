@@ -6,12 +6,14 @@ Materials are every BRDF the library builds (each diffuse and specular brick alo
 specular pair, a brick with slots with every filler combination) under every packing and normal
 brick that suits it (albedo_texture only where the BRDF reads rho_d); light sets are combinations
 of the light and shadow bricks. Objects pair materials with light sets until N distinct permutations
-exist (each used by K objects), in a fixed order: the same N gives the same bytes.
+exist (each used by K objects), drawn from all pairs in a fixed shuffled order: the same N gives
+the same bytes.
 """
 from __future__ import annotations
 
 import argparse
 import itertools
+import random
 import sys
 from pathlib import Path
 
@@ -74,12 +76,10 @@ def scene_text(n: int, per: int = 1) -> str:
     for k, s in enumerate(sets):
         out.append(f"set{k} = [{', '.join(repr(light_names[x]).replace(chr(39), chr(34)) for x in s)}]")
     out.append("")
-    used = set()
-    pairs = []
-    for k in range(n):  # walk materials fastest, so that the first permutations vary the BRDF
-        m, s = k % len(materials), (k // len(materials)) % len(sets)
-        pairs.append((m, s))
-        used.add(m)
+    pairs = [(m, s) for m in range(len(materials)) for s in range(len(sets))]
+    random.Random(0).shuffle(pairs)  # a fixed mix of materials and light sets
+    pairs = pairs[:n]
+    used = {m for m, _ in pairs}
     for m in sorted(used):
         b, p = materials[m]
         out += [f"[materials.m{m}]", f'brdf = "{b}"', f'packing = "{p}"', ""]

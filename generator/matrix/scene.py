@@ -27,12 +27,21 @@ from .permutation import (PRECISIONS, LightKey, Permutation, SpecError, canonica
 class Locator:
     """Finds line:col of tables and keys in TOML text (tomllib keeps no positions)."""
 
+    _HEADER = re.compile(r"^\s*\[\[?\s*([^\[\]]*?)\s*\]\]?")
+
     def __init__(self, path: str, text: str):
         self.path, self.lines = path, text.splitlines()
+        self._headers: dict[str, list[int]] | None = None  # "a.b" -> the lines of its [a.b] / [[a.b]] headers
 
     def _header(self, header: str, nth: int = 0) -> int:
-        pat = re.compile(r"^\s*\[\[?\s*" + r"\s*\.\s*".join(re.escape(p) for p in header.split(".")) + r"\s*\]\]?")
-        hits = [i for i, line in enumerate(self.lines) if pat.match(line)]
+        if self._headers is None:  # one pass over the text, on the first lookup: every lookup is then O(1)
+            self._headers = {}
+            for i, line in enumerate(self.lines):
+                m = self._HEADER.match(line)
+                if m:
+                    name = ".".join(p.strip() for p in m[1].split("."))
+                    self._headers.setdefault(name, []).append(i)
+        hits = self._headers.get(".".join(p.strip() for p in header.split(".")), [])
         return hits[nth] if len(hits) > nth else -1
 
     def find(self, header: str, *keys: str, nth: int = 0) -> tuple[int, int]:
