@@ -7,14 +7,17 @@ fails (brick error, compiler error) is reported and the others still build.
 """
 from __future__ import annotations
 
+import functools
+import hashlib
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
 from ..library.bricks import Library
-from ..io import atomic_write, sha256
+from ..io import atomic_write, content_key, sha256
 from ..analysis import cost_dict
+from ..matrix.permutation import SpecError, resolve
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
 from ..compose.uber import compose_ubershader
@@ -25,6 +28,9 @@ from ..toolchain.scenes import compile_scene, job_key
 from ..link.values import uploads
 from .reflection import scene_tables
 
+_PACKAGE = Path(__file__).resolve().parents[1]  # generator/
+_TEMPLATES = _PACKAGE.parent / "templates"
+
 
 @dataclass
 class BuildResult:
@@ -33,6 +39,7 @@ class BuildResult:
     written: int = 0
     unchanged: int = 0
     compile: CompileStats = field(default_factory=CompileStats)  # shaders: jobs, distinct, cached, compiled
+    kept: int = 0  # permutations up to date: not composed, compiled or analysed
     store: object = None  # the io.Store used, or None
 
     @property
@@ -44,14 +51,38 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     store: an io.Store (the content-addressed cache): compiled shaders and their costs are served from it
-    and put into it; None compiles everything."""
+    and put into it; None compiles everything.
+
+    Incremental: each permutation's manifest entry records ``input_key``, the sha256 of everything its
+    outputs depend on (its key, the source of every brick it reads, the scene values of the objects that
+    use it, the generator's own sources and templates, the tools' versions, the languages). A permutation
+    whose key is that of the previous manifest's entry, and whose files are all there with their recorded
+    sha256, is neither composed nor compiled nor analysed: its entry is kept as it was. The ubershader
+    likewise (its key covers every permutation's key and bricks).
+    """
     out = Path(out)
     res = BuildResult(manifest={}, store=store)
-    composed, errors, results = compile_scene(scene, lib, languages, store=store, stats=res.compile)
+    base = _globals(languages)
+    previous = _previous(out)
+    old = {e["hash"]: e for e in previous.get("permutations", [])}
+    keys, kept = {}, {}
+    for h, perm in sorted(scene.permutations.items()):
+        keys[h] = _perm_key(base, scene, lib, h, perm)
+        e = old.get(h)
+        if e is not None and e.get("input_key") == keys[h] and e.get("status") == "ok" and _intact(out, e):
+            kept[h] = e
+    todo = Scene(**{**scene.__dict__, "permutations": {h: p for h, p in scene.permutations.items() if h not in kept}})
+    composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile)
+    res.kept = len(kept)
 
     entries = []
     for h, perm in sorted(scene.permutations.items()):
-        entry = {"id": perm.canonical(), "hash": h, "objects": scene.users.get(h, []), "languages": {}}
+        if h in kept:
+            entries.append(kept[h])
+            res.unchanged += _files(kept[h])
+            continue
+        entry = {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
+                 "languages": {}}
         errs = list(errors.get(h, []))
         c = composed.get(h)
         if c is not None:
@@ -67,18 +98,86 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
             entry["errors"] = errs
             res.failures.append(f"{h} ({perm.canonical()}):\n  " + "\n  ".join(errs))
         entries.append(entry)
+    uber_key = content_key(base, "ubershader", [keys[h] for h in sorted(keys)])
+    old_uber = previous.get("ubershader") or {}
+    if old_uber.get("input_key") == uber_key and old_uber.get("status") == "ok" and _intact(out, old_uber):
+        uber = old_uber
+        res.unchanged += _files(uber)
+    else:
+        uber = _ubershader(res, scene, lib, out, languages)
+        if uber:
+            uber = {"input_key": uber_key, **uber}
     res.manifest = {
         "generator": f"shadermatrix {__version__}",
         "scene": scene.name,
         "tools": tool_versions(),
         "languages": list(languages),
         "permutations": entries,
-        "ubershader": _ubershader(res, scene, lib, out, languages),
-        **scene_tables(scene, composed),
+        "ubershader": uber,
+        **scene_tables(scene, composed, previous),
     }
     text = json.dumps(res.manifest, indent=2, sort_keys=False) + "\n"
     _count(res, atomic_write(out / "manifest.json", text.encode()))
     return res
+
+
+@functools.lru_cache(maxsize=1)
+def _own_sources() -> str:
+    """sha256 of the generator's own code and templates (relative path and bytes of every file)."""
+    h = hashlib.sha256()
+    for root in (_PACKAGE, _TEMPLATES):
+        for p in sorted(root.rglob("*")):
+            if p.is_file() and p.suffix in (".py", ".j2", ".toml"):
+                h.update(str(p.relative_to(root.parent)).encode() + b"\0" + p.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
+def _globals(languages) -> str:
+    return content_key("build-v1", __version__, _own_sources(), tool_versions(), list(languages))
+
+
+def _perm_key(base: str, scene: Scene, lib: Library, h: str, perm) -> str:
+    """Everything a permutation's outputs depend on (see build_scene)."""
+    try:
+        r = resolve(perm, lib)
+        nodes = [*r.brdf, r.packing, *(n for _, n in r.lights)]
+        bricks = {b.display_path: b.module.source_hash
+                  for b in [*(x.brick for n in nodes for x in n.walk()), *(lb for lb, _ in r.lights), r.output]}
+    except (SourceError, SpecError) as e:  # it will fail to compose too: key it by the error
+        bricks = {"error": str(e)}
+    objs = [o for o in scene.objects if o["permutation"] == h]
+    mats = sorted({o["material"] for o in objs})
+    lights = sorted({ln for o in objs for ln in o["lights"]})
+    values = {"objects": [[o["name"], o["material"], o["light_set"], list(o["lights"])] for o in objs],
+              "materials": [repr(scene.materials[m]) for m in mats], "lights": [repr(scene.lights[ln]) for ln in lights]}
+    return content_key(base, perm.canonical(), sorted(bricks.items()), values)
+
+
+def _previous(out: Path) -> dict:
+    """The manifest an earlier build left (an unreadable one counts as none: everything is rebuilt)."""
+    try:
+        m = json.loads((out / "manifest.json").read_text())
+        return m if isinstance(m, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def _items(entry: dict):
+    for stages in entry.get("languages", {}).values():
+        for item in stages.values():
+            yield from ((item[f], item[f"{f}_sha256"]) for f in ("source", "spirv") if f in item)
+
+
+def _files(entry: dict) -> int:
+    return sum(1 for _ in _items(entry))
+
+
+def _intact(out: Path, entry: dict) -> bool:
+    """Every file an entry lists is there with the sha256 it records."""
+    try:
+        return all(sha256((out / rel).read_bytes()) == digest for rel, digest in _items(entry))
+    except (OSError, TypeError):
+        return False
 
 
 def _write(res: BuildResult, out: Path, name: str, src, r) -> tuple[dict, list[str]]:

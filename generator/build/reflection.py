@@ -13,15 +13,23 @@ from ..link.values import light_values, material_values
 from ..matrix.scene import Scene
 
 
-def scene_tables(scene: Scene, interfaces: dict) -> dict:
+def scene_tables(scene: Scene, interfaces: dict, previous: dict | None = None) -> dict:
     """Named materials, lights, light sets and objects, with every value an engine uploads.
 
-    `interfaces`: permutation hash -> Composed (with .interface, .material, .lights slots).
+    `interfaces`: permutation hash -> Composed (with .interface, .material, .lights slots). `previous`: the
+    manifest of the last build; an object whose permutation was kept (not composed: its key, which covers
+    its materials' and lights' values, is unchanged) takes its material's and lights' entries from there.
     """
     materials, lights = {}, {}
+    old_m, old_l = (previous or {}).get("materials", {}), (previous or {}).get("lights", {})
     for obj in scene.objects:
         c = interfaces.get(obj["permutation"])
         if c is None:
+            if obj["material"] in old_m:
+                materials.setdefault(obj["material"], old_m[obj["material"]])
+            for ln in obj["lights"]:
+                if ln in old_l:
+                    lights.setdefault(ln, old_l[ln])
             continue
         iface = c.interface
         m = scene.materials[obj["material"]]
