@@ -41,12 +41,11 @@ def test_a_no_op_rebuild_composes_compiles_and_writes_nothing(built, monkeypatch
     def refuse(*a, **k):
         raise AssertionError("composed on a no-op rebuild")
     monkeypatch.setattr(compose, "compose_permutation", refuse)
-    monkeypatch.setattr("generator.toolchain.scenes.compose_permutation", refuse)
     monkeypatch.setattr(uber, "compose_ubershader", refuse)
-    monkeypatch.setattr("generator.build.compose_ubershader", refuse)
     again = build_scene(scene, lib, out)
-    assert again.ok and again.kept == len(scene.permutations) and again.compile.jobs == 0
+    assert again.ok and again.up_to_date and again.kept == len(scene.permutations) and again.compile.jobs == 0
     assert again.written == 0 and _stamps(out) == before  # not one file rewritten, timestamps too
+    assert again.manifest["permutations"]  # read from disk when asked for
 
 
 def test_a_changed_brick_rebuilds_only_the_permutations_that_read_it(built):

@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -20,11 +21,10 @@ from ..analysis import cost_dict
 from ..matrix.permutation import SpecError, resolve
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
-from ..compose.uber import compose_ubershader
 from ..lang import SourceError
 from ..link.uber import coverage
 from ..toolchain import CompileJob, CompileStats, compile_many, tool_versions
-from ..toolchain.scenes import compile_scene, job_key
+from ..toolchain.scenes import job_key
 from ..link.values import uploads
 from .reflection import scene_tables
 
@@ -32,19 +32,35 @@ _PACKAGE = Path(__file__).resolve().parents[1]  # generator/
 _TEMPLATES = _PACKAGE.parent / "templates"
 
 
+STATE = ".shadermatrix-state.json"  # the build's own record beside the manifest (deterministic: no times)
+
+
 @dataclass
 class BuildResult:
-    manifest: dict
+    out: Path
     failures: list[str] = field(default_factory=list)
     written: int = 0
     unchanged: int = 0
     compile: CompileStats = field(default_factory=CompileStats)  # shaders: jobs, distinct, cached, compiled
     kept: int = 0  # permutations up to date: not composed, compiled or analysed
     store: object = None  # the io.Store used, or None
+    up_to_date: bool = False  # nothing at all to do: the manifest was not even read
+    _manifest: dict | None = None
 
     @property
     def ok(self) -> bool:
         return not self.failures
+
+    @property
+    def manifest(self) -> dict:
+        """The build's manifest (read from out/manifest.json when the build had no need to)."""
+        if self._manifest is None:
+            self._manifest = json.loads((self.out / "manifest.json").read_text())
+        return self._manifest
+
+    @manifest.setter
+    def manifest(self, value: dict) -> None:
+        self._manifest = value
 
 
 def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None) -> BuildResult:
@@ -61,16 +77,25 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     likewise (its key covers every permutation's key and bricks).
     """
     out = Path(out)
-    res = BuildResult(manifest={}, store=store)
+    res = BuildResult(out, store=store)
     base = _globals(languages)
+    users: dict[str, list[dict]] = {}
+    for o in scene.objects:
+        users.setdefault(o["permutation"], []).append(o)
+    keys = {h: _perm_key(base, scene, lib, perm, users.get(h, [])) for h, perm in sorted(scene.permutations.items())}
+    uber_key = content_key(base, "ubershader", [keys[h] for h in sorted(keys)])
+    files = _up_to_date(out, keys, uber_key)
+    if files is not None:  # the record of the last build says every key and file is as it left them
+        res.up_to_date, res.kept, res.unchanged = True, len(keys), files + 1
+        return res
     previous = _previous(out)
     old = {e["hash"]: e for e in previous.get("permutations", [])}
-    keys, kept = {}, {}
+    kept = {}
     for h, perm in sorted(scene.permutations.items()):
-        keys[h] = _perm_key(base, scene, lib, h, perm)
         e = old.get(h)
         if e is not None and e.get("input_key") == keys[h] and e.get("status") == "ok" and _intact(out, e):
             kept[h] = e
+    from ..toolchain.scenes import compile_scene  # composing (Jinja and the emitters) only when needed
     todo = Scene(**{**scene.__dict__, "permutations": {h: p for h, p in scene.permutations.items() if h not in kept}})
     composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile)
     res.kept = len(kept)
@@ -98,7 +123,6 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
             entry["errors"] = errs
             res.failures.append(f"{h} ({perm.canonical()}):\n  " + "\n  ".join(errs))
         entries.append(entry)
-    uber_key = content_key(base, "ubershader", [keys[h] for h in sorted(keys)])
     old_uber = previous.get("ubershader") or {}
     if old_uber.get("input_key") == uber_key and old_uber.get("status") == "ok" and _intact(out, old_uber):
         uber = old_uber
@@ -116,9 +140,41 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
         "ubershader": uber,
         **scene_tables(scene, composed, previous),
     }
-    text = json.dumps(res.manifest, indent=2, sort_keys=False) + "\n"
-    _count(res, atomic_write(out / "manifest.json", text.encode()))
+    if res.manifest == previous and (out / "manifest.json").is_file():  # nothing changed: not even re-encoded
+        _count(res, False)
+        text = (out / "manifest.json").read_bytes()
+    else:
+        text = (json.dumps(res.manifest, indent=2, sort_keys=False) + "\n").encode()
+        _count(res, atomic_write(out / "manifest.json", text))
+    _record(out, res.manifest, text, keys, uber_key)
     return res
+
+
+def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str) -> None:
+    """What the next build checks first: every input key, the manifest's sha256, every file's size."""
+    ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
+        (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
+    entries = [*manifest["permutations"], manifest.get("ubershader") or {}]
+    state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys, "ubershader": uber_key,
+             "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)}}
+    atomic_write(out / STATE, (json.dumps(state, sort_keys=True) + "\n").encode())
+
+
+def _up_to_date(out: Path, keys: dict, uber_key: str) -> int | None:
+    """The number of files the last build left when nothing at all needs doing (its record has these keys,
+    the manifest is the one it wrote, every file it listed has its size), else None."""
+    try:
+        state = json.loads((out / STATE).read_text())
+        if not (state.get("complete") and state.get("keys") == keys and state.get("ubershader") == uber_key):
+            return None
+        if sha256((out / "manifest.json").read_bytes()) != state["manifest_sha256"]:
+            return None
+        for rel, size in state["files"].items():
+            if os.stat(out / rel).st_size != size:
+                return None
+        return len(state["files"])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
 
 
 @functools.lru_cache(maxsize=1)
@@ -136,8 +192,8 @@ def _globals(languages) -> str:
     return content_key("build-v1", __version__, _own_sources(), tool_versions(), list(languages))
 
 
-def _perm_key(base: str, scene: Scene, lib: Library, h: str, perm) -> str:
-    """Everything a permutation's outputs depend on (see build_scene)."""
+def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> str:
+    """Everything a permutation's outputs depend on (see build_scene); objs: the objects drawn with it."""
     try:
         r = resolve(perm, lib)
         nodes = [*r.brdf, r.packing, *(n for _, n in r.lights)]
@@ -145,7 +201,6 @@ def _perm_key(base: str, scene: Scene, lib: Library, h: str, perm) -> str:
                   for b in [*(x.brick for n in nodes for x in n.walk()), *(lb for lb, _ in r.lights), r.output]}
     except (SourceError, SpecError) as e:  # it will fail to compose too: key it by the error
         bricks = {"error": str(e)}
-    objs = [o for o in scene.objects if o["permutation"] == h]
     mats = sorted({o["material"] for o in objs})
     lights = sorted({ln for o in objs for ln in o["lights"]})
     values = {"objects": [[o["name"], o["material"], o["light_set"], list(o["lights"])] for o in objs],
@@ -202,6 +257,7 @@ def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, languag
 
     The build fails, naming the value, when an axis value of the matrix is not reachable in it.
     """
+    from ..compose.uber import compose_ubershader
     perms = [p for _, p in sorted(scene.permutations.items())]
     if not perms:
         return {}

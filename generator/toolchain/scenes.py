@@ -1,13 +1,17 @@
 """Compose and compile every permutation of a scene, in batches (what `build` and `costs` share)."""
 from __future__ import annotations
 
-from ..compose import Composed, compose_permutation
+from typing import TYPE_CHECKING
+
 from ..io import show_progress
 from ..lang import SourceError
 from ..library.bricks import Library
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
 from . import CompileJob, CompileResult, compile_many
+
+if TYPE_CHECKING:
+    from ..compose import Composed
 
 
 def job_key(h: str, stage: str, lang: str) -> str:
@@ -19,6 +23,7 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
     """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key).
 
     store, stats: as compile_many takes them (the content-addressed cache; what the compile did)."""
+    from ..compose import compose_permutation  # Jinja and the emitters load only when something is composed
     composed: dict[str, Composed] = {}
     errors: dict[str, list[str]] = {}
     jobs: list[CompileJob] = []

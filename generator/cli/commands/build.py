@@ -30,6 +30,10 @@ def run(args) -> int:
     scene = load_scene(args.scene, lib)
     store = None if args.no_cache else Store(args.cache_dir or default_cache_dir())
     res = build_scene(scene, lib, Path(args.out), store=store)
+    if res.up_to_date:
+        print(f"{scene.name}: {len(scene.permutations)} permutations up to date: 0 composed, 0 compiled; "
+              f"0 files written, {res.unchanged} unchanged → {args.out}/manifest.json")
+        return 0
     perms = res.manifest["permutations"]
     ok = sum(1 for p in perms if p["status"] == "ok")
     print(f"{scene.name}: {len(scene.objects)} objects, {len(scene.materials)} materials, "
