@@ -222,3 +222,31 @@ def test_warning_of_a_good_shader_stays_with_it_in_a_batch():
     (warning,) = results["w.frag.glsl"].diagnostics
     assert (warning.severity, warning.path, warning.line) == ("warning", "w.frag.glsl", 3)
     assert "GL_EXT_shadermatrix_nonexistent" in warning.message
+
+
+INVALID_SPVASM = """OpCapability Shader
+OpMemoryModel Logical GLSL450
+OpEntryPoint Fragment %main "main"
+OpExecutionMode %main OriginUpperLeft
+%void = OpTypeVoid
+%fn = OpTypeFunction %void
+%float = OpTypeFloat 32
+%main = OpFunction %void None %fn
+%label = OpLabel
+%sum = OpFAdd %float %label %label
+OpReturn
+OpFunctionEnd
+"""
+
+
+def test_an_invalid_front_end_module_fails_in_spirv_opt_with_the_validator_message(tmp_path):
+    """compile_many runs no spirv-val before spirv-opt, because spirv-opt validates its input: shown here."""
+    spirv_as = require_tool("spirv-as")
+    bad = tmp_path / "bad.spv"
+    subprocess.run([spirv_as, "--target-env", "vulkan1.1", "-", "-o", str(bad)], input=INVALID_SPVASM.encode(),
+                   check=True)
+    job = CompileJob("bad.frag.glsl", "glsl", "frag", "")
+    res = toolchain._spirv_steps({"spirv-opt": require_tool("spirv-opt"), "spirv-val": require_tool("spirv-val")},
+                                 str(tmp_path), 0, job, bad.read_bytes(), [], optimize=True, validate=True)
+    assert not res.ok and res.spirv is None
+    assert any("requires a type" in d.message and d.tool == "spirv-opt" for d in res.diagnostics), res.diagnostics

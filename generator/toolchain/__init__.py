@@ -20,9 +20,9 @@ Pipeline per job (all SPIR-V is version 1.3, validated for ``vulkan1.1``):
    - WGSL: ``naga --spirv-version 1.3 --keep-coordinate-space in.wgsl out.spv`` (no y flip:
     the same matrices place vertices alike in every language), one process per file
      (naga converts one input per run); about 2 ms each.
-2. ``spirv-val --target-env vulkan1.1`` on the front end's output;
-3. with ``optimize``: ``spirv-opt --target-env=vulkan1.1 -O`` and
-   ``spirv-val`` again on the result.
+2. with ``optimize``: ``spirv-opt --target-env=vulkan1.1 -O`` (which validates its input itself:
+   an invalid module is refused with the validator's message) and ``spirv-val`` on the result;
+   without: ``spirv-val --target-env vulkan1.1`` on the front end's output.
 
 Batches and per-file steps run on a thread pool of ``os.cpu_count()``
 workers; GLSL/HLSL jobs are dealt into one glslc batch per worker (at least
@@ -378,10 +378,12 @@ def _spirv_steps(tools: dict, tmp: str, idx: int, job: CompileJob, spv: bytes,
         diags.extend(found if _has_error(found) else [_failure(job, "spirv-val", rc, text)])
         return False
 
-    if not val(unopt):
-        return CompileResult(job.key, False, None, spv, diags)
     if not optimize:
+        if not val(unopt):
+            return CompileResult(job.key, False, None, spv, diags)
         return CompileResult(job.key, True, spv, spv, diags)
+    # No spirv-val before spirv-opt: spirv-opt validates its input itself (for the same target environment)
+    # and refuses an invalid module with the validator's message; the result is validated below.
     opt = Path(tmp, f"j{idx:06d}.opt.spv")
     rc, text = _run([tools["spirv-opt"], f"--target-env={TARGET_ENV}", "-O", str(unopt), "-o", str(opt)])
     if rc != 0 or not opt.is_file():
