@@ -134,7 +134,8 @@ def test_malformed_engine_brick_is_reported_with_its_location(tmp_path):
                                "def diffuse(NdotL: float) -> vec3:\n    return vec3(step(0.5, NdotL)) * 2\n")
     r = run("bricks", "--bricks", d)
     assert r.returncode == 1
-    assert f"{d / 'toon.py'}:5:12: cannot combine vec3 and int" in r.stderr, r.stderr
+    # named relative to the brick directory's parent, in messages as in outputs (no absolute path of this machine)
+    assert f"{d.name}/toon.py:5:12: cannot combine vec3 and int" in r.stderr, r.stderr
 
 
 def test_missing_brick_directory(tmp_path):
@@ -172,7 +173,7 @@ def test_compiler_failure_names_the_brick_line_and_other_permutations_still_buil
     r = run("build", scene, "--out", out, "--bricks", d)
     assert r.returncode == 1
     # naga's header points at the function; the underlined expression's line names the statement.
-    assert f"{d / 'branchy.py'}:8:0: error: " in r.stderr and "Division by zero [naga]" in r.stderr, r.stderr
+    assert f"{d.name}/branchy.py:8:0: error: " in r.stderr and "Division by zero [naga]" in r.stderr, r.stderr
     m = json.loads((out / "manifest.json").read_text())
     status = {p["id"].split(";")[0]: p["status"] for p in m["permutations"]}
     assert status == {"brdf=lambert+blinn_phong_normalized": "ok", "brdf=lambert": "failed"}

@@ -81,12 +81,22 @@ class Library:
         return [self.bricks[(k, brick_id)] for k in kinds if (k, brick_id) in self.bricks]
 
 
-def display(path: Path) -> str:
-    """A path as shown in messages and provenance: relative to the repo when inside it."""
+def display(path: Path, root: Path | None = None) -> str:
+    """A path as shown in messages, provenance, #line directives and the manifest: relative to the repo when
+    inside it, else to the brick directory's parent (an engine's ``/src/engine/bricks/x.py`` is
+    ``bricks/x.py``), so that no absolute path of this machine reaches an output and moving a brick
+    directory changes nothing that is built."""
+    path = path.resolve()
     try:
-        return str(path.resolve().relative_to(REPO))
+        return str(path.relative_to(REPO))
     except ValueError:
-        return str(path)
+        pass
+    if root is not None:
+        try:
+            return str(path.relative_to(Path(root).resolve().parent))
+        except ValueError:
+            pass
+    return str(path)
 
 
 def load_library(extra_dirs=(), strict: bool = True) -> Library:
@@ -98,7 +108,7 @@ def load_library(extra_dirs=(), strict: bool = True) -> Library:
             raise SourceError(str(d), 1, 1, "brick directory not found", "check the path of the extra brick directory")
         for path in sorted(d.rglob("*.py")):
             try:
-                b = load_brick(path)
+                b = load_brick(path, shown=display(path, d))
             except SourceError as e:
                 if strict:
                     raise
