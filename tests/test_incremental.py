@@ -81,7 +81,7 @@ def test_a_damaged_output_is_rebuilt(built):
     from generator.build import build_scene
 
     lib, scene, out = built
-    victim = sorted((out / "glsl").glob("*.frag.spv"))[0]
+    victim = sorted((out / "glsl").glob("*.frag.*.spv"))[0]
     victim.write_bytes(b"garbage")
     again = build_scene(scene, lib, out)
     assert again.ok and again.kept == len(scene.permutations) - 1

@@ -26,6 +26,7 @@ from ..link.uber import coverage
 from ..toolchain import CompileJob, CompileStats, compile_many, tool_versions
 from ..toolchain.scenes import job_key
 from ..link.values import uploads
+from .outputs import clean_leftovers, collect_garbage, locked, shown, write_depfile
 from .reflection import scene_tables
 
 _PACKAGE = Path(__file__).resolve().parents[1]  # generator/
@@ -63,11 +64,11 @@ class BuildResult:
         self._manifest = value
 
 
-def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None) -> BuildResult:
+def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None, depfile=None) -> BuildResult:
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     store: an io.Store (the content-addressed cache): compiled shaders and their costs are served from it
-    and put into it; None compiles everything.
+    and put into it; None compiles everything. depfile: where to write a Make-syntax depfile (or None).
 
     Incremental: each permutation's manifest entry records ``input_key``, the sha256 of everything its
     outputs depend on (its key, the source of every brick it reads, the scene values of the objects that
@@ -75,8 +76,46 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     whose key is that of the previous manifest's entry, and whose files are all there with their recorded
     sha256, is neither composed nor compiled nor analysed: its entry is kept as it was. The ubershader
     likewise (its key covers every permutation's key and bricks).
+
+    Consistent at every instant: artifacts are named by their content (``<hash>.<stage>.<sha12>.<ext>``)
+    and never overwritten; the manifest is replaced last, atomically, and only then are the files it no
+    longer names removed. A permutation that fails keeps its last good entry and files, marked
+    ``"status": "stale"`` with the errors and the failing sources beside (``failed_sources``).
+    One build at a time per output directory (outputs.locked); an interrupted build's leftovers are
+    removed by the next one.
     """
     out = Path(out)
+    with locked(out):
+        clean_leftovers(out)
+        res = _build(scene, lib, out, languages, store)
+        if res._manifest is not None:  # something was (re)written: drop what the new manifest no longer names
+            collect_garbage(out, res._manifest)
+        if depfile is not None:
+            write_depfile(depfile, shown(out / "manifest.json"), _deps(scene, lib, out))
+    return res
+
+
+def _deps(scene: Scene, lib: Library, out: Path) -> list[str]:
+    """Every file the build read: the scene, every brick the library loaded, every template composed with
+    (this process's, and the last build's for what it kept)."""
+    templates = set()
+    try:
+        templates.update(json.loads((out / STATE).read_text()).get("templates", []))
+    except (OSError, ValueError, AttributeError):
+        pass
+    return [shown(scene.path), *(shown(b.path) for b in lib.bricks.values()),
+            *(shown(_TEMPLATES / t) for t in sorted(templates))]
+
+
+def _templates_read() -> list[str]:
+    import sys
+    compose = sys.modules.get("generator.compose")
+    if compose is None:
+        return []
+    return sorted(str(Path(p).resolve().relative_to(_TEMPLATES)) for p in compose.loaded_templates())
+
+
+def _build(scene: Scene, lib: Library, out: Path, languages, store) -> BuildResult:
     res = BuildResult(out, store=store)
     base = _globals(languages)
     users: dict[str, list[dict]] = {}
@@ -114,23 +153,14 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
             entry["bricks"] = dict(sorted(c.bricks.items()))
             entry["interface"] = c.interface.as_dict()
             entry["uploads"] = uploads(scene, h, c)
-            for src in c.sources:
-                item, bad = _write(res, out, h, src, results[job_key(h, src.stage, src.language)])
-                errs += bad
-                entry["languages"].setdefault(src.language, {})[src.stage] = item
-        entry["status"] = "failed" if errs else "ok"
-        if errs:
-            entry["errors"] = errs
-            res.failures.append(f"{h} ({perm.canonical()}):\n  " + "\n  ".join(errs))
-        entries.append(entry)
+            errs += _write_all(res, out, h, c.sources, results, entry)
+        entries.append(_settle(res, entry, errs, old.get(h), out, f"{h} ({perm.canonical()})"))
     old_uber = previous.get("ubershader") or {}
     if old_uber.get("input_key") == uber_key and old_uber.get("status") == "ok" and _intact(out, old_uber):
         uber = old_uber
         res.unchanged += _files(uber)
     else:
-        uber = _ubershader(res, scene, lib, out, languages)
-        if uber:
-            uber = {"input_key": uber_key, **uber}
+        uber = _ubershader(res, scene, lib, out, languages, uber_key, old_uber)
     res.manifest = {
         "generator": f"shadermatrix {__version__}",
         "scene": scene.name,
@@ -146,17 +176,38 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     else:
         text = (json.dumps(res.manifest, indent=2, sort_keys=False) + "\n").encode()
         _count(res, atomic_write(out / "manifest.json", text))
-    _record(out, res.manifest, text, keys, uber_key)
+    _record(out, res.manifest, text, keys, uber_key, res.kept)
     return res
 
 
-def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str) -> None:
-    """What the next build checks first: every input key, the manifest's sha256, every file's size."""
+def _settle(res: BuildResult, entry: dict, errs: list[str], old: dict | None, out: Path, what: str) -> dict:
+    """An entry's status: ok; or, when it failed, its last good entry kept whole and marked stale."""
+    if not errs:
+        entry["status"] = "ok"
+        entry.pop("failed_sources", None)
+        return entry
+    res.failures.append(f"{what}:\n  " + "\n  ".join(errs))
+    failed = entry.get("failed_sources", {})
+    if old is not None and old.get("status") in ("ok", "stale") and _intact(out, old):
+        return {**old, "status": "stale", "errors": errs, "failed_sources": failed}
+    return {**entry, "languages": {}, "status": "failed", "errors": errs, "failed_sources": failed}
+
+
+def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, kept: int) -> None:
+    """What the next build checks first: every input key, the manifest's sha256, every file's size; and the
+    templates composed with (for the depfile of a build that composes nothing)."""
+    templates = set(_templates_read())
+    if kept:
+        try:
+            templates.update(json.loads((out / STATE).read_text()).get("templates", []))
+        except (OSError, ValueError, AttributeError):
+            pass
     ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
         (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
     entries = [*manifest["permutations"], manifest.get("ubershader") or {}]
     state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys, "ubershader": uber_key,
-             "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)}}
+             "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)},
+             "templates": sorted(templates)}
     atomic_write(out / STATE, (json.dumps(state, sort_keys=True) + "\n").encode())
 
 
@@ -235,24 +286,39 @@ def _intact(out: Path, entry: dict) -> bool:
         return False
 
 
-def _write(res: BuildResult, out: Path, name: str, src, r) -> tuple[dict, list[str]]:
-    """Write one compiled source (and its SPIR-V); returns its manifest item and its errors."""
+def _write_all(res: BuildResult, out: Path, name: str, sources, results, entry: dict) -> list[str]:
+    """Write a unit's sources and SPIR-V (content-named) into `entry` only when every one compiled; else
+    write the failing sources beside, as ``<name>.<stage>.failed.<lang>``, and return the errors."""
+    errs, failed = [], {}
+    for src in sources:
+        r = results[job_key(name, src.stage, src.language)]
+        if not (r.ok and r.spirv):
+            rel = f"{src.language}/{name}.{src.stage}.failed.{src.language}"
+            _count(res, atomic_write(out / rel, src.text.encode()))
+            failed[f"{src.language}.{src.stage}"] = rel
+            errs += r.errors()
+    if errs:
+        entry["failed_sources"] = failed
+        return errs
+    for src in sources:
+        r = results[job_key(name, src.stage, src.language)]
+        entry["languages"].setdefault(src.language, {})[src.stage] = _write(res, out, name, src, r)
+    return []
+
+
+def _write(res: BuildResult, out: Path, name: str, src, r) -> dict:
+    """Write one compiled source and its SPIR-V under content names; returns its manifest item."""
     data = src.text.encode()
-    if r.ok and r.spirv:
-        rel_src = f"{src.language}/{name}.{src.stage}.{src.language}"
-        rel_spv = f"{src.language}/{name}.{src.stage}.spv"
-        _count(res, atomic_write(out / rel_src, data))
-        _count(res, atomic_write(out / rel_spv, r.spirv))
-        return {"source": rel_src, "source_sha256": sha256(data), "spirv": rel_spv,
-                "spirv_sha256": sha256(r.spirv), "cost": cost_dict(r.spirv, res.store)}, []
-    # A source that does not compile goes beside, under its own name: an earlier
-    # build's source and SPIR-V stay a matching pair.
-    rel_src = f"{src.language}/{name}.{src.stage}.failed.{src.language}"
+    src_sha, spv_sha = sha256(data), sha256(r.spirv)
+    rel_src = f"{src.language}/{name}.{src.stage}.{src_sha[:12]}.{src.language}"
+    rel_spv = f"{src.language}/{name}.{src.stage}.{spv_sha[:12]}.spv"
     _count(res, atomic_write(out / rel_src, data))
-    return {"source": rel_src, "source_sha256": sha256(data)}, r.errors()
+    _count(res, atomic_write(out / rel_spv, r.spirv))
+    return {"source": rel_src, "source_sha256": src_sha, "spirv": rel_spv, "spirv_sha256": spv_sha,
+            "cost": cost_dict(r.spirv, res.store)}
 
 
-def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, languages) -> dict:
+def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, languages, key: str, old: dict) -> dict:
     """The fallback ubershader of the scene's matrix: sources, SPIR-V, its tables and Interface.
 
     The build fails, naming the value, when an axis value of the matrix is not reachable in it.
@@ -264,23 +330,15 @@ def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, languag
     try:
         c, u = compose_ubershader(perms, lib, languages)
     except SourceError as e:
-        res.failures.append(f"ubershader:\n  {e}")
-        return {"status": "failed", "errors": [str(e)]}
+        return _settle(res, {"input_key": key, "languages": {}}, [str(e)], old, out, "ubershader")
     problems = coverage(u, perms, lib)
     jobs = [CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
                        line_map=tuple(s.line_map)) for s in c.sources]
     results = compile_many(jobs, optimize=True, validate=True, store=res.store, stats=res.compile)
-    entry = {"hash": c.hash, "languages": {}, "tables": u.tables(), "interface": c.interface.as_dict()}
+    entry = {"input_key": key, "hash": c.hash, "languages": {}, "tables": u.tables(), "interface": c.interface.as_dict()}
     errs = [f"coverage: {p}" for p in problems]
-    for src in c.sources:
-        item, bad = _write(res, out, "ubershader", src, results[job_key("ubershader", src.stage, src.language)])
-        errs += bad
-        entry["languages"].setdefault(src.language, {})[src.stage] = item
-    entry["status"] = "failed" if errs else "ok"
-    if errs:
-        entry["errors"] = errs
-        res.failures.append("ubershader:\n  " + "\n  ".join(errs))
-    return entry
+    errs += _write_all(res, out, "ubershader", c.sources, results, entry)
+    return _settle(res, entry, errs, old, out, "ubershader")
 
 
 def _count(res: BuildResult, changed: bool) -> None:

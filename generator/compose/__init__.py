@@ -25,10 +25,27 @@ from ..targets.base import Emitted
 TEMPLATES = Path(__file__).resolve().parents[2] / "templates"
 
 
+_LOADED: set[str] = set()  # every template file this process has read (for depfiles)
+
+
+class _RecordingLoader(jinja2.FileSystemLoader):
+    """A FileSystemLoader that remembers which files it read: a build's depfile lists what was loaded."""
+
+    def get_source(self, environment, template):
+        source, filename, uptodate = super().get_source(environment, template)
+        _LOADED.add(filename)
+        return source, filename, uptodate
+
+
+def loaded_templates() -> list[str]:
+    """The template files (absolute paths) read so far by this process, sorted."""
+    return sorted(_LOADED)
+
+
 def jinja_env() -> jinja2.Environment:
     """The one Jinja environment (StrictUndefined: a missing value is an error, not an empty string)."""
     return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(TEMPLATES)),
+        loader=_RecordingLoader(str(TEMPLATES)),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
         lstrip_blocks=True,

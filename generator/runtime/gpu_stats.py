@@ -136,7 +136,7 @@ def statistics(jobs, families=DEFAULT_FAMILIES, ir_dir=None) -> Result:
     families = check_families(families)
     jobs = list(jobs)
     ir_dir = None if ir_dir is None else Path(ir_dir).resolve()  # the worker runs in the repository
-    with tempfile.TemporaryDirectory(prefix="shadermatrix-radv-") as tmp:
+    with tempfile.TemporaryDirectory(prefix=f"shadermatrix-radv-{os.getpid()}-") as tmp:
         request = Path(tmp) / "jobs.json"
         request.write_text(json.dumps([j.as_json() for j in jobs]))
 

@@ -531,7 +531,7 @@ def _compile_all(jobs: list[CompileJob], optimize: bool, validate: bool, progres
     results: dict[str, CompileResult] = {}
     batchable = [(i, j) for i, j in enumerate(jobs) if j.language != "wgsl"]
     n_chunks = max(min(workers, len(batchable) // 8), -(-len(batchable) // _MAX_BATCH), 1 if batchable else 0)
-    with tempfile.TemporaryDirectory(prefix="shadermatrix-") as tmp, \
+    with tempfile.TemporaryDirectory(prefix=f"shadermatrix-{os.getpid()}-") as tmp, \
             ThreadPoolExecutor(max_workers=workers) as pool, \
             tqdm(total=len(jobs), disable=not progress, unit="shader", leave=False) as bar:
         front = [pool.submit(_glslc_batch, tools["glslc"], tmp, batchable[k::n_chunks])

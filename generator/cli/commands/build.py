@@ -16,6 +16,8 @@ def add_arguments(p) -> None:
                    help="the content-addressed compile cache (default: $SHADERMATRIX_CACHE_DIR, else "
                         "$XDG_CACHE_HOME/shadermatrix, else ~/.cache/shadermatrix)")
     p.add_argument("--no-cache", action="store_true", help="compile everything; read and write no cache")
+    p.add_argument("--depfile", metavar="PATH",
+                   help="write a Make-syntax depfile (Ninja: deps = gcc): OUT/manifest.json and every file read")
 
 
 def run(args) -> int:
@@ -29,7 +31,7 @@ def run(args) -> int:
     lib = load_library(args.bricks or ())
     scene = load_scene(args.scene, lib)
     store = None if args.no_cache else Store(args.cache_dir or default_cache_dir())
-    res = build_scene(scene, lib, Path(args.out), store=store)
+    res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile)
     if res.up_to_date:
         print(f"{scene.name}: {len(scene.permutations)} permutations up to date: 0 composed, 0 compiled; "
               f"0 files written, {res.unchanged} unchanged → {args.out}/manifest.json")

@@ -1,0 +1,118 @@
+"""The output tree as a build system needs it: one build at a time, leftovers removed, depfiles.
+
+- ``locked(out)``: an exclusive ``flock`` on ``out/.shadermatrix-lock`` for the whole build; a second
+  build into the same directory says it is waiting (one line on stderr) and runs after the first —
+  never interleaved with it. The lock goes with the process, so a killed build never leaves it held.
+- ``clean_leftovers(out)``: what an interrupted build left — ``.<name>.<random>.tmp`` files in the output
+  tree (io.atomic_write's temporaries) and ``shadermatrix-<pid>-*`` directories in the system temp dir
+  whose process is gone.
+- ``collect_garbage(out, manifest)``: artifacts are content-named, so a rebuild never overwrites a file
+  the current manifest names; once the new manifest is in place, the files it no longer names
+  (superseded versions, permutations that left the scene) are removed.
+- ``write_depfile(path, target, deps)``: Make syntax, which Ninja reads (``deps = gcc``).
+"""
+from __future__ import annotations
+
+import errno
+import fcntl
+import os
+import re
+import shutil
+import sys
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+from ..io import atomic_write
+from ..targets import LANGUAGES
+
+LOCK = ".shadermatrix-lock"
+TEMP_DIR = re.compile(r"^shadermatrix-(?:radv-)?(\d+)-")
+OWN_TMP = re.compile(r"^\..+\.[^.]+\.tmp$")  # io.atomic_write: .<name>.<random>.tmp
+
+
+@contextmanager
+def locked(out: Path):
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(out))
+    out.mkdir(parents=True, exist_ok=True)
+    fd = os.open(out / LOCK, os.O_RDWR | os.O_CREAT, 0o666)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            print(f"waiting: another build into {out} is running", file=sys.stderr, flush=True)
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process: alive
+        return True
+    return True
+
+
+def clean_leftovers(out: Path) -> int:
+    """Remove an interrupted build's temporary files (output tree) and directories (system temp dir)."""
+    gone = 0
+    for p in out.rglob(".*.tmp"):
+        if p.is_file() and OWN_TMP.match(p.name):
+            p.unlink(missing_ok=True)
+            gone += 1
+    tmp = Path(tempfile.gettempdir())
+    for d in tmp.glob("shadermatrix-*"):
+        m = TEMP_DIR.match(d.name)
+        if m and d.is_dir() and int(m[1]) != os.getpid() and not _alive(int(m[1])):
+            shutil.rmtree(d, ignore_errors=True)
+            gone += 1
+    return gone
+
+
+def named(manifest: dict) -> set[str]:
+    """Every file a manifest names (relative paths)."""
+    out = set()
+    for e in [*manifest.get("permutations", []), manifest.get("ubershader") or {}]:
+        for stages in e.get("languages", {}).values():
+            for item in stages.values():
+                out.update(item[k] for k in ("source", "spirv") if k in item)
+        out.update(e.get("failed_sources", {}).values())
+    return out
+
+
+def collect_garbage(out: Path, manifest: dict) -> int:
+    """Remove the files of the language directories that the (new, already written) manifest does not name."""
+    keep, gone = named(manifest), 0
+    for lang in LANGUAGES:
+        d = out / lang
+        if not d.is_dir():
+            continue
+        for p in d.iterdir():
+            if p.is_file() and not p.name.startswith(".") and f"{lang}/{p.name}" not in keep:
+                p.unlink(missing_ok=True)
+                gone += 1
+    return gone
+
+
+def _escape(path: str) -> str:
+    return path.replace("\\", "\\\\").replace(" ", "\\ ").replace("#", "\\#").replace("$", "$$")
+
+
+def shown(path) -> str:
+    """A dependency as the build system invoked us sees it: relative to the working directory when inside it."""
+    p = Path(path).resolve()
+    try:
+        return str(p.relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(p)
+
+
+def write_depfile(path: Path, target: str, deps) -> bool:
+    """``target: dep dep ...`` (one dependency per line), atomically; False when it was already so."""
+    lines = [f"{_escape(target)}:"] + [f"  {_escape(d)}" for d in sorted(set(deps))]
+    return atomic_write(Path(path), (" \\\n".join(lines) + "\n").encode())

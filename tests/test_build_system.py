@@ -1,0 +1,166 @@
+"""The build as a build system calls it (issue 9): depfiles, one build at a time, kill -9 loses nothing,
+failures keep the last good outputs, removed permutations leave the tree, no machine paths in outputs."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+EXAMPLE = REPO / "scenes" / "example.toml"
+pytestmark = pytest.mark.toolchain
+
+
+def _cli(*args, cwd=REPO, **kw):
+    return subprocess.run([sys.executable, "-m", "generator.cli", *map(str, args)], cwd=cwd, capture_output=True,
+                          text=True, timeout=600, **kw)
+
+
+def _consistent(out: Path) -> dict:
+    """The manifest, after checking that the language directories hold exactly the files it names, intact."""
+    import hashlib
+    from generator.build.outputs import named
+    m = json.loads((out / "manifest.json").read_text())
+    files = {str(p.relative_to(out)) for p in out.glob("*/*") if p.is_file()}
+    assert files == named(m), (sorted(files - named(m))[:5], sorted(named(m) - files)[:5])
+    for e in [*m["permutations"], m["ubershader"]]:
+        for stages in e.get("languages", {}).values():
+            for item in stages.values():
+                assert hashlib.sha256((out / item["spirv"]).read_bytes()).hexdigest() == item["spirv_sha256"]
+    return m
+
+
+def test_the_depfile_lists_the_scene_every_brick_and_every_template_read(tmp_path):
+    dep = tmp_path / "out.d"
+    r = _cli("build", EXAMPLE, "--out", tmp_path / "out", "--depfile", dep)
+    assert r.returncode == 0, r.stderr
+    text = dep.read_text()
+    target, _, rest = text.partition(":")
+    assert target == str(tmp_path / "out" / "manifest.json")
+    deps = [d.strip().rstrip("\\").strip() for d in rest.splitlines() if d.strip().rstrip("\\").strip()]
+    assert "scenes/example.toml" in deps  # relative to the working directory, as the build system sees it
+    bricks = {str(p.relative_to(REPO)) for p in (REPO / "bricks").rglob("*.py")}
+    assert bricks <= set(deps)
+    templates = {d for d in deps if d.startswith("templates/")}
+    for lang in ("glsl", "hlsl", "wgsl"):  # what was composed with: vertex, fragment, the ubershader, macros
+        assert {f"templates/{lang}/vertex.{lang}.j2", f"templates/{lang}/fragment.{lang}.j2",
+                f"templates/{lang}/macros.{lang}.j2"} <= templates
+    assert all(Path(REPO / d).is_file() for d in deps)
+    again = _cli("build", EXAMPLE, "--out", tmp_path / "out", "--depfile", tmp_path / "again.d")
+    assert "up to date" in again.stdout and (tmp_path / "again.d").read_text() == text  # composed nothing, same deps
+
+
+def test_a_second_build_into_the_same_directory_waits_for_the_first(tmp_path):
+    from generator.build.outputs import locked
+    out = tmp_path / "out"
+    with locked(out):  # a build holds the directory ...
+        p = subprocess.Popen([sys.executable, "-m", "generator.cli", "build", str(EXAMPLE), "--out", str(out)],
+                             cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.time() + 60
+        while not (out / "manifest.json").exists() and time.time() < deadline and p.poll() is None:
+            time.sleep(0.2)
+            if time.time() > deadline - 55:
+                break
+        assert not (out / "manifest.json").exists() and p.poll() is None  # ... and the other one waits
+    stdout, stderr = p.communicate(timeout=300)
+    assert p.returncode == 0, stderr
+    assert "waiting: another build into" in stderr
+    _consistent(out)
+
+
+def test_kill_9_at_any_moment_loses_nothing_and_the_next_build_cleans_up(tmp_path):
+    out, cache = tmp_path / "out", tmp_path / "cache"
+    r = _cli("build", EXAMPLE, "--out", out, "--cache-dir", cache)
+    assert r.returncode == 0
+    before = _consistent(out)
+    engine = tmp_path / "engine"
+    engine.mkdir()
+    # an engine brick changes (a new output brick used by every permutation): every file is rebuilt
+    shutil.copy(REPO / "bricks" / "output" / "linear.py", engine / "tinted.py")
+    text = (engine / "tinted.py").read_text()
+    assert "return vec4(color, 1.0)" in text
+    (engine / "tinted.py").write_text(text.replace("return vec4(color, 1.0)", "return vec4(color * 0.5, 1.0)"))
+    scene = tmp_path / "scene.toml"
+    scene.write_text(EXAMPLE.read_text().replace('output = "linear"', 'output = "tinted"'))
+    for delay in (0.5, 1.0, 1.5, 2.5):
+        p = subprocess.Popen([sys.executable, "-m", "generator.cli", "build", str(scene), "--out", str(out),
+                              "--bricks", str(engine), "--cache-dir", str(cache)], cwd=REPO,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(delay)
+        p.send_signal(signal.SIGKILL)
+        p.wait()
+        m = _consistent(out)  # whatever the moment: the manifest and the files it names agree
+        assert m["scene"] == before["scene"]
+    r = _cli("build", scene, "--out", out, "--bricks", engine, "--cache-dir", cache)
+    assert r.returncode == 0, r.stderr
+    m = _consistent(out)
+    assert all(p["status"] == "ok" for p in m["permutations"])
+    assert not list(out.rglob("*.tmp"))
+    from generator.build.outputs import TEMP_DIR, _alive
+    left = [d for d in Path(tempfile.gettempdir()).glob("shadermatrix-*")
+            if (m := TEMP_DIR.match(d.name)) and not _alive(int(m[1]))]
+    assert left == []  # what the killed builds left in the temp dir went with the next build
+
+
+def test_a_failing_permutation_keeps_its_last_good_outputs_marked_stale(tmp_path):
+    engine = tmp_path / "engine"
+    engine.mkdir()
+    good = (REPO / "bricks" / "output" / "linear.py").read_text()
+    (engine / "tinted.py").write_text(good)
+    scene = tmp_path / "scene.toml"
+    scene.write_text(EXAMPLE.read_text().replace('output = "linear"', 'output = "tinted"'))
+    out = tmp_path / "out"
+    assert _cli("build", scene, "--out", out, "--bricks", engine).returncode == 0
+    first = _consistent(out)
+    # an edit that type-checks but that naga refuses (division by a constant zero), so every permutation fails
+    assert "return vec4(color, 1.0)" in good
+    (engine / "tinted.py").write_text(good.replace("return vec4(color, 1.0)", "k = 1\n    q = k / 0\n"
+                                                   "    return vec4(color * float(q), 1.0)"))
+    r = _cli("build", scene, "--out", out, "--bricks", engine)
+    assert r.returncode == 1 and "Division by zero" in r.stderr
+    m = _consistent(out)  # the last good set, whole
+    for old, new in zip(first["permutations"], m["permutations"]):
+        assert new["status"] == "stale" and new["errors"]
+        assert new["languages"] == old["languages"] and new["input_key"] == old["input_key"]
+        assert set(new["failed_sources"]) == {"wgsl.frag"}
+    (engine / "tinted.py").write_text(good)  # fixed: the next build is the first one's again
+    assert _cli("build", scene, "--out", out, "--bricks", engine).returncode == 0
+    assert _consistent(out)["permutations"] == first["permutations"]
+
+
+def test_permutations_that_leave_the_scene_leave_the_tree(tmp_path):
+    out = tmp_path / "out"
+    assert _cli("build", EXAMPLE, "--out", out).returncode == 0
+    n = len(_consistent(out)["permutations"])
+    fewer = tmp_path / "fewer.toml"
+    text = EXAMPLE.read_text()
+    fewer.write_text(text[:text.index("[[objects]]")] + '[[objects]]\nname = "only"\nmaterial = "red_plastic"\n'
+                     'lights = "indoor"\n')
+    assert _cli("build", fewer, "--out", out).returncode == 0
+    m = _consistent(out)
+    assert len(m["permutations"]) == 1 < n
+
+
+def test_moving_an_engine_brick_directory_changes_no_output_and_no_output_names_this_machine(tmp_path):
+    trees = []
+    for where in ("a/deep/place", "elsewhere"):
+        engine = tmp_path / where / "engine_bricks"
+        engine.mkdir(parents=True)
+        shutil.copy(REPO / "bricks" / "output" / "linear.py", engine / "tinted.py")
+        scene = tmp_path / where / "scene.toml"
+        scene.write_text(EXAMPLE.read_text().replace('output = "linear"', 'output = "tinted"'))
+        out = tmp_path / where / "out"
+        assert _cli("build", scene, "--out", out, "--bricks", engine, "--no-cache").returncode == 0
+        trees.append({str(p.relative_to(out)): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()
+                      and p.name != ".shadermatrix-lock"})
+    assert trees[0] == trees[1]
+    for data in trees[0].values():
+        assert str(tmp_path).encode() not in data and str(REPO).encode() not in data
