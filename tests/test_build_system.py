@@ -24,13 +24,17 @@ def _cli(*args, cwd=REPO, **kw):
                           text=True, timeout=600, **kw)
 
 
-def _consistent(out: Path) -> dict:
-    """The manifest, after checking that the language directories hold exactly the files it names, intact."""
+def _consistent(out: Path, exact: bool = True) -> dict:
+    """The manifest, after checking that every file it names is there and intact, and (exact) that the language
+    directories hold nothing else. An interrupted build may leave new, not yet named files: never a named one
+    changed or missing."""
     import hashlib
     from generator.build.outputs import named
     m = json.loads((out / "manifest.json").read_text())
     files = {str(p.relative_to(out)) for p in out.glob("*/*") if p.is_file()}
-    assert files == named(m), (sorted(files - named(m))[:5], sorted(named(m) - files)[:5])
+    assert named(m) <= files, sorted(named(m) - files)[:5]
+    if exact:
+        assert files == named(m), sorted(files - named(m))[:5]
     for e in [*m["permutations"], m["ubershader"]]:
         for stages in e.get("languages", {}).values():
             for item in stages.values():
@@ -97,7 +101,7 @@ def test_kill_9_at_any_moment_loses_nothing_and_the_next_build_cleans_up(tmp_pat
         time.sleep(delay)
         p.send_signal(signal.SIGKILL)
         p.wait()
-        m = _consistent(out)  # whatever the moment: the manifest and the files it names agree
+        m = _consistent(out, exact=False)  # whatever the moment: the manifest and the files it names agree
         assert m["scene"] == before["scene"]
     r = _cli("build", scene, "--out", out, "--bricks", engine, "--cache-dir", cache)
     assert r.returncode == 0, r.stderr

@@ -302,3 +302,21 @@ def walk(node):
 def walk_body(stmts):
     for s in stmts:
         yield from walk(s)
+
+
+def clone(node):
+    """A copy of an IR tree (expressions, statements, functions, parameters) in which every node is new and
+    types, locations and constants are shared: they are values, never mutated. What copy.deepcopy gives for
+    these trees, about 4× faster (the link stage copies every brick function it links)."""
+    if isinstance(node, (Expr, Stmt, Function, Param)):
+        new = object.__new__(type(node))
+        # an emitter's record of a function (targets/clike.py) is of that function, not of its copies
+        new.__dict__.update({k: clone(v) for k, v in node.__dict__.items() if k != "_emitted"})
+        return new
+    if isinstance(node, list):
+        return [clone(x) for x in node]
+    if isinstance(node, tuple):
+        return tuple(clone(x) for x in node)
+    if isinstance(node, dict):
+        return {k: clone(v) for k, v in node.items()}
+    return node

@@ -80,7 +80,7 @@ def eval_program(spec: str, lib: Library) -> EvalProgram:
     """Link a BRDF spec into the program its eval kernel runs (every target emits this IR)."""
     nodes = parse_brdf(spec, lib)
     canon = "+".join(n.canonical() for n in nodes)
-    prog = Program()
+    prog = Program(lib_memo=lib.memo)
     g: BrdfGlue = brdf_glue(prog, nodes)
     slots, count, iface = _eval_interface(g.params, g.reads, g.textures)
     return EvalProgram(canon, nodes, prog, g.params, g.signature, slots, count, g.tangent, iface,
@@ -91,7 +91,7 @@ def switch_program(specs: list[str], lib: Library) -> EvalProgram:
     """Several BRDFs in one program behind `brdf_switch(id, ...)`: id k evaluates specs[k]."""
     brdfs = [parse_brdf(s, lib) for s in specs]
     canon = [("+".join(n.canonical() for n in nodes)) for nodes in brdfs]
-    prog = Program()
+    prog = Program(lib_memo=lib.memo)
     f, glues = brdf_switch(prog, brdfs)
     union = switch_params(glues)
     tangent = any(g.tangent for g in glues)
@@ -129,7 +129,7 @@ def link_permutation(perm: Permutation, lib: Library, kernel: bool = False) -> L
     problem, todo = check_packing(r)
     if problem:
         raise SourceError("<key>", 1, 1, problem, todo)
-    prog = Program()
+    prog = Program(lib_memo=lib.memo)
     g = shade_glue(prog, r)
     if kernel and g.textures:
         t0 = g.textures[0]

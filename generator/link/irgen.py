@@ -1,7 +1,6 @@
 """Typed IR construction for the glue: small constructors, so glue is built as nodes, never as text."""
 from __future__ import annotations
 
-import copy
 
 from ..lang import ir
 from ..lang.types import BOOL, FLOAT, Type
@@ -54,7 +53,7 @@ class Builder:
 
     def copy(self, e: ir.Expr) -> ir.Expr:
         """A fresh copy of a shared expression (IR trees are not shared between statements)."""
-        return copy.deepcopy(e)
+        return ir.clone(e)
 
     # ---- statements
     def decl(self, name: str, value: ir.Expr) -> ir.Decl:

@@ -13,7 +13,6 @@ the host's entry, which the glue binds by name.
 """
 from __future__ import annotations
 
-import copy
 import hashlib
 from dataclasses import dataclass, field
 
@@ -58,6 +57,7 @@ class Program:
     bricks: dict[str, Brick] = field(default_factory=dict)  # display path -> brick
     by_name: dict[str, ir.Function] = field(default_factory=dict)
     _linked: dict = field(default_factory=dict)  # (kind, canonical) -> {function: linked name}
+    lib_memo: dict | None = None  # Library.memo: linked nodes shared between programs of one library
 
     def add(self, f: ir.Function, brick: Brick | None = None) -> ir.Function:
         """Append one function (callees must already be in the program)."""
@@ -82,10 +82,24 @@ class Program:
         if key in self._linked:
             return
         self.bricks[b.display_path] = b
+        # A node links to the same functions in every program (names are keyed by canonical node), so the
+        # library keeps them: the next program that links this node shares them (linked IR is never
+        # mutated after link(); tests/test_link.py checks), instead of deep-copying the brick again.
+        memo_key = ("link", key, tuple(x.brick.module.source_hash for x in node.walk()))
+        hit = self.lib_memo.get(memo_key) if self.lib_memo is not None else None
+        if hit is not None:
+            functions, structs, rename = hit
+            for f in functions:
+                self.add(f, b)
+            for st in structs:
+                if st not in self.structs:
+                    self.structs.append(st)
+            self._linked[key] = rename
+            return
         rename = {name: function_name(node, name) for name in b.module.functions}
         fillers = {slot: filler for slot, filler in node.fillers
                    if KINDS[b.slots[slot]["kind"]].slot}
-        fns = {name: copy.deepcopy(b.module.functions[name]) for name in call_order(b.module)}
+        fns = {name: ir.clone(b.module.functions[name]) for name in call_order(b.module)}
         extra: dict[str, dict[str, Type]] = {}  # host function -> threaded parameters it gains
         for name, f in fns.items():  # callees first, so a helper's threaded names are known at its callers
             need: dict[str, Type] = {}
@@ -109,6 +123,8 @@ class Program:
             if st not in self.structs:
                 self.structs.append(st)
         self._linked[key] = rename
+        if self.lib_memo is not None:
+            self.lib_memo[memo_key] = (list(fns.values()), list(b.module.structs.values()), rename)
 
     def _bind_slot(self, host: Brick, call: ir.Call, filler: Node) -> dict[str, Type]:
         """Point a slot call at the filler's entry, its parameters bound by name; returns the threaded ones."""

@@ -141,7 +141,7 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
             light_types += [lk.light] if lk.light not in light_types else []
             shadows += [lk.shadow] if lk.shadow not in shadows else []
         shadowed = max(shadowed, sum(1 for lk in p.lights if _shadow_textures(lib, lk.shadow)))
-    prog, b = Program(), Builder()
+    prog, b = Program(lib_memo=lib.memo), Builder()
     bind = _Binder(b)
     M = max([1] + [max([1] + [s.index + s.width for s in v.slots]) for v in variants])
     lnodes = {t: Node(lib.get("light", t), ()) for t in light_types}

@@ -140,9 +140,27 @@ class CLikeTarget(ControlMixin, ResourceMixin):
                 w.line(text)
             w.line("")
         for f in functions:
-            self.function(w, f)
+            self._function_cached(w, f)
             w.line("")
         return Emitted(w.text(), w.line_map)
+
+    def _function_cached(self, w: Writer, f: ir.Function) -> None:
+        """self.function(w, f), replayed from the function's own record when this target has emitted it
+        before from the same writer state (linked brick functions are shared by every program of a library,
+        and never change: link/program.py); the bytes are the same, the walk is skipped."""
+        key = (type(self), w.directives, w._next, w.depth)
+        memo = f.__dict__.setdefault("_emitted", {})
+        hit = memo.get(key)
+        if hit is not None:
+            lines, mapped, end = hit
+            base = len(w.lines)
+            w.lines.extend(lines)
+            w.line_map.extend((base + g, path, line) for g, path, line in mapped)
+            w._next = end
+            return
+        start, start_map = len(w.lines), len(w.line_map)
+        self.function(w, f)
+        memo[key] = (w.lines[start:], [(g - start, path, line) for g, path, line in w.line_map[start_map:]], w._next)
 
     # ------------------------------------------------------------ declarations
     def struct_decl(self, w: Writer, s: Type) -> None:
