@@ -128,19 +128,27 @@ def analyze_function(mod: Module, fn: Function, callee_peak: dict[int, int] | No
     live_out = {label: frozenset() for label in blocks}
 
     def scan(label: int):
-        """Walk a block backward from its live-out set; returns (live at top, peak in block)."""
+        """Walk a block backward from its live-out set; returns (live at top, peak in block). The width of the
+        live set is kept as it changes (one value in or out at a time), not summed again per instruction."""
         live = set(live_out[label])
-        peak = width(live)
+        w = width(live)
+        peak = w
         for ins in reversed(blocks[label].body):
             if ins.name == "Phi":
                 continue
             d = ins.result if ins.result in widths else None
-            after = live - {d} if d else live
+            if d is not None and d in live:  # live above its definition: no longer
+                live.discard(d)
+                w -= widths[d]
+            wd = widths[d] if d is not None else 0
             if ins.name == "FunctionCall":
-                peak = max(peak, width(after) + callee_peak.get(ins.operands[0], 0) + (widths[d] if d else 0))
-            peak = max(peak, width(after) + (widths[d] if d else 0))
-            live = after | uses(id_operands(ins))
-            peak = max(peak, width(live))
+                peak = max(peak, w + callee_peak.get(ins.operands[0], 0) + wd)
+            peak = max(peak, w + wd)
+            for u in uses(id_operands(ins)):
+                if u not in live:
+                    live.add(u)
+                    w += widths[u]
+            peak = max(peak, w)
         return live, peak
 
     changed = True
