@@ -10,23 +10,11 @@ import hashlib
 import json
 import os
 import sys
-import tempfile
+import itertools
 import threading
 from pathlib import Path
 
-def _umask() -> int:
-    """The process's umask now: Linux reports it in /proc/self/status; elsewhere os.umask sets and
-    returns it (restored at once). mkstemp creates files 0600; an artifact gets what open() would give."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
+_TMP_SERIAL = itertools.count()
 
 
 def sha256(data: bytes) -> str:
@@ -48,9 +36,11 @@ def atomic_write(path: Path, data: bytes) -> bool:
     except OSError:
         pass
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    # Created with mode 0666 and O_EXCL: the kernel applies the umask, as for any file a program writes
+    # (tempfile.mkstemp would give 0600); the name is this process's and unique within it.
+    tmp = path.parent / f".{path.name}.{os.getpid()}-{next(_TMP_SERIAL)}.tmp"
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o666)
     try:
-        os.fchmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as f:
             f.write(data)
         os.replace(tmp, path)

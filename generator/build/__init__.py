@@ -135,8 +135,14 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store) -> BuildResu
         if e is not None and e.get("input_key") == keys[h] and e.get("status") == "ok" and _intact(out, e):
             kept[h] = e
     from ..toolchain.scenes import compile_scene  # composing (Jinja and the emitters) only when needed
+    old_uber = previous.get("ubershader") or {}
+    uber_kept = old_uber.get("input_key") == uber_key and old_uber.get("status") == "ok" and _intact(out, old_uber)
+    uber_unit = None if uber_kept else _compose_ubershader(scene, lib, languages)
+    extra = [] if not isinstance(uber_unit, tuple) else [
+        CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
+                   line_map=tuple(s.line_map)) for s in uber_unit[0].sources]
     todo = Scene(**{**scene.__dict__, "permutations": {h: p for h, p in scene.permutations.items() if h not in kept}})
-    composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile)
+    composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra)
     res.kept = len(kept)
 
     entries = []
@@ -155,12 +161,11 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store) -> BuildResu
             entry["uploads"] = uploads(scene, h, c)
             errs += _write_all(res, out, h, c.sources, results, entry)
         entries.append(_settle(res, entry, errs, old.get(h), out, f"{h} ({perm.canonical()})"))
-    old_uber = previous.get("ubershader") or {}
-    if old_uber.get("input_key") == uber_key and old_uber.get("status") == "ok" and _intact(out, old_uber):
+    if uber_kept:
         uber = old_uber
         res.unchanged += _files(uber)
     else:
-        uber = _ubershader(res, scene, lib, out, languages, uber_key, old_uber)
+        uber = _ubershader(res, scene, lib, out, uber_unit, results, uber_key, old_uber)
     res.manifest = {
         "generator": f"shadermatrix {__version__}",
         "scene": scene.name,
@@ -318,25 +323,31 @@ def _write(res: BuildResult, out: Path, name: str, src, r) -> dict:
             "cost": cost_dict(r.spirv, res.store)}
 
 
-def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, languages, key: str, old: dict) -> dict:
+def _compose_ubershader(scene: Scene, lib: Library, languages):
+    """(Composed, Uber) of the scene's ubershader, the compose error as text, or None without permutations."""
+    from ..compose.uber import compose_ubershader
+    perms = [p for _, p in sorted(scene.permutations.items())]
+    if not perms:
+        return None
+    try:
+        return compose_ubershader(perms, lib, languages)
+    except SourceError as e:
+        return str(e)
+
+
+def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, unit, results, key: str, old: dict) -> dict:
     """The fallback ubershader of the scene's matrix: sources, SPIR-V, its tables and Interface.
 
     The build fails, naming the value, when an axis value of the matrix is not reachable in it.
     """
-    from ..compose.uber import compose_ubershader
-    perms = [p for _, p in sorted(scene.permutations.items())]
-    if not perms:
+    if unit is None:
         return {}
-    try:
-        c, u = compose_ubershader(perms, lib, languages)
-    except SourceError as e:
-        return _settle(res, {"input_key": key, "languages": {}}, [str(e)], old, out, "ubershader")
-    problems = coverage(u, perms, lib)
-    jobs = [CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
-                       line_map=tuple(s.line_map)) for s in c.sources]
-    results = compile_many(jobs, optimize=True, validate=True, store=res.store, stats=res.compile)
+    if isinstance(unit, str):
+        return _settle(res, {"input_key": key, "languages": {}}, [unit], old, out, "ubershader")
+    c, u = unit
+    perms = [p for _, p in sorted(scene.permutations.items())]
     entry = {"input_key": key, "hash": c.hash, "languages": {}, "tables": u.tables(), "interface": c.interface.as_dict()}
-    errs = [f"coverage: {p}" for p in problems]
+    errs = [f"coverage: {p}" for p in coverage(u, perms, lib)]
     errs += _write_all(res, out, "ubershader", c.sources, results, entry)
     return _settle(res, entry, errs, old, out, "ubershader")
 

@@ -18,15 +18,17 @@ def job_key(h: str, stage: str, lang: str) -> str:
     return f"{h}.{stage}.{lang}"
 
 
-def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, stats=None
+def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, stats=None, extra=()
                   ) -> tuple[dict[str, Composed], dict[str, list[str]], dict[str, CompileResult]]:
     """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key).
 
-    store, stats: as compile_many takes them (the content-addressed cache; what the compile did)."""
+    store, stats: as compile_many takes them (the content-addressed cache; what the compile did).
+    extra: more CompileJobs for the same batch (the ubershader: its large shaders start with the others
+    instead of after them)."""
     from ..compose import compose_permutation  # Jinja and the emitters load only when something is composed
     composed: dict[str, Composed] = {}
     errors: dict[str, list[str]] = {}
-    jobs: list[CompileJob] = []
+    jobs: list[CompileJob] = list(extra)
     for h, perm in sorted(scene.permutations.items()):
         try:
             c = compose_permutation(perm, lib, languages)
