@@ -64,11 +64,14 @@ class BuildResult:
         self._manifest = value
 
 
-def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None, depfile=None) -> BuildResult:
+def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None, depfile=None,
+                workers: int | None = None, executor=None) -> BuildResult:
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     store: an io.Store (the content-addressed cache): compiled shaders and their costs are served from it
     and put into it; None compiles everything. depfile: where to write a Make-syntax depfile (or None).
+    workers: tool processes at once (default: the core count); executor: where compiles run instead
+    (toolchain/dask.py). Neither changes a byte of the output.
 
     Incremental: each permutation's manifest entry records ``input_key``, the sha256 of everything its
     outputs depend on (its key, the source of every brick it reads, the scene values of the objects that
@@ -87,7 +90,7 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     out = Path(out)
     with locked(out):
         clean_leftovers(out)
-        res = _build(scene, lib, out, languages, store)
+        res = _build(scene, lib, out, languages, store, workers, executor)
         if res._manifest is not None:  # something was (re)written: drop what the new manifest no longer names
             collect_garbage(out, res._manifest)
         if depfile is not None:
@@ -115,7 +118,7 @@ def _templates_read() -> list[str]:
     return sorted(str(Path(p).resolve().relative_to(_TEMPLATES)) for p in compose.loaded_templates())
 
 
-def _build(scene: Scene, lib: Library, out: Path, languages, store) -> BuildResult:
+def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None, executor=None) -> BuildResult:
     res = BuildResult(out, store=store)
     base = _globals(languages)
     users: dict[str, list[dict]] = {}
@@ -142,7 +145,8 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store) -> BuildResu
         CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
                    line_map=tuple(s.line_map)) for s in uber_unit[0].sources]
     todo = Scene(**{**scene.__dict__, "permutations": {h: p for h, p in scene.permutations.items() if h not in kept}})
-    composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra)
+    composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra,
+                                              workers=workers, executor=executor)
     res.kept = len(kept)
 
     entries = []

@@ -450,14 +450,17 @@ class CompileStats:
 
 
 def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate: bool = True,
-                 progress: bool = False, store=None, stats: CompileStats | None = None) -> dict[str, CompileResult]:
+                 progress: bool = False, store=None, stats: CompileStats | None = None,
+                 workers: int | None = None, executor=None) -> dict[str, CompileResult]:
     """Compile and validate every job; returns {key: CompileResult} in input order.
 
     Jobs with the same :func:`cache_key` are compiled once (identical shaders, e.g. vertex shaders whose
     sources differ only in their provenance header). store: an io.Store; a job whose key is there is
     served from it (no tool runs) and every successful compile is put there. Failures are not stored
     (their diagnostics name each job's own lines), and a job whose twin failed is compiled on its own.
-    stats: a CompileStats to fill in.
+    stats: a CompileStats to fill in. workers: how many tool processes run at once (default: the core
+    count). executor: where the compiles run instead of here (toolchain/dask.py: a Dask cluster); the
+    store, deduplication and results are the same wherever they ran.
 
     Raises ToolMissing if a tool the jobs need is absent, ValueError on a
     malformed job (duplicate key, unknown language or stage).
@@ -490,7 +493,8 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
                 results[job.key] = _renamed(hit, job.key)
         else:
             todo.append(members[0])
-    fresh = _compile_all(todo, optimize, validate, progress)
+    run = executor.compile if executor is not None else _compile_all
+    fresh = run(todo, optimize, validate, progress, workers)
     stats.compiled += len(todo)
     again = []
     for first in todo:
@@ -506,12 +510,13 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
             again += members[1:]
     if again:  # a failed shader's twins: each reports its own lines
         stats.compiled += len(again)
-        results.update(_compile_all(again, optimize, validate, progress))
+        results.update(run(again, optimize, validate, progress, workers))
     return {job.key: results[job.key] for job in jobs}
 
 
-def _compile_all(jobs: list[CompileJob], optimize: bool, validate: bool, progress: bool) -> dict[str, CompileResult]:
-    """Run the tools on every job (no store, no deduplication)."""
+def _compile_all(jobs: list[CompileJob], optimize: bool, validate: bool, progress: bool,
+                 workers: int | None = None) -> dict[str, CompileResult]:
+    """Run the tools on every job (no store, no deduplication), `workers` tool processes at a time."""
     if not jobs:
         return {}
     tools: dict[str, str] = {}
@@ -526,7 +531,7 @@ def _compile_all(jobs: list[CompileJob], optimize: bool, validate: bool, progres
 
     from tqdm import tqdm
 
-    workers = max(1, os.cpu_count() or 1)
+    workers = max(1, workers or os.cpu_count() or 1)
     index = {job.key: i for i, job in enumerate(jobs)}
     results: dict[str, CompileResult] = {}
     batchable = [(i, j) for i, j in enumerate(jobs) if j.language != "wgsl"]

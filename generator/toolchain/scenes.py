@@ -18,7 +18,8 @@ def job_key(h: str, stage: str, lang: str) -> str:
     return f"{h}.{stage}.{lang}"
 
 
-def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, stats=None, extra=()
+def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, stats=None, extra=(), workers=None,
+                  executor=None
                   ) -> tuple[dict[str, Composed], dict[str, list[str]], dict[str, CompileResult]]:
     """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key).
 
@@ -39,5 +40,6 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
         for src in c.sources:
             jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
                                    line_map=tuple(src.line_map)))
-    results = compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store, stats=stats)
+    results = compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store, stats=stats,
+                           workers=workers, executor=executor)
     return composed, errors, results

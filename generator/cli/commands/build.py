@@ -16,6 +16,10 @@ def add_arguments(p) -> None:
                    help="the content-addressed compile cache (default: $SHADERMATRIX_CACHE_DIR, else "
                         "$XDG_CACHE_HOME/shadermatrix, else ~/.cache/shadermatrix)")
     p.add_argument("--no-cache", action="store_true", help="compile everything; read and write no cache")
+    p.add_argument("-j", "--jobs", type=int, metavar="N",
+                   help="tool processes at once (default: the core count); the output is the same for any N")
+    p.add_argument("--executor", metavar="dask://HOST:PORT",
+                   help="compile on a Dask distributed cluster (its workers need the pinned tools: README)")
     p.add_argument("--depfile", metavar="PATH",
                    help="write a Make-syntax depfile (Ninja: deps = gcc): OUT/manifest.json and every file read")
 
@@ -31,7 +35,22 @@ def run(args) -> int:
     lib = load_library(args.bricks or ())
     scene = load_scene(args.scene, lib)
     store = None if args.no_cache else Store(args.cache_dir or default_cache_dir())
-    res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile)
+    if args.jobs is not None and args.jobs < 1:
+        print(f"error: -j {args.jobs}: give at least one job", file=sys.stderr)
+        return 2
+    executor = None
+    if args.executor:
+        from ...toolchain.dask import SCHEME, DaskExecutor
+        if not args.executor.startswith(SCHEME):
+            print(f"error: --executor {args.executor}: write dask://HOST:PORT", file=sys.stderr)
+            return 2
+        executor = DaskExecutor(args.executor)
+    try:
+        res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile, workers=args.jobs,
+                          executor=executor)
+    finally:
+        if executor is not None:
+            executor.close()
     if res.up_to_date:
         print(f"{scene.name}: {len(scene.permutations)} permutations up to date: 0 composed, 0 compiled; "
               f"0 files written, {res.unchanged} unchanged → {args.out}/manifest.json")

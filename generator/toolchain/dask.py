@@ -1,0 +1,73 @@
+"""Compile jobs on a Dask distributed cluster (`build --executor dask://HOST:PORT`).
+
+A compile job is a pure function of its inputs (source, language, stage, flags, tool versions: the
+cache key), so any worker can run it. The jobs are cut into chunks (four per worker), each chunk is
+compiled on a worker by the same code as a local build (toolchain._compile_all), and the results come
+back to this process, which deduplicates, serves and fills the content-addressed store exactly as it
+does for a local build: the output is byte-identical.
+
+A worker needs what a build machine needs: this shadermatrix version (importable: same code) and the
+pinned tools (glslc, naga, spirv-opt, spirv-val: `make setup`). Each chunk first checks the worker's tool
+versions against this build's (they are part of every cache key); a worker without a tool, or with
+another version, fails the build with one line naming the worker and the tool — a result from another
+compiler is never taken.
+"""
+from __future__ import annotations
+
+from . import ToolMissing, _compile_all, tool_versions
+from ..lang.errors import UserError
+
+SCHEME = "dask://"
+
+
+class WorkerMismatch(UserError):
+    """A Dask worker cannot compile for this build (missing or other tool versions)."""
+
+
+def _on_worker(jobs, optimize: bool, validate: bool, versions: dict):
+    import socket
+    here = tool_versions()
+    wrong = {k: (v, here.get(k)) for k, v in versions.items() if here.get(k) != v}
+    if wrong:
+        what = ", ".join(f"{k} {have or 'missing'} (this build: {want})" for k, (want, have) in sorted(wrong.items()))
+        raise WorkerMismatch(f"dask worker {socket.gethostname()}: {what} — install the pinned tools there "
+                             "(`make setup`)")
+    try:
+        return _compile_all(list(jobs), optimize, validate, False)
+    except ToolMissing as e:
+        raise WorkerMismatch(f"dask worker {socket.gethostname()}: {e}") from None
+
+
+class DaskExecutor:
+    """Runs compile_many's tool work on the cluster at `address` (tcp://host:port or host:port)."""
+
+    def __init__(self, address: str):
+        from distributed import Client
+        address = address[len(SCHEME):] if address.startswith(SCHEME) else address
+        if "://" not in address:
+            address = f"tcp://{address}"
+        try:
+            self.client = Client(address, timeout="10s", set_as_default=False)
+        except OSError as e:
+            raise UserError(f"no Dask scheduler at {address}: {e} — start one (`dask scheduler`) or check the "
+                            "address") from None
+        self.address = address
+
+    def workers(self) -> int:
+        return max(1, len(self.client.scheduler_info().get("workers", {})))
+
+    def compile(self, jobs, optimize: bool, validate: bool, progress: bool = False, workers=None) -> dict:
+        if not jobs:
+            return {}
+        n = 4 * self.workers()
+        chunks = [jobs[k::n] for k in range(min(n, len(jobs)))]
+        versions = tool_versions()
+        futures = self.client.map(_on_worker, chunks, optimize=optimize, validate=validate, versions=versions,
+                                  pure=False)
+        out = {}
+        for part in self.client.gather(futures):
+            out.update(part)
+        return out
+
+    def close(self) -> None:
+        self.client.close()
