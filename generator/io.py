@@ -55,7 +55,8 @@ def atomic_write(path: Path, data: bytes) -> bool:
 
 def show_progress() -> bool:
     """Progress bars on a terminal, quiet in CI and in pipes."""
-    return sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")
+    return (sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")
+            and not os.environ.get("SHADERMATRIX_QUIET"))
 
 
 # ------------------------------------------------------------------ the content-addressed store

@@ -320,7 +320,9 @@ def _write(res: BuildResult, out: Path, name: str, src, r) -> dict:
     data = src.text.encode()
     src_sha, spv_sha = sha256(data), sha256(r.spirv)
     rel_src = f"{src.language}/{name}.{src.stage}.{src_sha[:12]}.{src.language}"
-    rel_spv = f"{src.language}/{name}.{src.stage}.{spv_sha[:12]}.spv"
+    # SPIR-V is named by its content alone: identical modules (the vertex shaders of most permutations) are
+    # one file, and every manifest item that has them names it (aliased); sources keep their own header
+    rel_spv = f"{src.language}/{spv_sha[:16]}.{src.stage}.spv"
     _count(res, atomic_write(out / rel_src, data))
     _count(res, atomic_write(out / rel_spv, r.spirv))
     return {"source": rel_src, "source_sha256": src_sha, "spirv": rel_spv, "spirv_sha256": spv_sha,

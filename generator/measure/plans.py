@@ -124,8 +124,8 @@ class Row:
 class _Batch:
     """Shaders to compile once each (eval kernels and permutation fragment shaders), then their costs."""
 
-    def __init__(self, lib: Library, languages, vert: bool = False):
-        self.lib, self.languages = lib, tuple(languages)
+    def __init__(self, lib: Library, languages, vert: bool = False, store=None):
+        self.lib, self.languages, self.store = lib, tuple(languages), store
         self.vert = vert  # compile the vertex shaders of permutation units too (graphics pipelines for --gpu)
         self.units: dict[str, Composed | str] = {}  # unit key -> composed, or an error message
         self.results: dict = {}
@@ -152,7 +152,7 @@ class _Batch:
                 if (src.stage in ("comp", "frag") or (self.vert and src.stage == "vert")) and k not in seen:
                     seen.add(k)
                     jobs.append(CompileJob(k, src.language, src.stage, src.text, line_map=tuple(src.line_map)))
-        self.results = compile_many(jobs, progress=show_progress())
+        self.results = compile_many(jobs, progress=show_progress(), store=self.store)
 
     def spirv(self, unit: str, language: str) -> tuple[str, dict[str, bytes]] | None:
         """(job key, {stage: SPIR-V}) of a unit in one language, None when it did not build."""
@@ -235,11 +235,11 @@ class _Plan:
     course: CourseFigure | None = None
 
 
-def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None) -> list[Row]:
+def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -> list[Row]:
     """Per-brick and per-model rows; `lib` must include the stand-ins (see load_cost_library).
 
     gpu: a measure.gpu.GpuRequest, to add RADV's statistics (with minus without) to every row."""
-    batch = _Batch(lib, languages, vert=gpu is not None)
+    batch = _Batch(lib, languages, vert=gpu is not None, store=store)
     sd, ss = standin(lib, "diffuse").id, standin(lib, "specular").id
 
     def pair(kind: str, spec: str) -> str:
@@ -343,13 +343,13 @@ def _attach_gpu(gpu, pairs) -> None:
 
 # ------------------------------------------------------------------ per permutation
 
-def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None) -> list[Row]:
+def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -> list[Row]:
     """Fragment and vertex shader cost of every permutation of a scene and of its ubershader, per language.
 
     gpu: a measure.gpu.GpuRequest, to add RADV's statistics to every row."""
     from ..compose.uber import compose_ubershader
 
-    composed, errors, results = compile_scene(scene, lib, languages)
+    composed, errors, results = compile_scene(scene, lib, languages, store=store)
     rows, pairs = [], []
 
     def row_of(table, subject, perm_key, stage, lang, c_hash, course=None, objects=(), lights=0, error=None):
@@ -379,7 +379,7 @@ def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None)
             uber, _ = compose_ubershader(perms, lib, languages)
             jobs = [CompileJob(job_key("ubershader", src.stage, src.language), src.language, src.stage, src.text,
                                line_map=tuple(src.line_map)) for src in uber.sources]
-            results.update(compile_many(jobs, optimize=True, validate=True, progress=show_progress()))
+            results.update(compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store))
             failed = None
         except (SourceError, SpecError) as e:
             failed = str(e)

@@ -1,6 +1,7 @@
 """`shadermatrix build`: a scene's shader matrix in every language, validated, with manifest.json."""
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
@@ -20,6 +21,8 @@ def add_arguments(p) -> None:
                    help="tool processes at once (default: the core count); the output is the same for any N")
     p.add_argument("--executor", metavar="dask://HOST:PORT",
                    help="compile on a Dask distributed cluster (its workers need the pinned tools: README)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="no per-permutation lines and no progress bar: the summary line and errors only")
     p.add_argument("--depfile", metavar="PATH",
                    help="write a Make-syntax depfile (Ninja: deps = gcc): OUT/manifest.json and every file read")
 
@@ -28,7 +31,12 @@ def run(args) -> int:
     from ...library.bricks import load_library
     from ...build import build_scene
     from ...matrix.scene import load_scene
+    import time
+
     from ...io import Store, default_cache_dir
+    started = time.perf_counter()
+    if args.quiet:
+        os.environ["SHADERMATRIX_QUIET"] = "1"  # io.show_progress: no bar
     if args.no_cache and args.cache_dir:
         print("error: --no-cache and --cache-dir contradict each other — give one", file=sys.stderr)
         return 2
@@ -51,26 +59,30 @@ def run(args) -> int:
     finally:
         if executor is not None:
             executor.close()
+    seconds = time.perf_counter() - started
     if res.up_to_date:
         print(f"{scene.name}: {len(scene.permutations)} permutations up to date: 0 composed, 0 compiled; "
-              f"0 files written, {res.unchanged} unchanged → {args.out}/manifest.json")
+              f"0 files written, {res.unchanged} unchanged → {args.out}/manifest.json ({seconds:.2f} s)")
         return 0
     perms = res.manifest["permutations"]
     ok = sum(1 for p in perms if p["status"] == "ok")
-    print(f"{scene.name}: {len(scene.objects)} objects, {len(scene.materials)} materials, "
-          f"{len(scene.lights)} lights → {len(perms)} permutations × {len(res.manifest['languages'])} languages")
-    for p in perms:
-        print(f"  {p['status']:<6} {p['hash']}  {p['id']}  [{', '.join(p['languages'])}]  ({', '.join(p['objects'])})")
+    stale = sum(1 for p in perms if p["status"] == "stale")
+    if not args.quiet:
+        print(f"{scene.name}: {len(scene.objects)} objects, {len(scene.materials)} materials, "
+              f"{len(scene.lights)} lights → {len(perms)} permutations × {len(res.manifest['languages'])} languages")
+        for p in perms:
+            print(f"  {p['status']:<6} {p['hash']}  {p['id']}  [{', '.join(p['languages'])}]  ({', '.join(p['objects'])})")
     uber = res.manifest.get("ubershader") or {}
-    if uber:
+    if uber and not args.quiet:
         t = uber.get("tables", {})
         print(f"  {uber['status']:<6} ubershader    {len(t.get('variants', []))} material variants, light types "
               f"{', '.join(t.get('light_types', []))}, shadows {', '.join(t.get('shadows', []))}: every permutation reachable"
               if uber["status"] == "ok" else f"  {uber['status']:<6} ubershader")
     c = res.compile
-    print(f"{ok}/{len(perms)} permutations valid SPIR-V in every language; {c.jobs} shaders, {c.distinct} distinct "
+    print(f"{ok}/{len(perms)} permutations valid SPIR-V in every language ({res.kept} up to date, "
+          f"{len(perms) - ok - stale} failed, {stale} stale); {c.jobs} shaders, {c.distinct} distinct "
           f"({c.jobs - c.distinct} merged), {c.cached} from the cache, {c.compiled} compiled; "
-          f"{res.written} files written, {res.unchanged} unchanged → {args.out}/manifest.json")
+          f"{res.written} files written, {res.unchanged} unchanged → {args.out}/manifest.json ({seconds:.1f} s)")
     for f in res.failures:
         print(f"error: {f}", file=sys.stderr)
     return 0 if res.ok else 1

@@ -13,6 +13,8 @@ def add_arguments(p) -> None:
     p.add_argument("--brick-dir", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
     p.add_argument("--format", choices=("md", "csv", "json"), default="md", help="output format (default md)")
+    p.add_argument("--no-cache", action="store_true",
+                   help="compile everything; by default shaders come from the compile cache `build` fills")
     p.add_argument("--gpu", nargs="?", const="default", metavar="FAMILIES",
                    help="add AMD compiler statistics from Mesa RADV's null device (no GPU needed) for these "
                         "comma-separated families; alone: polaris10,navi21,vangogh,navi31")
@@ -28,6 +30,8 @@ def run(args) -> int:
     from ...measure.plans import brick_rows, course_models, load_cost_library, scene_rows
     from ...measure.report import markdown, to_csv, to_json
 
+    from ...io import Store, default_cache_dir
+    store = None if args.no_cache else Store(default_cache_dir())
     gpu = None
     if args.gpu is not None:
         from ...measure.gpu import GpuRequest
@@ -47,14 +51,14 @@ def run(args) -> int:
         return 2
     models = None
     if args.bricks:
-        rows = brick_rows(load_cost_library(args.brick_dir), gpu=gpu)
+        rows = brick_rows(load_cost_library(args.brick_dir), gpu=gpu, store=store)
         subject, title, models = "bricks", "Costs per brick", course_models()[0]
     else:
         from ...library.bricks import load_library
         from ...matrix.scene import load_scene
         lib = load_library(args.brick_dir)
         scene = load_scene(args.scene, lib)
-        rows = scene_rows(scene, lib, gpu=gpu)
+        rows = scene_rows(scene, lib, gpu=gpu, store=store)
         subject, title = scene.name, f"Costs of scene {scene.name}"
     if args.format == "md":
         sys.stdout.write(markdown(rows, title, models, gpu))
