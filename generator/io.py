@@ -37,8 +37,9 @@ def atomic_write(path: Path, data: bytes) -> bool:
         pass
     path.parent.mkdir(parents=True, exist_ok=True)
     # Created with mode 0666 and O_EXCL: the kernel applies the umask, as for any file a program writes
-    # (tempfile.mkstemp would give 0600); the name is this process's and unique within it.
-    tmp = path.parent / f".{path.name}.{os.getpid()}-{next(_TMP_SERIAL)}.tmp"
+    # (tempfile.mkstemp would give 0600). The random part: a killed process's leftover of the same pid
+    # (containers reuse pids run after run) never stands in the way.
+    tmp = path.parent / f".{path.name}.{os.getpid()}-{next(_TMP_SERIAL)}-{os.urandom(4).hex()}.tmp"
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o666)
     try:
         with os.fdopen(fd, "wb") as f:
@@ -66,12 +67,17 @@ def content_key(*parts) -> str:
     return sha256(json.dumps(parts, sort_keys=True, separators=(",", ":")).encode())
 
 
-def default_cache_dir() -> Path:
+def default_cache_dir() -> Path | None:
     """$SHADERMATRIX_CACHE_DIR, else $XDG_CACHE_HOME/shadermatrix, else ~/.cache/shadermatrix (a per-user
-    directory, never the source tree)."""
+    directory, never the source tree); None when there is no home directory to put it in."""
     if os.environ.get("SHADERMATRIX_CACHE_DIR"):
         return Path(os.environ["SHADERMATRIX_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    base = os.environ.get("XDG_CACHE_HOME")
+    if not base:
+        try:
+            base = str(Path.home() / ".cache")
+        except RuntimeError:  # no $HOME and no passwd entry (some containers)
+            return None
     return Path(base) / "shadermatrix"
 
 
@@ -88,6 +94,7 @@ class Store:
     def __init__(self, root):
         self.root = Path(root)
         self.hits = self.misses = self.corrupt = self.written = 0
+        self.unwritable = ""  # why puts stopped (a read-only or full cache): the build goes on without them
         self._lock = threading.Lock()
 
     def _path(self, namespace: str, key: str) -> Path:
@@ -117,8 +124,19 @@ class Store:
         return payload
 
     def put(self, namespace: str, key: str, payload: bytes) -> None:
-        if atomic_write(self._path(namespace, key), payload + hashlib.sha256(payload).digest()):
-            self._count("written")
+        """Store an entry; a cache that cannot be written (read-only, full, not a directory) is said once on
+        stderr and then left alone: the build never fails for its cache."""
+        if self.unwritable:
+            return
+        try:
+            if atomic_write(self._path(namespace, key), payload + hashlib.sha256(payload).digest()):
+                self._count("written")
+        except OSError as e:
+            with self._lock:
+                if not self.unwritable:
+                    self.unwritable = f"{e.filename or self.root}: {e.strerror or e}"
+                    print(f"warning: the compile cache cannot be written ({self.unwritable}) — building without "
+                          "storing into it", file=sys.stderr)
 
     def entries(self) -> dict[str, tuple[int, int]]:
         """{namespace: (entries, bytes)} of what is stored now."""

@@ -651,3 +651,25 @@ def test_stress_set_covers_the_extremes_of_every_tangent_row_of_the_inputs_table
             zero = [i for i, s in enumerate(labels) if s.startswith(f"{row.name} = 0")]
             assert hi and zero, row.name
             assert np.all(np.abs(g[row.name][hi]) > 0.99) and np.all(np.abs(g[row.name][zero]) < 1e-12), row.name
+
+
+def test_bricks_linked_once_and_shared_compose_what_a_fresh_library_composes():
+    """Library.memo shares linked brick functions between programs and the emitters replay their text
+    (link/program.py, targets/clike.py): sound only while nothing changes a linked function afterwards.
+    Composing the example's permutations in two orders on one library, after its ubershader, must give
+    exactly what a fresh library gives for each."""
+    from generator.compose import compose_permutation
+    from generator.compose.uber import compose_ubershader
+    from generator.matrix.scene import load_scene
+
+    def sources(lib, perm):
+        return [(s.language, s.stage, s.text) for s in compose_permutation(perm, lib).sources]
+
+    scene = load_scene(REPO / "scenes" / "example.toml", load_library())
+    perms = [p for _, p in sorted(scene.permutations.items())]
+    fresh = {p.canonical(): sources(load_library(), p) for p in perms}
+    shared = load_library()
+    compose_ubershader(perms, shared)
+    for p in [*perms, *reversed(perms)]:
+        assert sources(shared, p) == fresh[p.canonical()], p.canonical()
+    assert shared.memo  # the library did keep linked nodes

@@ -46,7 +46,9 @@ class BuildResult:
     kept: int = 0  # permutations up to date: not composed, compiled or analysed
     store: object = None  # the io.Store used, or None
     up_to_date: bool = False  # nothing at all to do: the manifest was not even read
+    aliased: int = 0  # SPIR-V files another item of this build already wrote (identical modules: one file)
     _manifest: dict | None = None
+    _done: set = field(default_factory=set)  # files this build has written or found in place
 
     @property
     def ok(self) -> bool:
@@ -91,8 +93,6 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     with locked(out):
         clean_leftovers(out)
         res = _build(scene, lib, out, languages, store, workers, executor)
-        if res._manifest is not None:  # something was (re)written: drop what the new manifest no longer names
-            collect_garbage(out, res._manifest)
         if depfile is not None:
             write_depfile(depfile, shown(out / "manifest.json"), _deps(scene, lib, out))
     return res
@@ -124,9 +124,16 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     users: dict[str, list[dict]] = {}
     for o in scene.objects:
         users.setdefault(o["permutation"], []).append(o)
-    keys = {h: _perm_key(base, scene, lib, perm, users.get(h, [])) for h, perm in sorted(scene.permutations.items())}
-    uber_key = content_key(base, "ubershader", [keys[h] for h in sorted(keys)])
-    files = _up_to_date(out, keys, uber_key)
+    keys, shapes = {}, {}
+    for h, perm in sorted(scene.permutations.items()):
+        keys[h], shapes[h] = _perm_key(base, scene, lib, perm, users.get(h, []))
+    # the ubershader reads no scene values: its key is the permutations' keys without them
+    uber_key = content_key(base, "ubershader", [shapes[h] for h in sorted(shapes)])
+    # what the manifest's scene-wide tables hold beyond the permutations: name, light sets, objects in order
+    scene_key = content_key(base, scene.name, sorted((k, list(v)) for k, v in scene.light_sets.items()),
+                            [[o["name"], o["material"], o["light_set"], o["permutation"]] for o in scene.objects],
+                            sorted(repr(m) for m in scene.materials.values()), sorted(repr(x) for x in scene.lights.values()))
+    files = _up_to_date(out, keys, uber_key, scene_key)
     if files is not None:  # the record of the last build says every key and file is as it left them
         res.up_to_date, res.kept, res.unchanged = True, len(keys), files + 1
         return res
@@ -185,7 +192,8 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     else:
         text = (json.dumps(res.manifest, indent=2, sort_keys=False) + "\n").encode()
         _count(res, atomic_write(out / "manifest.json", text))
-    _record(out, res.manifest, text, keys, uber_key, res.kept)
+    collect_garbage(out, res.manifest)  # the new manifest is in place: drop what it no longer names
+    _record(out, res.manifest, text, keys, uber_key, res.kept, scene_key)  # last: the no-op check trusts it
     return res
 
 
@@ -202,7 +210,7 @@ def _settle(res: BuildResult, entry: dict, errs: list[str], old: dict | None, ou
     return {**entry, "languages": {}, "status": "failed", "errors": errs, "failed_sources": failed}
 
 
-def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, kept: int) -> None:
+def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, kept: int, scene_key: str) -> None:
     """What the next build checks first: every input key, the manifest's sha256, every file's size; and the
     templates composed with (for the depfile of a build that composes nothing)."""
     templates = set(_templates_read())
@@ -214,18 +222,19 @@ def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, k
     ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
         (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
     entries = [*manifest["permutations"], manifest.get("ubershader") or {}]
-    state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys, "ubershader": uber_key,
+    state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys, "ubershader": uber_key, "scene": scene_key,
              "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)},
              "templates": sorted(templates)}
     atomic_write(out / STATE, (json.dumps(state, sort_keys=True) + "\n").encode())
 
 
-def _up_to_date(out: Path, keys: dict, uber_key: str) -> int | None:
+def _up_to_date(out: Path, keys: dict, uber_key: str, scene_key: str) -> int | None:
     """The number of files the last build left when nothing at all needs doing (its record has these keys,
     the manifest is the one it wrote, every file it listed has its size), else None."""
     try:
         state = json.loads((out / STATE).read_text())
-        if not (state.get("complete") and state.get("keys") == keys and state.get("ubershader") == uber_key):
+        if not (state.get("complete") and state.get("keys") == keys and state.get("ubershader") == uber_key
+                and state.get("scene") == scene_key):
             return None
         if sha256((out / "manifest.json").read_bytes()) != state["manifest_sha256"]:
             return None
@@ -252,8 +261,9 @@ def _globals(languages) -> str:
     return content_key("build-v1", __version__, _own_sources(), tool_versions(), list(languages))
 
 
-def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> str:
-    """Everything a permutation's outputs depend on (see build_scene); objs: the objects drawn with it."""
+def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> tuple[str, str]:
+    """(Everything a permutation's outputs depend on (see build_scene), the same without the scene values);
+    objs: the objects drawn with it."""
     try:
         r = resolve(perm, lib)
         nodes = [*r.brdf, r.packing, *(n for _, n in r.lights)]
@@ -265,16 +275,27 @@ def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> 
     lights = sorted({ln for o in objs for ln in o["lights"]})
     values = {"objects": [[o["name"], o["material"], o["light_set"], list(o["lights"])] for o in objs],
               "materials": [repr(scene.materials[m]) for m in mats], "lights": [repr(scene.lights[ln]) for ln in lights]}
-    return content_key(base, perm.canonical(), sorted(bricks.items()), values)
+    shape = content_key(base, perm.canonical(), sorted(bricks.items()))
+    return content_key(shape, values), shape
 
 
 def _previous(out: Path) -> dict:
-    """The manifest an earlier build left (an unreadable one counts as none: everything is rebuilt)."""
+    """The manifest an earlier build left; an unreadable or malformed one (edited by hand, damaged) counts as
+    none: everything is rebuilt."""
     try:
         m = json.loads((out / "manifest.json").read_text())
-        return m if isinstance(m, dict) else {}
     except (OSError, ValueError):
         return {}
+    if not isinstance(m, dict):
+        return {}
+    perms, uber = m.get("permutations", []), m.get("ubershader") or {}
+    try:
+        ok = (isinstance(perms, list) and isinstance(uber, dict)
+              and all(isinstance(e, dict) and isinstance(e.get("hash"), str) for e in perms)
+              and all(isinstance(x, str) for e in [*perms, uber] for pair in _items(e) for x in pair))
+    except (AttributeError, TypeError, KeyError):
+        ok = False
+    return m if ok else {}
 
 
 def _items(entry: dict):
@@ -291,7 +312,7 @@ def _intact(out: Path, entry: dict) -> bool:
     """Every file an entry lists is there with the sha256 it records."""
     try:
         return all(sha256((out / rel).read_bytes()) == digest for rel, digest in _items(entry))
-    except (OSError, TypeError):
+    except (OSError, TypeError, KeyError, AttributeError):
         return False
 
 
@@ -324,7 +345,11 @@ def _write(res: BuildResult, out: Path, name: str, src, r) -> dict:
     # one file, and every manifest item that has them names it (aliased); sources keep their own header
     rel_spv = f"{src.language}/{spv_sha[:16]}.{src.stage}.spv"
     _count(res, atomic_write(out / rel_src, data))
-    _count(res, atomic_write(out / rel_spv, r.spirv))
+    if rel_spv in res._done:
+        res.aliased += 1
+    else:
+        res._done.add(rel_spv)
+        _count(res, atomic_write(out / rel_spv, r.spirv))
     return {"source": rel_src, "source_sha256": src_sha, "spirv": rel_spv, "spirv_sha256": spv_sha,
             "cost": cost_dict(r.spirv, res.store)}
 

@@ -20,6 +20,7 @@ import re
 import shutil
 import sys
 import tempfile
+import time
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -58,17 +59,30 @@ def _alive(pid: int) -> bool:
     return True
 
 
+STALE_S = 600  # a temp dir of a process that is gone, and untouched this long, is a leftover
+
+
 def clean_leftovers(out: Path) -> int:
-    """Remove an interrupted build's temporary files (output tree) and directories (system temp dir)."""
+    """Remove an interrupted build's temporary files (the output tree's own directories: the lock is ours, so
+    no other build writes there) and directories (system temp dir: of a dead process, untouched for
+    STALE_S seconds, since a process in another pid namespace that shares /tmp looks dead from here)."""
     gone = 0
-    for p in out.rglob(".*.tmp"):
-        if p.is_file() and OWN_TMP.match(p.name):
-            p.unlink(missing_ok=True)
-            gone += 1
+    for d in [out, *(out / lang for lang in LANGUAGES)]:
+        if not d.is_dir():
+            continue
+        for p in d.glob(".*.tmp"):
+            if p.is_file() and OWN_TMP.match(p.name):
+                p.unlink(missing_ok=True)
+                gone += 1
     tmp = Path(tempfile.gettempdir())
+    now = time.time()
     for d in tmp.glob("shadermatrix-*"):
         m = TEMP_DIR.match(d.name)
-        if m and d.is_dir() and int(m[1]) != os.getpid() and not _alive(int(m[1])):
+        try:
+            old = now - d.stat().st_mtime > STALE_S
+        except OSError:
+            continue
+        if m and d.is_dir() and old and int(m[1]) != os.getpid() and not _alive(int(m[1])):
             shutil.rmtree(d, ignore_errors=True)
             gone += 1
     return gone

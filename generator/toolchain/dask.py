@@ -52,6 +52,12 @@ class DaskExecutor:
             raise UserError(f"no Dask scheduler at {address}: {e} — start one (`dask scheduler`) or check the "
                             "address") from None
         self.address = address
+        try:
+            self.client.wait_for_workers(1, timeout=30)
+        except Exception:  # noqa: BLE001 — distributed's TimeoutError or a closed scheduler
+            self.client.close()
+            raise UserError(f"the Dask scheduler at {address} has no workers (waited 30 s) — start one "
+                            f"(`dask worker {address}`)") from None
 
     def workers(self) -> int:
         return max(1, len(self.client.scheduler_info().get("workers", {})))
@@ -65,7 +71,14 @@ class DaskExecutor:
         futures = self.client.map(_on_worker, chunks, optimize=optimize, validate=validate, versions=versions,
                                   pure=False)
         out = {}
-        for part in self.client.gather(futures):
+        try:
+            parts = self.client.gather(futures)
+        except UserError:
+            raise
+        except Exception as e:  # noqa: BLE001 — a worker died (KilledWorker), the connection closed …
+            raise UserError(f"the Dask cluster at {self.address} failed the compile: {type(e).__name__}: {e} — "
+                            "check its workers, or build without --executor") from None
+        for part in parts:
             out.update(part)
         return out
 

@@ -35,14 +35,19 @@ def run(args) -> int:
 
     from ...io import Store, default_cache_dir
     started = time.perf_counter()
+    quiet_before = os.environ.get("SHADERMATRIX_QUIET")
     if args.quiet:
-        os.environ["SHADERMATRIX_QUIET"] = "1"  # io.show_progress: no bar
+        os.environ["SHADERMATRIX_QUIET"] = "1"  # io.show_progress: no bar (restored when the build ends)
     if args.no_cache and args.cache_dir:
         print("error: --no-cache and --cache-dir contradict each other — give one", file=sys.stderr)
         return 2
     lib = load_library(args.bricks or ())
     scene = load_scene(args.scene, lib)
-    store = None if args.no_cache else Store(args.cache_dir or default_cache_dir())
+    root = args.cache_dir or default_cache_dir()
+    if root is None and not args.no_cache:
+        print("note: no home directory for the compile cache — building without it (--cache-dir DIR to keep one)",
+              file=sys.stderr)
+    store = None if args.no_cache or root is None else Store(root)
     if args.jobs is not None and args.jobs < 1:
         print(f"error: -j {args.jobs}: give at least one job", file=sys.stderr)
         return 2
@@ -59,6 +64,8 @@ def run(args) -> int:
     finally:
         if executor is not None:
             executor.close()
+        if args.quiet and quiet_before is None:
+            os.environ.pop("SHADERMATRIX_QUIET", None)
     seconds = time.perf_counter() - started
     if res.up_to_date:
         print(f"{scene.name}: {len(scene.permutations)} permutations up to date: 0 composed, 0 compiled; "
@@ -82,7 +89,8 @@ def run(args) -> int:
     print(f"{ok}/{len(perms)} permutations valid SPIR-V in every language ({res.kept} up to date, "
           f"{len(perms) - ok - stale} failed, {stale} stale); {c.jobs} shaders, {c.distinct} distinct "
           f"({c.jobs - c.distinct} merged), {c.cached} from the cache, {c.compiled} compiled; "
-          f"{res.written} files written, {res.unchanged} unchanged → {args.out}/manifest.json ({seconds:.1f} s)")
+          f"{res.written} files written, {res.unchanged} unchanged, {res.aliased} SPIR-V shared → "
+          f"{args.out}/manifest.json ({seconds:.1f} s)")
     for f in res.failures:
         print(f"error: {f}", file=sys.stderr)
     return 0 if res.ok else 1

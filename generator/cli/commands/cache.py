@@ -1,6 +1,8 @@
 """`shadermatrix cache stats|clear`: the content-addressed compile cache that `build` reads and fills."""
 from __future__ import annotations
 
+import sys
+
 HELP = "the content-addressed compile cache: what it holds (stats) or empty it (clear)"
 
 
@@ -13,7 +15,11 @@ def add_arguments(p) -> None:
 
 def run(args) -> int:
     from ...io import Store, default_cache_dir
-    store = Store(args.cache_dir or default_cache_dir())
+    root = args.cache_dir or default_cache_dir()
+    if root is None:
+        print("error: no cache directory: there is no home directory — give --cache-dir DIR", file=sys.stderr)
+        return 1
+    store = Store(root)
     if args.action == "clear":
         print(f"{store.clear()} entries removed from {store.root}")
         return 0

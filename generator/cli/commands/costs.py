@@ -13,6 +13,7 @@ def add_arguments(p) -> None:
     p.add_argument("--brick-dir", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
     p.add_argument("--format", choices=("md", "csv", "json"), default="md", help="output format (default md)")
+    p.add_argument("--cache-dir", metavar="DIR", help="the compile cache (default: as `build`'s)")
     p.add_argument("--no-cache", action="store_true",
                    help="compile everything; by default shaders come from the compile cache `build` fills")
     p.add_argument("--gpu", nargs="?", const="default", metavar="FAMILIES",
@@ -31,7 +32,8 @@ def run(args) -> int:
     from ...measure.report import markdown, to_csv, to_json
 
     from ...io import Store, default_cache_dir
-    store = None if args.no_cache else Store(default_cache_dir())
+    root = args.cache_dir or default_cache_dir()
+    store = None if args.no_cache or root is None else Store(root)
     gpu = None
     if args.gpu is not None:
         from ...measure.gpu import GpuRequest
