@@ -152,8 +152,19 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
                    line_map=tuple(s.line_map)) for s in uber_unit[0].sources]
     todo = Scene(**{**scene.__dict__, "permutations": {h: p for h, p in scene.permutations.items() if h not in kept}})
+    built: dict[str, dict] = {}
+
+    def written(pairs, part):  # a compiled chunk: written and analysed while the next chunks compile
+        for h, c in pairs:
+            perm = scene.permutations[h]
+            entry = {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
+                     "languages": {}, "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
+                     "uploads": uploads(scene, h, c)}
+            errs = _write_all(res, out, h, c.sources, part, entry)
+            built[h] = _settle(res, entry, errs, old.get(h), out, f"{h} ({perm.canonical()})")
+
     composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra,
-                                              workers=workers, executor=executor)
+                                              workers=workers, executor=executor, on_done=written)
     res.kept = len(kept)
 
     entries = []
@@ -161,17 +172,12 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         if h in kept:
             entries.append(kept[h])
             res.unchanged += _files(kept[h])
-            continue
-        entry = {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
-                 "languages": {}}
-        errs = list(errors.get(h, []))
-        c = composed.get(h)
-        if c is not None:
-            entry["bricks"] = dict(sorted(c.bricks.items()))
-            entry["interface"] = c.interface.as_dict()
-            entry["uploads"] = uploads(scene, h, c)
-            errs += _write_all(res, out, h, c.sources, results, entry)
-        entries.append(_settle(res, entry, errs, old.get(h), out, f"{h} ({perm.canonical()})"))
+        elif h in built:
+            entries.append(built[h])
+        else:  # it did not compose
+            entry = {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
+                     "languages": {}}
+            entries.append(_settle(res, entry, list(errors.get(h, [])), old.get(h), out, f"{h} ({perm.canonical()})"))
     if uber_kept:
         uber = old_uber
         res.unchanged += _files(uber)

@@ -451,13 +451,15 @@ class CompileStats:
 
 def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate: bool = True,
                  progress: bool = False, store=None, stats: CompileStats | None = None,
-                 workers: int | None = None, executor=None) -> dict[str, CompileResult]:
+                 workers: int | None = None, executor=None, memo: dict | None = None) -> dict[str, CompileResult]:
     """Compile and validate every job; returns {key: CompileResult} in input order.
 
     Jobs with the same :func:`cache_key` are compiled once (identical shaders, e.g. vertex shaders whose
     sources differ only in their provenance header). store: an io.Store; a job whose key is there is
     served from it (no tool runs) and every successful compile is put there. Failures are not stored
     (their diagnostics name each job's own lines), and a job whose twin failed is compiled on its own.
+    memo: a dict (cache key -> result) shared by several calls of one build: a shader another call
+    compiled is not compiled again (and not counted distinct again).
     stats: a CompileStats to fill in. workers: how many tool processes run at once (default: the core
     count). executor: where the compiles run instead of here (toolchain/dask.py: a Dask cluster); the
     store, deduplication and results are the same wherever they ran.
@@ -481,14 +483,20 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
     groups: dict[str, list[CompileJob]] = {}
     for job in jobs:
         groups.setdefault(keys[job.key], []).append(job)
-    stats.distinct += len(groups)
     results: dict[str, CompileResult] = {}
     todo = []
     for ck, members in groups.items():
+        if memo is not None and ck in memo:  # compiled by an earlier call of this build
+            for job in members:
+                results[job.key] = _renamed(memo[ck], job.key)
+            continue
+        stats.distinct += 1
         data = store.get(COMPILE_NAMESPACE, ck) if store is not None else None
         hit = _decode(data, members[0].key) if data is not None else None
         if hit is not None:
             stats.cached += 1
+            if memo is not None:
+                memo[ck] = hit
             for job in members:
                 results[job.key] = _renamed(hit, job.key)
         else:
@@ -503,6 +511,8 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
         if r.ok:
             if store is not None:
                 store.put(COMPILE_NAMESPACE, keys[first.key], _encode(r))
+            if memo is not None:
+                memo[keys[first.key]] = r
             for job in members:
                 results[job.key] = _renamed(r, job.key)
         else:

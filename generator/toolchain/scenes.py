@@ -18,28 +18,92 @@ def job_key(h: str, stage: str, lang: str) -> str:
     return f"{h}.{stage}.{lang}"
 
 
+CHUNK = 64  # permutations composed per compile batch when pipelining
+
+
 def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, stats=None, extra=(), workers=None,
-                  executor=None
+                  executor=None, on_done=None
                   ) -> tuple[dict[str, Composed], dict[str, list[str]], dict[str, CompileResult]]:
     """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key).
 
     store, stats: as compile_many takes them (the content-addressed cache; what the compile did).
     extra: more CompileJobs for the same batch (the ubershader: its large shaders start with the others
-    instead of after them)."""
+    instead of after them).
+    on_done([(hash, Composed)], results): pipelined. Permutations are composed CHUNK at a time and each chunk is
+    compiled on a thread of its own as soon as it is composed, while this thread composes the next one;
+    on_done is called here, in chunk order, for every compiled chunk (as soon as it is, between composing
+    later ones), so that writing and analysing overlap the compilers too. Shaders identical across chunks
+    are compiled once (an in-memory record beside the store).
+    """
+    import queue
+    import threading
+
     from ..compose import compose_permutation  # Jinja and the emitters load only when something is composed
     composed: dict[str, Composed] = {}
     errors: dict[str, list[str]] = {}
-    jobs: list[CompileJob] = list(extra)
-    for h, perm in sorted(scene.permutations.items()):
-        try:
-            c = compose_permutation(perm, lib, languages)
-        except SourceError as e:
-            errors[h] = [str(e)]
-            continue
-        composed[h] = c
-        for src in c.sources:
-            jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
-                                   line_map=tuple(src.line_map)))
-    results = compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store, stats=stats,
-                           workers=workers, executor=executor)
+    results: dict[str, CompileResult] = {}
+    items = sorted(scene.permutations.items())
+    size = CHUNK if on_done is not None else max(1, len(items))
+    chunks = [items[k:k + size] for k in range(0, len(items), size)] or [[]]
+    memo: dict = {}
+    todo: queue.Queue = queue.Queue()
+    finished: queue.Queue = queue.Queue()
+
+    def compiler():
+        while True:
+            got = todo.get()
+            if got is None:
+                return
+            k, jobs = got
+            try:
+                finished.put((k, compile_many(jobs, optimize=True, validate=True, progress=show_progress(),
+                                              store=store, stats=stats, workers=workers, executor=executor,
+                                              memo=memo), None))
+            except BaseException as e:  # re-raised on this thread's caller
+                finished.put((k, None, e))
+
+    thread = threading.Thread(target=compiler, name="compile", daemon=True)
+    thread.start()
+    hashes_of: dict[int, list[str]] = {}
+    pending, next_done = 0, 0
+    done_results: dict[int, dict] = {}
+
+    def deliver(block: bool) -> None:
+        nonlocal pending, next_done
+        while pending and (block or not finished.empty()):
+            k, res, exc = finished.get()
+            pending -= 1
+            if exc is not None:
+                raise exc
+            done_results[k] = res
+            while next_done in done_results:  # in chunk order
+                part = done_results.pop(next_done)
+                results.update(part)
+                if on_done is not None:
+                    on_done([(h, composed[h]) for h in hashes_of[next_done]], part)
+                next_done += 1
+            block = block and pending > 0
+
+    try:
+        for k, chunk in enumerate(chunks):
+            jobs: list[CompileJob] = list(extra) if k == 0 else []
+            hashes_of[k] = []
+            for h, perm in chunk:
+                try:
+                    c = compose_permutation(perm, lib, languages)
+                except SourceError as e:
+                    errors[h] = [str(e)]
+                    continue
+                composed[h] = c
+                hashes_of[k].append(h)
+                for src in c.sources:
+                    jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
+                                           line_map=tuple(src.line_map)))
+            todo.put((k, jobs))
+            pending += 1
+            deliver(block=False)
+        deliver(block=True)
+    finally:
+        todo.put(None)
+        thread.join()
     return composed, errors, results
