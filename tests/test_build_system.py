@@ -154,14 +154,20 @@ def test_a_failing_permutation_keeps_its_last_good_outputs_marked_stale(tmp_path
 def test_permutations_that_leave_the_scene_leave_the_tree(tmp_path):
     out = tmp_path / "out"
     assert _cli("build", EXAMPLE, "--out", out).returncode == 0
-    n = len(_consistent(out)["permutations"])
+    first = {e["hash"] for e in _consistent(out)["permutations"]}
+    n = len(first)
     fewer = tmp_path / "fewer.toml"
     text = EXAMPLE.read_text()
     fewer.write_text(text[:text.index("[[objects]]")] + '[[objects]]\nname = "only"\nmaterial = "red_plastic"\n'
                      'lights = "indoor"\n')
+    assert _cli("build", fewer, "--out", out, "--keep-removed").returncode == 0  # kept, and listed as removed
+    m = _consistent(out)
+    assert len(m["permutations"]) == 1
+    assert {e["hash"] for e in m["removed"]} == first - {m["permutations"][0]["hash"]}
+    assert all(e["status"] == "removed" for e in m["removed"])
     assert _cli("build", fewer, "--out", out).returncode == 0
     m = _consistent(out)
-    assert len(m["permutations"]) == 1 < n
+    assert len(m["permutations"]) == 1 < n and "removed" not in m
 
 
 def test_moving_an_engine_brick_directory_changes_no_output_and_no_output_names_this_machine(tmp_path):

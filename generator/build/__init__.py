@@ -67,13 +67,14 @@ class BuildResult:
 
 
 def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None, depfile=None,
-                workers: int | None = None, executor=None) -> BuildResult:
+                workers: int | None = None, executor=None, keep_removed: bool = False) -> BuildResult:
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     store: an io.Store (the content-addressed cache): compiled shaders and their costs are served from it
     and put into it; None compiles everything. depfile: where to write a Make-syntax depfile (or None).
     workers: tool processes at once (default: the core count); executor: where compiles run instead
-    (toolchain/dask.py). Neither changes a byte of the output.
+    (toolchain/dask.py). Neither changes a byte of the output. keep_removed: the outputs of permutations that
+    left the scene stay, listed under the manifest's ``removed`` (marked so), instead of being deleted.
 
     Incremental: each permutation's manifest entry records ``input_key``, the sha256 of everything its
     outputs depend on (its key, the source of every brick it reads, the scene values of the objects that
@@ -92,7 +93,7 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     out = Path(out)
     with locked(out):
         clean_leftovers(out)
-        res = _build(scene, lib, out, languages, store, workers, executor)
+        res = _build(scene, lib, out, languages, store, workers, executor, keep_removed)
         if depfile is not None:
             write_depfile(depfile, shown(out / "manifest.json"), _deps(scene, lib, out))
     return res
@@ -118,7 +119,8 @@ def _templates_read() -> list[str]:
     return sorted(str(Path(p).resolve().relative_to(_TEMPLATES)) for p in compose.loaded_templates())
 
 
-def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None, executor=None) -> BuildResult:
+def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None, executor=None,
+           keep_removed: bool = False) -> BuildResult:
     res = BuildResult(out, store=store)
     base = _globals(languages)
     users: dict[str, list[dict]] = {}
@@ -133,6 +135,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     scene_key = content_key(base, scene.name, sorted((k, list(v)) for k, v in scene.light_sets.items()),
                             [[o["name"], o["material"], o["light_set"], o["permutation"]] for o in scene.objects],
                             sorted(repr(m) for m in scene.materials.values()), sorted(repr(x) for x in scene.lights.values()))
+    scene_key = content_key(scene_key, keep_removed)
     files = _up_to_date(out, keys, uber_key, scene_key)
     if files is not None:  # the record of the last build says every key and file is as it left them
         res.up_to_date, res.kept, res.unchanged = True, len(keys), files + 1
@@ -192,6 +195,12 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         "ubershader": uber,
         **scene_tables(scene, composed, previous),
     }
+    if keep_removed:  # what left the scene stays, listed as such (its files intact), until a build without the flag
+        gone = [e for e in [*previous.get("permutations", []), *previous.get("removed", [])]
+                if e["hash"] not in scene.permutations and e.get("status") in ("ok", "stale", "removed")
+                and _intact(out, e)]
+        res.manifest["removed"] = [{**e, "status": "removed"} for e in sorted({e["hash"]: e for e in gone}.values(),
+                                                                             key=lambda e: e["hash"])]
     if res.manifest == previous and (out / "manifest.json").is_file():  # nothing changed: not even re-encoded
         _count(res, False)
         text = (out / "manifest.json").read_bytes()
@@ -227,7 +236,7 @@ def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, k
             pass
     ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
         (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
-    entries = [*manifest["permutations"], manifest.get("ubershader") or {}]
+    entries = [*manifest["permutations"], *manifest.get("removed", []), manifest.get("ubershader") or {}]
     state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys, "ubershader": uber_key, "scene": scene_key,
              "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)},
              "templates": sorted(templates)}

@@ -21,6 +21,9 @@ def add_arguments(p) -> None:
                    help="tool processes at once (default: the core count); the output is the same for any N")
     p.add_argument("--executor", metavar="dask://HOST:PORT",
                    help="compile on a Dask distributed cluster (its workers need the pinned tools: README)")
+    p.add_argument("--keep-removed", action="store_true",
+                   help="keep the outputs of permutations that left the scene, listed under the manifest's "
+                        "\"removed\" (default: they are deleted)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
     p.add_argument("--depfile", metavar="PATH",
@@ -60,7 +63,7 @@ def run(args) -> int:
         executor = DaskExecutor(args.executor)
     try:
         res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile, workers=args.jobs,
-                          executor=executor)
+                          executor=executor, keep_removed=args.keep_removed)
     finally:
         if executor is not None:
             executor.close()
