@@ -15,7 +15,6 @@ ubershader table). Counts, not times: the figures are the same on every run.
 """
 from __future__ import annotations
 
-import itertools
 import json
 import sys
 from pathlib import Path
@@ -23,6 +22,7 @@ from types import SimpleNamespace
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "benchmarks"))
 
 import numpy as np  # noqa: E402
 
@@ -44,16 +44,8 @@ LANGUAGES = ("hlsl", "glsl", "wgsl")
 
 def brdf_specs(lib) -> list[str]:
     """Every BRDF term the library builds, alone: each brick, and a brick with slots with every filler combination."""
-    specs = []
-    for kind in BRDF_KINDS:
-        for b in sorted(lib.of_kind(kind), key=lambda b: b.id):
-            if not b.slots:
-                specs.append(b.id)
-                continue
-            options = [[f"{slot}={f.id}" for f in sorted(lib.of_kind(v["kind"]), key=lambda f: f.id)]
-                       for slot, v in b.slots.items()]
-            specs += [f"{b.id}({','.join(c)})" for c in itertools.product(*options)]
-    return specs
+    from scenegen import _terms  # benchmarks/scenegen.py: the same enumeration the generated scenes use
+    return [t for kind in BRDF_KINDS for t in _terms(lib, kind)]
 
 
 def kernel_rows(lib, families) -> list:
