@@ -24,13 +24,46 @@ def at(loc, message: str, hint: str = "") -> SourceError:
     return SourceError(loc.path, loc.line, loc.col, message, hint)
 
 
+MAX_INPUT_BYTES = 16 << 20  # a brick or scene file larger than this is refused (the shipped ones are < 20 KB)
+
+
 def read_text(path, what: str) -> str:
-    """A UTF-8 file's text; a decoding or reading problem is a SourceError at the offending byte."""
+    """A UTF-8 file's text; a decoding or reading problem is a SourceError at the offending byte.
+
+    Only regular files are read (a FIFO would block forever, a device or a symlink to /dev/zero never
+    ends), and at most MAX_INPUT_BYTES of them: anything else is one located error.
+    """
+    import os
+    import stat
+
     shown = str(path)
     try:
-        data = open(path, "rb").read()
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))  # a FIFO opens without waiting
     except OSError as e:
         raise SourceError(shown, 1, 1, f"cannot read {what}: {e.strerror}", "check the path") from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            kind = ("a FIFO" if stat.S_ISFIFO(st.st_mode) else "a device" if stat.S_ISCHR(st.st_mode) or
+                    stat.S_ISBLK(st.st_mode) else "a socket" if stat.S_ISSOCK(st.st_mode) else "not a file")
+            raise SourceError(shown, 1, 1, f"the {what} is {kind}, not a regular file", f"give a {what} file")
+        if st.st_size > MAX_INPUT_BYTES:
+            raise SourceError(shown, 1, 1, f"the {what} is {st.st_size} bytes, more than the {MAX_INPUT_BYTES} "
+                              "allowed", f"split it, or check that this is a {what}")
+        chunks, size = [], 0
+        while True:
+            part = os.read(fd, 1 << 20)
+            if not part:
+                break
+            size += len(part)
+            if size > MAX_INPUT_BYTES:
+                raise SourceError(shown, 1, 1, f"the {what} is more than {MAX_INPUT_BYTES} bytes", "check the path")
+            chunks.append(part)
+        data = b"".join(chunks)
+    except OSError as e:
+        raise SourceError(shown, 1, 1, f"cannot read {what}: {e.strerror}", "check the path") from None
+    finally:
+        os.close(fd)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as e:

@@ -148,9 +148,13 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     The brick id is the file stem; `shown` names it in messages and #line directives.
     """
     shown = shown or display(path)
-    if '"' in shown or "\n" in shown:
-        raise SourceError(shown.replace("\n", " "), 1, 1, "the brick's path contains a quote or a line break",
-                          "rename the file or its directory: the path is written into #line directives")
+    bad = sorted({c for c in shown if c == '"' or not c.isprintable()})
+    if bad:  # it is written into generated sources (#line, provenance comments): nothing there may end a line
+        what = ", ".join("a quote" if c == '"' else f"U+{ord(c):04X}" for c in bad)
+        safe = "".join(c if c.isprintable() and c != '"' else "?" for c in shown)
+        raise SourceError(safe, 1, 1, f"the brick's path contains {what} (a quote, a line break or another "
+                          "control character)", "rename the file or its directory: the path is written into #line "
+                          "directives and provenance comments")
     if text is None:
         text = read_text(path, "brick")
     meta, loc, doc = read_meta(text, shown)
