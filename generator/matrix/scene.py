@@ -128,11 +128,8 @@ def load_scene(path, lib: Library) -> Scene:
     if path.is_dir():
         raise SourceError(shown, 1, 1, "is a directory, not a scene file", "pass a .toml scene file")
     data, loc = read_toml(path, "scene", "fix the scene file's syntax")
-    known = {"scene", "materials", "lights", "light_sets", "objects"}
-    for key in data:
-        if key not in known:
-            raise loc.error(loc.top(key), f"unknown section '{key}'",
-                            f"sections: {', '.join(sorted(known))}")
+    from .schema import check
+    check(data, loc)  # the shape first: keys and types (matrix/schema.py), then what the names mean
     head = data.get("scene", {})
     output = head.get("output", "linear")
     precision = head.get("precision", "fp32")
@@ -150,7 +147,7 @@ def load_scene(path, lib: Library) -> Scene:
             raise loc.error(where, f"material '{name}' has no brdf", 'add brdf = "lambert+blinn_phong_normalized"')
         brdf = _spec(loc, f"materials.{name}", "brdf", m["brdf"], lambda s: canonical(parse_brdf(s, lib)))
         packing = _spec(loc, f"materials.{name}", "packing", m.get("packing", "constants"),
-                        lambda s: canonical(parse_spec(s, lib, ("packing",))))
+                        lambda s: canonical(_one(s, parse_spec(s, lib, ("packing",)), "packing")))
         nodes = parse_brdf(brdf, lib)
         try:
             # one policy over the BRDF, the packing and the output brick (whose parameters,
@@ -174,7 +171,7 @@ def load_scene(path, lib: Library) -> Scene:
                             f"light '{name}' has unknown type {ltype!r}",
                             f"type is one of {', '.join(b.id for b in lib.of_kind('light'))}")
         shadow = _spec(loc, f"lights.{name}", "shadow", li.get("shadow", "none"),
-                       lambda s: canonical(parse_spec(s, lib, ("shadow",))))
+                       lambda s: canonical(_one(s, parse_spec(s, lib, ("shadow",)), "shadow filter")))
         snode = parse_spec(shadow, lib, ("shadow",))[0]
         try:
             specs = spec_params([lb, snode])
@@ -197,9 +194,15 @@ def load_scene(path, lib: Library) -> Scene:
     objects = data.get("objects", [])
     if not isinstance(objects, list):
         raise loc.error((1, 1), "objects must be an array of tables", "write [[objects]] sections")
+    seen_names: dict[str, int] = {}
     for i, obj in enumerate(objects):
         where = loc.find("objects", nth=i)
         oname = obj.get("name", f"object{i}")
+        if oname in seen_names:
+            raise loc.error(loc.find("objects", "name", nth=i) if "name" in obj else where,
+                            f"object name '{oname}' is used twice (object {seen_names[oname] + 1} and {i + 1})",
+                            "give every object its own name")
+        seen_names[oname] = i
         mat = obj.get("material")
         if mat not in scene.materials:
             raise loc.error(loc.find("objects", "material", nth=i), f"object '{oname}' uses unknown material {mat!r}",
@@ -228,6 +231,15 @@ def _table(loc: Locator, data: dict, key: str) -> dict:
     if not isinstance(t, dict):
         raise loc.error(loc.top(key), f"'{key}' must be a table", f"write [{key}.NAME] sections")
     return t
+
+
+def _one(spec: str, nodes: list, what: str) -> list:
+    """The one brick a packing or shadow spec names; a second term ('shadow_map+none') is an error, not dropped."""
+    if len(nodes) != 1:
+        plus = spec.find("+")
+        raise SpecError(spec, plus + 1 if plus >= 0 else 1, f"a {what} is one brick, and '{spec}' names {len(nodes)}",
+                        f"keep one: {nodes[0].canonical()}")
+    return nodes
 
 
 def _spec(loc: Locator, header: str, key: str, value, resolve) -> str:

@@ -1,0 +1,110 @@
+"""The scene file's shape as a JSON Schema, checked before any value is interpreted (issue 10).
+
+Why a schema (jsonschema, pinned): the rules are data, not code spread over the reader — one place
+says which keys a table has and what type each value is, and an engine's tools can read the same
+schema (`SCENE_SCHEMA`). Every violation becomes one located line through the scene's Locator: the
+TOML position of the offending key, what is wrong, and what to do — for an unknown key, the closest
+valid one ("unknown key 'ouput' in [scene] — did you mean 'output'?"). The reader then checks what a
+schema cannot: that names exist (bricks, materials, light sets), and the parameters' ranges.
+"""
+from __future__ import annotations
+
+import datetime
+import difflib
+
+NAME = {"type": "string", "minLength": 1, "maxLength": 256, "pattern": r"^[^\x00-\x1f\x7f\u0085\u2028\u2029]*$"}
+SPEC = {"type": "string", "minLength": 1, "maxLength": 4096}
+NUMBER = {"type": "number"}
+PARAMS = {"type": "object", "additionalProperties": {"anyOf": [NUMBER, {"type": "array", "items": NUMBER,
+                                                                        "minItems": 1, "maxItems": 64}]}}
+SCENE_SCHEMA = {
+    "$schema": "https://json-schema.org/draft/2020-12/schema",
+    "title": "shadermatrix scene",
+    "type": "object",
+    "additionalProperties": False,
+    "properties": {
+        "scene": {"type": "object", "additionalProperties": False,
+                  "properties": {"name": NAME, "output": SPEC, "precision": {"type": "string"}}},
+        "materials": {"type": "object", "additionalProperties": {
+            "type": "object", "additionalProperties": False, "required": ["brdf"],
+            "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS}}},
+        "lights": {"type": "object", "additionalProperties": {
+            "type": "object", "additionalProperties": False, "required": ["type"],
+            "properties": {"type": NAME, "shadow": SPEC, "params": PARAMS}}},
+        "light_sets": {"type": "object", "additionalProperties": {"type": "array", "items": NAME, "maxItems": 4096}},
+        "objects": {"type": "array", "items": {
+            "type": "object", "additionalProperties": False, "required": ["material", "lights"],
+            "properties": {"name": NAME, "material": NAME, "lights": NAME}}},
+    },
+}
+
+_TYPES = {"object": "a table", "array": "an array", "string": "a string", "number": "a number"}
+_EXAMPLES = {"scene": "[scene] name = \"courtyard\"", "materials": "[materials.NAME] brdf = \"lambert\"",
+             "lights": "[lights.NAME] type = \"point\"", "light_sets": "[light_sets] NAME = [\"sun\"]",
+             "objects": "[[objects]] material = \"NAME\" lights = \"SET\""}
+
+
+def _what(value) -> str:
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (datetime.date, datetime.time)):
+        return "a date or time"
+    return {dict: "a table", list: "an array", str: "a string", int: "a number", float: "a number"}.get(
+        type(value), type(value).__name__)
+
+
+def _header(path: list) -> tuple[str, list, int]:
+    """(TOML header, keys below it, nth) of a schema error path such as ['objects', 3, 'name']."""
+    if not path:
+        return "", [], 0
+    if path[0] == "objects":
+        nth = path[1] if len(path) > 1 and isinstance(path[1], int) else 0
+        return "objects", [str(p) for p in path[2:]], nth
+    if path[0] in ("materials", "lights") and len(path) > 1:
+        return f"{path[0]}.{path[1]}", [str(p) for p in path[2:]], 0
+    return str(path[0]), [str(p) for p in path[1:]], 0
+
+
+def _where(path: list) -> str:
+    head, keys, nth = _header(path)
+    if head == "objects":
+        return f"object {nth + 1} ([[objects]])"
+    return f"[{head}]" if head else "the scene"
+
+
+def check(data: dict, loc) -> None:
+    """Raise the scene's first schema violation as a located SourceError (schema order: deterministic)."""
+    from jsonschema import Draft202012Validator
+
+    errors = sorted(Draft202012Validator(SCENE_SCHEMA).iter_errors(data), key=lambda e: [str(p) for p in e.path])
+    if not errors:
+        return
+    e = errors[0]
+    path = list(e.path)
+    head, keys, nth = _header(path)
+    if e.validator == "additionalProperties":
+        allowed = sorted(e.schema.get("properties", {}))
+        extra = sorted(set(e.instance) - set(allowed))[0]
+        pos = loc.top(extra) if not path else loc.find(head, *keys, extra, nth=nth)
+        near = difflib.get_close_matches(extra, allowed, n=1)
+        hint = f"did you mean '{near[0]}'?" if near else f"allowed: {', '.join(allowed)}"
+        raise loc.error(pos, f"unknown key '{extra}' in {_where(path)}", hint)
+    pos = loc.find(head, *keys, nth=nth) if head else (1, 1)
+    key = ".".join(str(p) for p in path) or "the scene"
+    if e.validator == "required":
+        missing = next(k for k in e.validator_value if k not in e.instance)
+        raise loc.error(pos, f"{_where(path)} has no '{missing}'", f"add {missing} = …")
+    if e.validator == "type":
+        want = _TYPES.get(e.validator_value, e.validator_value)
+        example = _EXAMPLES.get(str(path[0]) if path else "", "see README, \"Scene files\"")
+        raise loc.error(pos, f"'{key}' must be {want}, not {_what(e.instance)}", f"write {example}"
+                        if len(path) <= 1 else f"give {want}")
+    if e.validator == "anyOf":
+        raise loc.error(pos, f"'{key}' must be a number or an array of numbers, not {_what(e.instance)}",
+                        "write e.g. 0.5 or [0.8, 0.1, 0.1]")
+    if e.validator in ("minLength", "maxLength", "pattern", "minItems", "maxItems"):
+        what = {"minLength": "is empty", "maxLength": "is too long", "pattern": "holds a control character",
+                "minItems": "is empty", "maxItems": "has too many items"}[e.validator]
+        raise loc.error(pos, f"'{key}' {what}", "give a printable name of at most 256 characters"
+                        if e.validator in ("maxLength", "pattern") else "give at least one")
+    raise loc.error(pos, f"'{key}': {e.message}", "see README, \"Scene files\"")

@@ -1,0 +1,62 @@
+"""Scene files against their schema (issue 10): every wrong key or type is one located line with what to do,
+checked before any value is interpreted (generator/matrix/schema.py); each case below was a traceback, or a
+scene accepted that builds something else."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from generator.lang import SourceError
+
+REPO = Path(__file__).resolve().parent.parent
+BASE = (REPO / "scenes" / "example.toml").read_text()
+
+CASES = [  # (id, what replaces what, line of the error, words of the message)
+    ("material-is-a-list", ('material = "painted_wood"', "material = ['a']"), 50,
+     "'objects.0.material' must be a string, not an array"),
+    ("scene-is-a-number", ('[scene]\nname = "courtyard"\noutput = "linear"\nprecision = "fp32"', "scene = 1"), 1,
+     "'scene' must be a table, not a number"),
+    ("output-is-a-list", ('output = "linear"', "output = []"), 6, "'scene.output' must be a string, not an array"),
+    ("object-name-is-a-number", ('name = "bench"', "name = 5"), 49, "'objects.0.name' must be a string, not a number"),
+    ("scene-name-is-a-date", ('name = "courtyard"', "name = 1979-05-27"), 5, "must be a string, not a date or time"),
+    ("typo-in-scene", ('output = "linear"', 'ouput = "linear"'), 6, "unknown key 'ouput' in [scene]",
+     "did you mean 'output'?"),
+    ("typo-in-light", ('shadow = "shadow_map"', 'shadows = "shadow_map"'), 33, "unknown key 'shadows' in [lights.sun]",
+     "did you mean 'shadow'?"),
+    ("duplicate-object-names", ('name = "ground"', 'name = "bench"'), 54, "object name 'bench' is used twice"),
+    ("second-shadow-dropped", ('shadow = "shadow_map"', 'shadow = "shadow_map+none"'), 33,
+     "a shadow filter is one brick, and 'shadow_map+none' names 2"),
+    ("params-not-a-table", ('params = { alpha = 0.15, f0 = [1.0, 0.71, 0.29] }', 'params = "x"'), 20,
+     "'materials.polished_gold.params' must be a table, not a string"),
+    ("param-is-a-boolean", ("alpha = 0.15", "alpha = true"), 20, "must be a number or an array of numbers"),
+    ("light-set-not-a-list", ('outdoor = ["sun", "lamp"]', "outdoor = 3"), 45, "'light_sets.outdoor' must be an array"),
+    ("control-character-in-a-name", ('name = "bench"', 'name = "be\\u2028nch"'), 49, "holds a control character"),
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_a_malformed_scene_is_one_located_error(case, tmp_path):
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+
+    _, (old, new), line, *words = case
+    assert old in BASE
+    path = tmp_path / "scene.toml"
+    path.write_text(BASE.replace(old, new, 1))
+    with pytest.raises(SourceError) as e:
+        load_scene(path, load_library())
+    text = str(e.value)
+    assert text.startswith(f"{path}:{line}:") and " — " in text, text
+    assert all(w in text for w in words), text
+    assert "\n" not in text
+
+
+def test_the_shipped_scenes_pass_the_schema():
+    import tomllib
+
+    from generator.matrix.schema import SCENE_SCHEMA
+    from jsonschema import Draft202012Validator
+    Draft202012Validator.check_schema(SCENE_SCHEMA)
+    for p in [REPO / "scenes" / "example.toml", REPO / "tests" / "scenes" / "shadow.toml"]:
+        assert not list(Draft202012Validator(SCENE_SCHEMA).iter_errors(tomllib.loads(p.read_text())))
