@@ -47,19 +47,31 @@ def _syntax_tree(text: str, path: str) -> ast.Module:
 
 def read_meta(text: str, path: str) -> tuple[dict, ir.Loc, str]:
     """Read only a brick's docstring and BRICK metadata (no function bodies)."""
+    meta, loc, doc, _ = read_meta_node(text, path)
+    return meta, loc, doc
+
+
+def read_meta_node(text: str, path: str) -> tuple[dict, ir.Loc, str, ast.AST]:
+    """read_meta, and the BRICK literal's syntax node (where each of its keys is). A second BRICK is an error."""
     tree = _syntax_tree(text, path)
     doc = ast.get_docstring(tree) or ""
+    found = None
     for node in tree.body:
         if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "BRICK" for t in node.targets):
+            if found is not None:
+                raise _err(path, node, f"a second BRICK (the first is at line {found[1].line})",
+                           "keep one BRICK dict per brick")
             try:
                 meta = ast.literal_eval(node.value)
-            except (ValueError, SyntaxError, TypeError):
+            except (ValueError, SyntaxError, TypeError, MemoryError, RecursionError):
                 raise _err(path, node.value, "BRICK must be a literal dict",
                            "use only strings, numbers, lists and dicts in BRICK (no names or calls)") from None
             if not isinstance(meta, dict):
                 raise _err(path, node.value, "BRICK must be a dict", 'write BRICK = {"kind": ..., "params": {...}}')
-            return meta, _loc(path, node), doc
-    raise SourceError(path, 1, 1, "no BRICK metadata dict", 'add BRICK = {"kind": "...", "params": {...}} at top level')
+            found = (meta, _loc(path, node), doc, node.value)
+    if found is None:
+        raise SourceError(path, 1, 1, "no BRICK metadata dict", 'add BRICK = {"kind": "...", "params": {...}} at top level')
+    return found
 
 
 def parse_module(text: str, path: str, externals: dict[str, Signature] | None = None) -> ir.Module:

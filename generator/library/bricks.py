@@ -10,7 +10,8 @@ import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..lang import Signature, SourceError, parse_module, read_meta
+from ..lang import Signature, SourceError, parse_module
+from ..lang.parse import read_meta_node
 from ..lang.errors import read_text
 from ..lang import ir
 from ..lang.types import BUILTIN_TYPES, INT, Type, array
@@ -157,7 +158,9 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
                           "directives and provenance comments")
     if text is None:
         text = read_text(path, "brick")
-    meta, loc, doc = read_meta(text, shown)
+    meta, loc, doc, node = read_meta_node(text, shown)
+    from .schema import check, key_positions
+    check(meta, shown, loc, key_positions(node))  # the shape first (library/schema.py), then the meaning
     unknown = set(meta) - META_KEYS
     if unknown:
         raise _meta_error(shown, loc, f"unknown BRICK key(s): {', '.join(sorted(unknown))}",

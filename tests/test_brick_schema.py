@@ -1,0 +1,65 @@
+"""BRICK metadata against its schema (issue 10): every case here was a traceback or an invalid brick accepted;
+each is now one line at the offending key of the BRICK literal (generator/library/schema.py)."""
+from __future__ import annotations
+
+import pytest
+
+from generator.lang import SourceError
+
+GOOD = '''"""Test brick."""
+BRICK = {
+    "kind": "specular",
+    "cite": "test",
+    "params": {"n": {"type": "float", "range": [1.0, 100.0], "default": 8.0}},
+}
+
+
+def specular(NdotH: float, n: float) -> vec3:
+    return vec3(pow(NdotH, n))
+'''
+
+CASES = [  # (id, replace, with, line, words)
+    ("range-of-strings", '"range": [1.0, 100.0]', '"range": ["a", "b"]', 5, "BRICK['params']['n']['range'][0] must be a number"),
+    ("range-of-three", '"range": [1.0, 100.0]', '"range": [1.0, 2.0, 3.0]', 5, "has 3 items", "[low, high]"),
+    ("cite-is-a-number", '"cite": "test"', '"cite": 5', 4, "BRICK['cite'] must be a string, not an integer"),
+    ("kind-is-a-list", '"kind": "specular"', '"kind": ["specular"]', 3, "BRICK['kind'] must be a string, not a list"),
+    ("param-name-with-a-space", '"n": {', '"a b": {', 5, "'a b' is not a name of the brick language"),
+    ("param-name-empty", '"n": {', '"": {', 5, "is not a name of the brick language"),
+    ("param-key-not-a-string", '"n": {', '1: {', 5, "a key that is not a string"),
+    ("typo-in-param", '"default": 8.0', '"defualt": 8.0', 5, "unknown key 'defualt'", "did you mean 'default'?"),
+    ("typo-at-top", '"cite": "test"', '"cite": "test", "slot": {}', 4, "unknown key 'slot' in BRICK", "did you mean 'slots'?"),
+    ("texture-not-a-dict", '"cite": "test"', '"cite": "test", "textures": {"t": 1}', 4,
+     "BRICK['textures']['t'] must be a dict, not an integer"),
+    ("srgb-not-a-boolean", '"cite": "test"', '"cite": "test", "textures": {"t": {"srgb": "yes"}}', 4,
+     "BRICK['textures']['t']['srgb'] must be True or False, not a string"),
+    ("slot-default-not-an-id", '"cite": "test"', '"cite": "test", "slots": {"ndf": {"kind": "ndf", "default": "a-b"}}',
+     4, "'a-b' is not a name of the brick language"),
+    ("slot-name-a-list", '"cite": "test"', '"cite": "test", "slots": {"ndf": {"kind": ["ndf"], "default": "ggx"}}',
+     4, "BRICK['slots']['ndf']['kind'] must be a string, not a list"),
+    ("second-brick", 'def specular', 'BRICK = {"kind": "diffuse"}\n\n\ndef specular', 9, "a second BRICK",
+     "the first is at line 2"),
+    ("count-not-an-integer", '"default": 8.0', '"default": 8.0, "count": 2.5', 5,
+     "BRICK['params']['n']['count'] must be an integer, not a number"),
+]
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_a_malformed_brick_is_one_error_at_its_key(case, tmp_path):
+    from generator.library.bricks import load_brick
+
+    _, old, new, line, *words = case
+    assert old in GOOD
+    path = tmp_path / "test_brick.py"
+    path.write_text(GOOD.replace(old, new, 1))
+    with pytest.raises(SourceError) as e:
+        load_brick(path)
+    text = str(e.value)
+    assert f":{line}:" in text.split(" ")[0] and " — " in text, text
+    assert all(w in text for w in words), text
+
+
+def test_the_good_brick_and_every_shipped_brick_pass_the_schema(tmp_path):
+    from generator.library.bricks import load_brick, load_library
+    (tmp_path / "test_brick.py").write_text(GOOD)
+    assert load_brick(tmp_path / "test_brick.py").params["n"].default == 8.0
+    assert load_library().bricks  # every shipped brick loads through the schema
