@@ -63,3 +63,35 @@ def test_the_good_brick_and_every_shipped_brick_pass_the_schema(tmp_path):
     (tmp_path / "test_brick.py").write_text(GOOD)
     assert load_brick(tmp_path / "test_brick.py").params["n"].default == 8.0
     assert load_library().bricks  # every shipped brick loads through the schema
+
+
+BODY = '''"""T."""
+BRICK = {"kind": "diffuse", "cite": "x"}
+PRE
+
+
+def diffuse(NdotL: float) -> vec3:
+    BODY
+'''
+
+LIMITS = [  # (id, module-level text, body, line, words) — each was a traceback or an emitter assertion
+    ("constant-out-of-fp32", "K = -1e400", "return vec3(NdotL * K)", 3, "constant K = -inf is outside the fp32 range"),
+    ("constant-out-of-int32", "N = 3000000000", "return vec3(NdotL)", 3, "constant N = 3000000000 does not fit in 32 bits"),
+    ("loop-count-past-int32", "", "s = 0.0\n    for i in range(3000000000):\n        s = s + NdotL\n    return vec3(s)", 8,
+     "the loop count 3000000000 does not fit in 32 bits"),
+    ("a-500-term-sum", "", "return vec3(" + " + ".join(["NdotL"] * 500) + ")", 7, "nested more than 100 deep"),
+    ("a-10000-term-sum", "", "return vec3(" + " + ".join(["NdotL"] * 10000) + ")", 1, "too long or too deeply nested"),
+]
+
+
+@pytest.mark.parametrize("case", LIMITS, ids=[c[0] for c in LIMITS])
+def test_a_brick_past_a_limit_is_one_located_error(case, tmp_path):
+    from generator.library.bricks import load_brick
+
+    _, pre, body, line, words = case
+    path = tmp_path / "t.py"
+    path.write_text(BODY.replace("PRE", pre).replace("BODY", body))
+    with pytest.raises(SourceError) as e:
+        load_brick(path)
+    text = str(e.value)
+    assert text.split(" ")[0].split(":")[1] == str(line) and words in text, text

@@ -47,6 +47,9 @@ class ControlChecker:
         if bound is None and (count is None or count < 0):
             raise self.err(count_node, "the loop count must be a non-negative int constant",
                            "write range(4) or range(N) with N = 4 at the top of the brick")
+        if bound is None and count >= 2**31:
+            raise self.err(count_node, f"the loop count {count} does not fit in 32 bits",
+                           "a loop runs at most 2147483647 times (a shader's int)")
         check_identifier(self.path, n.target, n.target.id)
         if self.lookup(n.target.id) is not None:
             raise self.err(n.target, f"loop variable '{n.target.id}' is already declared", "use a new name")

@@ -37,12 +37,33 @@ def _err(path, node, message, hint=""):
     return SourceError(loc.path, loc.line, loc.col, message, hint)
 
 
+MAX_DEPTH = 100  # syntax nesting (expressions and statements) a brick may have: README, "The brick language"
+
+
+def _check_depth(tree: ast.AST, path: str) -> None:
+    """A brick nested deeper than MAX_DEPTH is one located error (the type checker, the link stage and the
+    emitters walk trees recursively; a 500-term sum would exhaust Python's stack)."""
+    stack = [(tree, 0, 1, 1)]
+    while stack:
+        node, depth, line, col = stack.pop()
+        line, col = getattr(node, "lineno", line), getattr(node, "col_offset", col - 1) + 1  # operators: the parent's
+        if depth > MAX_DEPTH:
+            raise SourceError(path, line, col, f"this expression is nested more than {MAX_DEPTH} deep",
+                              "split it into locals (a sum of many terms: add them a few at a time)")
+        stack.extend((child, depth + 1, line, col) for child in ast.iter_child_nodes(node))
+
+
 def _syntax_tree(text: str, path: str) -> ast.Module:
     try:
-        return ast.parse(text, filename=path)
+        tree = ast.parse(text, filename=path)
+        _check_depth(tree, path)
+        return tree
     except SyntaxError as e:
         raise SourceError(path, e.lineno or 1, e.offset or 1, f"syntax error: {e.msg}",
                           "a brick is written in a small typed subset of Python syntax") from None
+    except (RecursionError, MemoryError):  # Python's own parser gives up on a 10,000-term expression
+        raise SourceError(path, 1, 1, "an expression is too long or too deeply nested to parse",
+                          "split it into locals of a few terms each") from None
 
 
 def read_meta(text: str, path: str) -> tuple[dict, ir.Loc, str]:
@@ -165,6 +186,10 @@ def _module_constant(path, node, name, value) -> ir.Const:
         sign, v = -1, v.operand
     if isinstance(v, ast.Constant) and type(v.value) in (int, float):
         val = sign * v.value
+        if isinstance(val, int) and not -2**31 <= val < 2**31:
+            raise _err(path, value, f"constant {name} = {val} does not fit in 32 bits", "use a smaller value or a float")
+        if isinstance(val, float) and not abs(val) <= 3.4028234663852886e38:
+            raise _err(path, value, f"constant {name} = {val!r} is outside the fp32 range", "use a value below 3.4e38")
         ty = BUILTIN_TYPES["float" if isinstance(val, float) else "int"]
         return ir.Const(ty, _loc(path, node), val)
     raise _err(path, value, f"constant {name} must be a number literal", "write e.g. K = 0.5 or N = 4")
