@@ -302,3 +302,31 @@ def test_cli_errors_exit_1_and_leave_the_output_alone(tmp_path):
         assert "Traceback" not in r.stderr
         assert out.read_bytes() == b"earlier result"
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+
+
+def test_non_finite_and_non_unit_samples_are_refused_naming_the_row(tmp_path):
+    """Every target treats a NaN its own way (the reference returned 0, NumPy and the GPU 0.189 for an all-NaN row):
+    the samples are checked first, and --unchecked passes them through as they are."""
+    good = np.tile([0.0, 0.0, 1.0], (5, 3))
+    nan = good.copy()
+    nan[3, 4] = np.nan
+    r = cli("lambert", "--input", save(tmp_path / "nan.npy", nan), "--output", tmp_path / "f.npy", "--target", "numpy")
+    assert r.returncode == 1 and "row 3 holds a NaN or infinity" in r.stderr and "--unchecked" in r.stderr, r.stderr
+    long = good.copy()
+    long[2, 6:9] = [0.0, 0.0, 2.0]
+    r = cli("lambert", "--input", save(tmp_path / "long.npy", long), "--output", tmp_path / "f.npy", "--target", "numpy")
+    assert r.returncode == 1 and "row 2: N has length 2, not 1" in r.stderr, r.stderr
+    r = cli("lambert", "--input", tmp_path / "long.npy", "--output", tmp_path / "f.npy", "--target", "numpy",
+            "--unchecked")
+    assert r.returncode == 0, r.stderr
+    assert not (tmp_path / "never.npy").exists()
+
+
+def test_a_header_declaring_more_samples_than_allowed_allocates_nothing(tmp_path):
+    import io
+
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": (10 ** 12, 9)})
+    (tmp_path / "huge.npy").write_bytes(buf.getvalue())  # a header, no data
+    r = cli("lambert", "--input", tmp_path / "huge.npy", "--output", tmp_path / "f.npy", "--target", "numpy")
+    assert r.returncode == 1 and "1000000000000 samples declared" in r.stderr and "Traceback" not in r.stderr, r.stderr

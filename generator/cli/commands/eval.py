@@ -6,6 +6,12 @@
 S.npy: float (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T], unit vectors in one
 frame (nothing is normalized unless a brick does). F.npy: float64 (N, 3), the
 bare BRDF in 1/sr (no cosine, no π), written atomically.
+
+Samples are checked before any target sees them: a non-finite component or a vector whose length is
+not 1 within UNIT_TOL is an error naming the first such row (every target would treat it its own way:
+the float64 reference, NumPy and the GPU kernels disagree on NaN). --unchecked passes them through
+unchanged, identically to every target. The .npy header is read first: an array larger than
+MAX_SAMPLES rows is refused before anything is allocated.
 """
 from __future__ import annotations
 
@@ -29,6 +35,8 @@ def add_arguments(p) -> None:
     p.add_argument("--dtype", choices=DTYPES,
                    help="numpy: float64 (default), float32 or float16; GPU targets: float32 only")
     p.add_argument("--bricks", action="append", metavar="DIR", help="an extra brick directory (repeatable)")
+    p.add_argument("--unchecked", action="store_true",
+                   help="pass non-finite and non-unit sample vectors through as they are (default: an error)")
 
 
 class _Usage(Exception):
@@ -53,13 +61,26 @@ def parse_params(items: list[str]) -> dict[str, list[float]]:
     return out
 
 
-def load_samples(path: str):
-    """The (N, 9|12) sample array of an .npy file, as float64."""
+UNIT_TOL = 1e-3  # |length - 1| a sample vector may have (float16 inputs round to ~5e-4)
+MAX_SAMPLES = 50_000_000  # rows of an input (12 float64 columns: 4.8 GB)
+
+
+def load_samples(path: str, checked: bool = True):
+    """The (N, 9|12) sample array of an .npy file, as float64 (checked: finite unit vectors)."""
     import numpy as np
 
     p = Path(path)
     if not p.is_file():
         raise _Usage(f"{path}: no such file — pass an .npy file of samples with --input")
+    try:
+        with open(p, "rb") as f:  # the header alone first: a declared shape past the limit allocates nothing
+            version = np.lib.format.read_magic(f)
+            read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+            shape, _, _ = read(f)
+    except (ValueError, OSError, EOFError, SyntaxError) as exc:
+        raise _Usage(f"{path}: not a readable .npy array ({exc}) — save the samples with numpy.save") from None
+    if len(shape) == 2 and shape[0] > MAX_SAMPLES:
+        raise _Usage(f"{path}: {shape[0]} samples declared, more than the {MAX_SAMPLES} allowed — split the file")
     try:
         a = np.load(p, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
@@ -69,7 +90,21 @@ def load_samples(path: str):
                      "save float32 or float64 samples")
     if a.ndim != 2 or a.shape[1] not in (9, 12):
         raise _Usage(f"{path}: shape {a.shape} — samples are (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T]")
-    return a.astype(np.float64)
+    a = a.astype(np.float64)
+    if checked and len(a):
+        bad = ~np.isfinite(a).all(axis=1)
+        if bad.any():
+            row = int(np.argmax(bad))
+            raise _Usage(f"{path}: row {row} holds a NaN or infinity ({a[row].tolist()}) — fix the samples, or pass "
+                         "--unchecked to evaluate them as they are")
+        names = ["L", "V", "N", "T"][:a.shape[1] // 3]
+        lengths = np.linalg.norm(a.reshape(len(a), -1, 3), axis=2)
+        off = np.abs(lengths - 1.0) > UNIT_TOL
+        if off.any():
+            row, col = (int(x) for x in np.argwhere(off)[0])
+            raise _Usage(f"{path}: row {row}: {names[col]} has length {lengths[row, col]:.6g}, not 1 — normalize the "
+                         "sample vectors, or pass --unchecked to evaluate them as they are")
+    return a
 
 
 def run(args) -> int:
@@ -83,7 +118,7 @@ def run(args) -> int:
 
     try:
         params = parse_params(args.param)
-        s = load_samples(args.input)
+        s = load_samples(args.input, checked=not args.unchecked)
         lib = load_library(args.bricks or ())
         T = s[:, 9:12] if s.shape[1] == 12 else None
         f = evaluate(args.spec, s[:, 0:3], s[:, 3:6], s[:, 6:9], T=T, params=params,
