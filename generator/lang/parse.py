@@ -54,8 +54,12 @@ def _check_depth(tree: ast.AST, path: str) -> None:
 
 
 def _syntax_tree(text: str, path: str) -> ast.Module:
+    import warnings
     try:
-        tree = ast.parse(text, filename=path)
+        with warnings.catch_warnings():  # Python's warnings about its own syntax (an invalid escape in a docstring)
+            warnings.simplefilter("ignore", SyntaxWarning)
+            warnings.simplefilter("ignore", DeprecationWarning)
+            tree = ast.parse(text, filename=path)
         _check_depth(tree, path)
         return tree
     except SyntaxError as e:
