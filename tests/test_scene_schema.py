@@ -52,6 +52,41 @@ def test_a_malformed_scene_is_one_located_error(case, tmp_path):
     assert "\n" not in text
 
 
+def test_deeply_nested_toml_is_one_located_error(tmp_path):
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+
+    path = tmp_path / "deep.toml"
+    path.write_text("x = " + "[" * 2000 + "]" * 2000 + "\n")
+    with pytest.raises(SourceError) as e:
+        load_scene(path, load_library())
+    assert "nests arrays or tables too deeply" in str(e.value)
+
+
+def test_an_array_parameter_is_an_array_of_vectors_in_a_scene(tmp_path):
+    """A brick parameter with a count (tests/link_bricks/specular/lobes.py) takes one vector per element."""
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+
+    path = tmp_path / "lobes.toml"
+    path.write_text('[materials.m]\nbrdf = "lobes(lobes=2)"\nparams = { lobes = [[-1.0, 1.0, 8.0, 0.5], '
+                    '[0.0, 1.0, 16.0, 0.25], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]] }\n[lights.s]\ntype = "point"\n[light_sets]\na = ["s"]\n'
+                    '[[objects]]\nname = "o"\nmaterial = "m"\nlights = "a"\n')
+    scene = load_scene(path, load_library([REPO / "tests" / "link_bricks"]))
+    assert scene.materials["m"].params["lobes"][1] == [0.0, 1.0, 16.0, 0.25]
+
+
+def test_a_name_with_a_trailing_line_break_is_refused(tmp_path):
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+
+    path = tmp_path / "nl.toml"
+    path.write_text(BASE.replace('name = "bench"', 'name = "bench\\n"', 1))
+    with pytest.raises(SourceError) as e:
+        load_scene(path, load_library())
+    assert "control character or a line break" in str(e.value) and "\n" not in str(e.value)
+
+
 def test_the_shipped_scenes_pass_the_schema():
     import tomllib
 

@@ -16,7 +16,9 @@ class SourceError(UserError):
 
     def __str__(self) -> str:
         text = f"{self.path}:{self.line}:{self.col}: {self.message}"
-        return f"{text} — {self.hint}" if self.hint else text
+        text = f"{text} — {self.hint}" if self.hint else text
+        # one line, whatever an input put into a name it quotes: control characters and line breaks shown escaped
+        return "".join(c if c.isprintable() else ascii(c)[1:-1] for c in text)
 
 
 def at(loc, message: str, hint: str = "") -> SourceError:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import ast
 import difflib
 
-IDENT = {"type": "string", "pattern": r"^[A-Za-z_][A-Za-z0-9_]{0,63}$"}
+IDENT = {"type": "string", "pattern": r"^[A-Za-z_][A-Za-z0-9_]{0,63}(?!\n)$"}  # Python's $ matches before a final \n
 NUMBER = {"type": "number"}
 VALUE = {"anyOf": [NUMBER, {"type": "array", "items": NUMBER, "minItems": 1, "maxItems": 64},
                    {"type": "array", "items": {"type": "array", "items": NUMBER, "minItems": 1, "maxItems": 16},
@@ -49,7 +49,7 @@ def _what(v) -> str:
     if isinstance(v, bool):
         return "a boolean"
     return {dict: "a dict", list: "a list", tuple: "a tuple", str: "a string", int: "an integer", float: "a number",
-            set: "a set", bytes: "bytes"}.get(type(v), type(v).__name__)
+            set: "a set", bytes: "bytes", type(None): "None"}.get(type(v), type(v).__name__)
 
 
 def key_positions(node: ast.AST) -> dict[tuple, tuple[int, int]]:
@@ -107,6 +107,7 @@ def check(meta: dict, shown: str, loc, positions: dict) -> None:
                           f"did you mean '{near[0]}'?" if near else f"allowed: {', '.join(allowed)}")
     if e.validator == "propertyNames" or (e.validator == "pattern" and isinstance(e.instance, str)):
         name = e.instance if isinstance(e.instance, str) else ""
+        line, col = positions.get((*path, name), (line, col))  # at the bad name itself
         raise SourceError(shown, line, col, f"{key} {name!r} is not a name of the brick language",
                           "use letters, digits and _, starting with a letter or _, at most 64 characters")
     if e.validator == "required":

@@ -113,6 +113,9 @@ def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]
     text = read_text(path, what)
     try:
         data = tomllib.loads(text)
+    except (RecursionError, MemoryError):  # tomllib recurses on nested arrays and inline tables
+        raise SourceError(shown, 1, 1, f"the {what} nests arrays or tables too deeply to read",
+                          "a scene needs at most a table of tables of arrays") from None
     except tomllib.TOMLDecodeError as e:
         m = re.search(r"\(at line (\d+), column (\d+)\)", str(e))
         line, col = (int(m.group(1)), int(m.group(2))) if m else (1, 1)

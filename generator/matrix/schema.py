@@ -12,11 +12,14 @@ from __future__ import annotations
 import datetime
 import difflib
 
-NAME = {"type": "string", "minLength": 1, "maxLength": 256, "pattern": r"^[^\x00-\x1f\x7f\u0085\u2028\u2029]*$"}
+NAME = {"type": "string", "minLength": 1, "maxLength": 256,
+        "pattern": r"^[^\x00-\x1f\x7f\u0085\u2028\u2029]*(?!\n)$"}  # (?!\n): Python's $ also matches before a final \n
 SPEC = {"type": "string", "minLength": 1, "maxLength": 4096}
 NUMBER = {"type": "number"}
-PARAMS = {"type": "object", "additionalProperties": {"anyOf": [NUMBER, {"type": "array", "items": NUMBER,
-                                                                        "minItems": 1, "maxItems": 64}]}}
+VECTOR = {"type": "array", "items": NUMBER, "minItems": 1, "maxItems": 64}
+# a number, a vector, or an array parameter's elements ("count": N in the brick: [[…], […]]); check_value does the rest
+PARAMS = {"type": "object", "propertyNames": NAME, "additionalProperties": {"anyOf": [
+    NUMBER, VECTOR, {"type": "array", "items": {"anyOf": [NUMBER, VECTOR]}, "minItems": 1, "maxItems": 64}]}}
 SCENE_SCHEMA = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "shadermatrix scene",
@@ -24,14 +27,15 @@ SCENE_SCHEMA = {
     "additionalProperties": False,
     "properties": {
         "scene": {"type": "object", "additionalProperties": False,
-                  "properties": {"name": NAME, "output": SPEC, "precision": {"type": "string"}}},
-        "materials": {"type": "object", "additionalProperties": {
+                  "properties": {"name": NAME, "output": SPEC, "precision": NAME}},
+        "materials": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["brdf"],
             "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS}}},
-        "lights": {"type": "object", "additionalProperties": {
+        "lights": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type"],
             "properties": {"type": NAME, "shadow": SPEC, "params": PARAMS}}},
-        "light_sets": {"type": "object", "additionalProperties": {"type": "array", "items": NAME, "maxItems": 4096}},
+        "light_sets": {"type": "object", "propertyNames": NAME,
+                       "additionalProperties": {"type": "array", "items": NAME, "maxItems": 4096}},
         "objects": {"type": "array", "items": {
             "type": "object", "additionalProperties": False, "required": ["material", "lights"],
             "properties": {"name": NAME, "material": NAME, "lights": NAME}}},
@@ -102,9 +106,15 @@ def check(data: dict, loc) -> None:
     if e.validator == "anyOf":
         raise loc.error(pos, f"'{key}' must be a number or an array of numbers, not {_what(e.instance)}",
                         "write e.g. 0.5 or [0.8, 0.1, 0.1]")
+    if e.validator == "propertyNames":
+        raise loc.error(pos, f"a name in '{key}' is empty, too long or holds a control character",
+                        "give printable names of at most 256 characters")
     if e.validator in ("minLength", "maxLength", "pattern", "minItems", "maxItems"):
-        what = {"minLength": "is empty", "maxLength": "is too long", "pattern": "holds a control character",
-                "minItems": "is empty", "maxItems": "has too many items"}[e.validator]
-        raise loc.error(pos, f"'{key}' {what}", "give a printable name of at most 256 characters"
-                        if e.validator in ("maxLength", "pattern") else "give at least one")
+        limit = e.validator_value
+        what, todo = {"minLength": ("is empty", "give a value"),
+                      "maxLength": (f"is longer than {limit} characters", f"keep it to {limit}"),
+                      "pattern": ("holds a control character or a line break", "give a printable name"),
+                      "minItems": ("is empty", "give at least one item"),
+                      "maxItems": (f"has more than {limit} items", f"keep it to {limit}")}[e.validator]
+        raise loc.error(pos, f"'{key}' {what}", todo)
     raise loc.error(pos, f"'{key}': {e.message}", "see README, \"Scene files\"")

@@ -76,11 +76,19 @@ def load_samples(path: str, checked: bool = True):
         with open(p, "rb") as f:  # the header alone first: a declared shape past the limit allocates nothing
             version = np.lib.format.read_magic(f)
             read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
-            shape, _, _ = read(f)
+            shape, _, dtype = read(f)
+            start = f.tell()
     except (ValueError, OSError, EOFError, SyntaxError) as exc:
         raise _Usage(f"{path}: not a readable .npy array ({exc}) — save the samples with numpy.save") from None
-    if len(shape) == 2 and shape[0] > MAX_SAMPLES:
+    # everything the header declares is checked before np.load allocates a byte
+    if dtype.kind != "f":
+        raise _Usage(f"{path}: dtype {dtype} is not a float array — save float32 or float64 samples")
+    if len(shape) != 2 or shape[1] not in (9, 12):
+        raise _Usage(f"{path}: shape {shape} — samples are (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T]")
+    if shape[0] > MAX_SAMPLES:
         raise _Usage(f"{path}: {shape[0]} samples declared, more than the {MAX_SAMPLES} allowed — split the file")
+    if p.stat().st_size - start < shape[0] * shape[1] * dtype.itemsize:
+        raise _Usage(f"{path}: the header declares {shape[0]} samples, but the file is shorter — save it again")
     try:
         a = np.load(p, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
@@ -98,7 +106,8 @@ def load_samples(path: str, checked: bool = True):
             raise _Usage(f"{path}: row {row} holds a NaN or infinity ({a[row].tolist()}) — fix the samples, or pass "
                          "--unchecked to evaluate them as they are")
         names = ["L", "V", "N", "T"][:a.shape[1] // 3]
-        lengths = np.linalg.norm(a.reshape(len(a), -1, 3), axis=2)
+        with np.errstate(over="ignore", invalid="ignore"):  # huge finite values: an overflowed length is "not 1"
+            lengths = np.linalg.norm(a.reshape(len(a), -1, 3), axis=2)
         off = np.abs(lengths - 1.0) > UNIT_TOL
         if off.any():
             row, col = (int(x) for x in np.argwhere(off)[0])
