@@ -95,3 +95,30 @@ def test_a_brick_past_a_limit_is_one_located_error(case, tmp_path):
         load_brick(path)
     text = str(e.value)
     assert text.split(" ")[0].split(":")[1] == str(line) and words in text, text
+
+
+def test_a_brick_id_that_is_not_a_name_and_a_packing_without_a_normal_slot(tmp_path):
+    from generator.library.bricks import load_brick
+
+    (tmp_path / "a-b.py").write_text(BODY.replace("PRE", "").replace("BODY", "return vec3(NdotL)"))
+    with pytest.raises(SourceError, match=r"a-b\.py:1:1: the brick id 'a-b' \(its file name\) is not a name"):
+        load_brick(tmp_path / "a-b.py")
+    (tmp_path / "pk.py").write_text('"""P."""\nBRICK = {"kind": "packing", "cite": "x"}\n\n\n'
+                                    "def get_rho_d(rho_d: vec3) -> vec3:\n    return rho_d\n")
+    with pytest.raises(SourceError, match=r"pk\.py:2:1: a packing brick needs a 'normal' slot"):
+        load_brick(tmp_path / "pk.py")
+
+
+def test_slot_defaults_that_form_a_cycle_are_one_error(tmp_path):
+    from generator.library.bricks import load_library
+    from generator.matrix.permutation import SpecError, parse_brdf
+
+    (tmp_path / "sp.py").write_text('"""S."""\nBRICK = {"kind": "specular", "cite": "x", '
+                                    '"slots": {"ndf": {"kind": "ndf", "default": "cyc"}}}\n\n\n'
+                                    "def specular(NdotH: float, NxH2: float) -> vec3:\n"
+                                    "    return vec3(ndf(NdotH, NxH2, 0.5))\n")
+    (tmp_path / "cyc.py").write_text('"""C."""\nBRICK = {"kind": "ndf", "cite": "x", '
+                                     '"slots": {"x": {"kind": "specular", "default": "sp"}}}\n\n\n'
+                                     "def ndf(NdotH: float, NxH2: float, alpha: float) -> float:\n    return NdotH\n")
+    with pytest.raises(SpecError, match="the slot defaults form a cycle"):
+        parse_brdf("sp", load_library([tmp_path]))

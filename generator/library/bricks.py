@@ -6,6 +6,7 @@ comes from its BRICK metadata. Bricks are parsed (generator.lang), never importe
 from __future__ import annotations
 
 import difflib
+import re
 import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -193,6 +194,12 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         raise SourceError(shown, where.line, where.col, f"buffer '{g.name}' is declared at the top level of a {kind} brick, "
                           "and the link stage binds no brick buffers yet",
                           "pass the values as parameters (an array parameter: \"count\": N) or a texture")
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]{0,63}", path.stem):
+        raise SourceError(shown, 1, 1, f"the brick id '{path.stem}' (its file name) is not a name of the brick language",
+                          "rename the file: letters, digits and _, starting with a letter or _, at most 64 characters")
+    if kind == "packing" and "normal" not in slots:
+        raise _meta_error(shown, loc, "a packing brick needs a 'normal' slot (the shading normal it provides)",
+                          '"slots": {"normal": {"kind": "normal", "default": "vertex"}}')
     brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip())
     _check_entries(brick, loc)
     return brick

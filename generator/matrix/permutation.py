@@ -144,13 +144,18 @@ def parse_spec(spec: str, lib: Library, kinds) -> list[Node]:
     return nodes
 
 
-def _default_fillers(brick: Brick, lib: Library, spec: str, col: int) -> tuple:
+def _default_fillers(brick: Brick, lib: Library, spec: str, col: int, chain: tuple = ()) -> tuple:
+    chain = (*chain, (brick.kind, brick.id))
     out = []
     for sname, s in brick.slots.items():
         d = lib.get(s["kind"], s["default"])
         if d is None:
             raise SpecError(spec, col, f"default filler '{s['default']}' of slot '{sname}' is missing", "")
-        out.append((sname, Node(d, _default_fillers(d, lib, spec, col), _default_counts(d))))
+        if (d.kind, d.id) in chain:  # a slot default naming a brick it is inside: it would never end
+            cycle = " → ".join(f"{k} '{i}'" for k, i in (*chain, (d.kind, d.id)))
+            raise SpecError(spec, col, f"the slot defaults form a cycle: {cycle}",
+                            f"change the default of slot '{sname}' in {brick.display_path}")
+        out.append((sname, Node(d, _default_fillers(d, lib, spec, col, chain), _default_counts(d))))
     return tuple(out)
 
 
