@@ -95,3 +95,19 @@ def test_the_shipped_scenes_pass_the_schema():
     Draft202012Validator.check_schema(SCENE_SCHEMA)
     for p in [REPO / "scenes" / "example.toml", REPO / "tests" / "scenes" / "shadow.toml"]:
         assert not list(Draft202012Validator(SCENE_SCHEMA).iter_errors(tomllib.loads(p.read_text())))
+
+
+def test_a_light_set_past_the_limit_is_one_located_error(tmp_path):
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import MAX_LIGHTS_PER_SET, load_scene
+
+    n = MAX_LIGHTS_PER_SET + 1
+    lights = "".join(f'[lights.l{i}]\ntype = "point"\n' for i in range(n))
+    names = ", ".join(f'"l{i}"' for i in range(n))
+    path = tmp_path / "many.toml"
+    path.write_text(f'[materials.m]\nbrdf = "lambert"\n{lights}[light_sets]\nmany = [{names}]\n'
+                    '[[objects]]\nname = "o"\nmaterial = "m"\nlights = "many"\n')
+    with pytest.raises(SourceError) as e:
+        load_scene(path, load_library())
+    assert f"light set 'many' has {n} lights, more than the {MAX_LIGHTS_PER_SET}" in str(e.value)
+    assert str(e.value).startswith(f"{path}:{4 + 2 * n}:")  # the line of many = [...]
