@@ -81,7 +81,7 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     use it, the generator's own sources and templates, the tools' versions, the languages). A permutation
     whose key is that of the previous manifest's entry, and whose files are all there with their recorded
     sha256, is neither composed nor compiled nor analysed: its entry is kept as it was. The ubershader
-    likewise (its key covers every permutation's key and bricks).
+    likewise (its key covers every permutation's key and bricks, not the scene values: it reads none).
 
     Consistent at every instant: artifacts are named by their content (``<hash>.<stage>.<sha12>.<ext>``)
     and never overwritten; the manifest is replaced last, atomically, and only then are the files it no
@@ -102,11 +102,7 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
 def _deps(scene: Scene, lib: Library, out: Path) -> list[str]:
     """Every file the build read: the scene, every brick the library loaded, every template composed with
     (this process's, and the last build's for what it kept)."""
-    templates = set()
-    try:
-        templates.update(json.loads((out / STATE).read_text()).get("templates", []))
-    except (OSError, ValueError, AttributeError):
-        pass
+    templates = _state(out).get("templates", [])
     return [shown(scene.path), *(shown(b.path) for b in lib.bricks.values()),
             *(shown(_TEMPLATES / t) for t in sorted(templates))]
 
@@ -134,8 +130,8 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     # what the manifest's scene-wide tables hold beyond the permutations: name, light sets, objects in order
     scene_key = content_key(base, scene.name, sorted((k, list(v)) for k, v in scene.light_sets.items()),
                             [[o["name"], o["material"], o["light_set"], o["permutation"]] for o in scene.objects],
-                            sorted(repr(m) for m in scene.materials.values()), sorted(repr(x) for x in scene.lights.values()))
-    scene_key = content_key(scene_key, keep_removed)
+                            sorted(repr(m) for m in scene.materials.values()), sorted(repr(x) for x in scene.lights.values()),
+                            keep_removed)
     files = _up_to_date(out, keys, uber_key, scene_key)
     if files is not None:  # the record of the last build says every key and file is as it left them
         res.up_to_date, res.kept, res.unchanged = True, len(keys), files + 1
@@ -157,14 +153,17 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     todo = Scene(**{**scene.__dict__, "permutations": {h: p for h, p in scene.permutations.items() if h not in kept}})
     built: dict[str, dict] = {}
 
+    def head(h: str) -> dict:
+        perm = scene.permutations[h]
+        return {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
+                "languages": {}}
+
     def written(pairs, part):  # a compiled chunk: written and analysed while the next chunks compile
         for h, c in pairs:
-            perm = scene.permutations[h]
-            entry = {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
-                     "languages": {}, "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
+            entry = {**head(h), "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
                      "uploads": uploads(scene, h, c)}
             errs = _write_all(res, out, h, c.sources, part, entry)
-            built[h] = _settle(res, entry, errs, old.get(h), out, f"{h} ({perm.canonical()})")
+            built[h] = _settle(res, entry, errs, old.get(h), out, f"{h} ({entry['id']})")
 
     composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra,
                                               workers=workers, executor=executor, on_done=written)
@@ -178,9 +177,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         elif h in built:
             entries.append(built[h])
         else:  # it did not compose
-            entry = {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
-                     "languages": {}}
-            entries.append(_settle(res, entry, list(errors.get(h, [])), old.get(h), out, f"{h} ({perm.canonical()})"))
+            entries.append(_settle(res, head(h), list(errors.get(h, [])), old.get(h), out, f"{h} ({perm.canonical()})"))
     if uber_kept:
         uber = old_uber
         res.unchanged += _files(uber)
@@ -230,10 +227,7 @@ def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, k
     templates composed with (for the depfile of a build that composes nothing)."""
     templates = set(_templates_read())
     if kept:
-        try:
-            templates.update(json.loads((out / STATE).read_text()).get("templates", []))
-        except (OSError, ValueError, AttributeError):
-            pass
+        templates.update(_state(out).get("templates", []))
     ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
         (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
     entries = [*manifest["permutations"], *manifest.get("removed", []), manifest.get("ubershader") or {}]
@@ -243,11 +237,20 @@ def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, k
     atomic_write(out / STATE, (json.dumps(state, sort_keys=True) + "\n").encode())
 
 
+def _state(out: Path) -> dict:
+    """The last build's record (empty when there is none or it does not read as one)."""
+    try:
+        state = json.loads((out / STATE).read_text())
+    except (OSError, ValueError):
+        return {}
+    return state if isinstance(state, dict) else {}
+
+
 def _up_to_date(out: Path, keys: dict, uber_key: str, scene_key: str) -> int | None:
     """The number of files the last build left when nothing at all needs doing (its record has these keys,
     the manifest is the one it wrote, every file it listed has its size), else None."""
+    state = _state(out)
     try:
-        state = json.loads((out / STATE).read_text())
         if not (state.get("complete") and state.get("keys") == keys and state.get("ubershader") == uber_key
                 and state.get("scene") == scene_key):
             return None

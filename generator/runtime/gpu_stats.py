@@ -204,9 +204,13 @@ def _vertex_inputs(vert: bytes):
 
 
 def _value(stat) -> float:
-    v = stat.value
-    return {0: lambda: int(bool(v.b32)), 1: lambda: int(v.i64), 2: lambda: int(v.u64),
-            3: lambda: float(v.f64)}[int(stat.format)]()
+    """A statistic's value by its VkPipelineExecutableStatisticFormatKHR: bool32, int64, uint64, float64."""
+    v, fmt = stat.value, int(stat.format)
+    if fmt == 0:
+        return int(bool(v.b32))
+    if fmt == 3:
+        return float(v.f64)
+    return int(v.i64 if fmt == 1 else v.u64)
 
 
 def _read(device, pipeline, capture_ir: bool) -> tuple[dict, dict]:

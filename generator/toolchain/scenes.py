@@ -35,8 +35,8 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
     later ones), so that writing and analysing overlap the compilers too. Shaders identical across chunks
     are compiled once (an in-memory record beside the store).
     """
-    import queue
-    import threading
+    from collections import deque
+    from concurrent.futures import ThreadPoolExecutor
 
     from ..compose import compose_permutation  # Jinja and the emitters load only when something is composed
     composed: dict[str, Composed] = {}
@@ -46,48 +46,20 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
     size = CHUNK if on_done is not None else max(1, len(items))
     chunks = [items[k:k + size] for k in range(0, len(items), size)] or [[]]
     memo: dict = {}
-    todo: queue.Queue = queue.Queue()
-    finished: queue.Queue = queue.Queue()
-
-    def compiler():
-        while True:
-            got = todo.get()
-            if got is None:
-                return
-            k, jobs = got
-            try:
-                finished.put((k, compile_many(jobs, optimize=True, validate=True, progress=show_progress(),
-                                              store=store, stats=stats, workers=workers, executor=executor,
-                                              memo=memo), None))
-            except BaseException as e:  # re-raised on this thread's caller
-                finished.put((k, None, e))
-
-    thread = threading.Thread(target=compiler, name="compile", daemon=True)
-    thread.start()
-    hashes_of: dict[int, list[str]] = {}
-    pending, next_done = 0, 0
-    done_results: dict[int, dict] = {}
+    waiting: deque = deque()  # (hashes, future) in chunk order: one compile thread, so they finish in order
 
     def deliver(block: bool) -> None:
-        nonlocal pending, next_done
-        while pending and (block or not finished.empty()):
-            k, res, exc = finished.get()
-            pending -= 1
-            if exc is not None:
-                raise exc
-            done_results[k] = res
-            while next_done in done_results:  # in chunk order
-                part = done_results.pop(next_done)
-                results.update(part)
-                if on_done is not None:
-                    on_done([(h, composed[h]) for h in hashes_of[next_done]], part)
-                next_done += 1
-            block = block and pending > 0
+        while waiting and (block or waiting[0][1].done()):
+            hashes, future = waiting.popleft()
+            part = future.result()  # a compile error is raised here, on the caller's thread
+            results.update(part)
+            if on_done is not None:
+                on_done([(h, composed[h]) for h in hashes], part)
 
-    try:
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="compile") as pool:
         for k, chunk in enumerate(chunks):
             jobs: list[CompileJob] = list(extra) if k == 0 else []
-            hashes_of[k] = []
+            hashes = []
             for h, perm in chunk:
                 try:
                     c = compose_permutation(perm, lib, languages)
@@ -95,15 +67,13 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
                     errors[h] = [str(e)]
                     continue
                 composed[h] = c
-                hashes_of[k].append(h)
+                hashes.append(h)
                 for src in c.sources:
                     jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
                                            line_map=tuple(src.line_map)))
-            todo.put((k, jobs))
-            pending += 1
+            waiting.append((hashes, pool.submit(compile_many, jobs, optimize=True, validate=True,
+                                                progress=show_progress(), store=store, stats=stats, workers=workers,
+                                                executor=executor, memo=memo)))
             deliver(block=False)
         deliver(block=True)
-    finally:
-        todo.put(None)
-        thread.join()
     return composed, errors, results
