@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -110,6 +111,7 @@ def test_kill_9_at_any_moment_loses_nothing_and_the_next_build_cleans_up(tmp_pat
         _consistent(out, exact=False)  # whatever the moment: the manifest (old or new) and the files it names agree
     assert landed >= 3, f"only {landed} of the kills found the build running (a build takes {took:.2f} s)"
     from generator.build.outputs import STALE_S
+    _orphans_done()
     for d in Path(tempfile.gettempdir()).glob("shadermatrix-*"):  # let the killed builds' temp dirs be old
         old = time.time() - STALE_S - 1
         os.utime(d, (old, old))
@@ -123,6 +125,23 @@ def test_kill_9_at_any_moment_loses_nothing_and_the_next_build_cleans_up(tmp_pat
     left = [d for d in Path(tempfile.gettempdir()).glob("shadermatrix-*")
             if (m := TEMP_DIR.match(d.name)) and not _alive(int(m[1]))]
     assert left == []  # what the killed builds left in the temp dir went with the next build
+
+
+def _orphans_done(bound_s: float = 60.0) -> None:
+    """Wait until no compiler a killed build started is still running: an orphaned glslc or naga goes on writing
+    into its temp dir after the build is gone, which makes the dir new again (and not a leftover yet)."""
+    end = time.monotonic() + bound_s
+    while time.monotonic() < end:
+        running = []
+        for p in Path("/proc").glob("[0-9]*"):  # the tools run with the build's temp dir as their cwd
+            try:
+                if Path(os.readlink(p / "cwd")).name.startswith("shadermatrix-"):
+                    running.append(p.name)
+            except OSError:
+                continue
+        if not running:
+            return
+        time.sleep(0.2)
 
 
 def test_a_failing_permutation_keeps_its_last_good_outputs_marked_stale(tmp_path):
@@ -141,6 +160,17 @@ def test_a_failing_permutation_keeps_its_last_good_outputs_marked_stale(tmp_path
                                                    "    return vec4(color * float(q), 1.0)"))
     r = _cli("build", scene, "--out", out, "--bricks", engine)
     assert r.returncode == 1 and "Division by zero" in r.stderr
+    # every failure is located at the scene position that asks for it: its first object's material key
+    # (the ubershader's at [scene]), then the brick line the compiler refused
+    heads = [line for line in r.stderr.splitlines() if line.startswith("error: ")]
+    text = scene.read_text().splitlines()
+    assert len(heads) == len(first["permutations"]) + 1
+    for line in heads:
+        m = re.match(rf"error: {re.escape(str(scene))}:(\d+):1: (permutation \w+ \(material '(\w+)'|the scene's "
+                     r"ubershader).* does not build — fix the errors below \(its last good outputs stay", line)
+        assert m, line
+        assert text[int(m[1]) - 1] == (f'material = "{m[3]}"' if m[3] else "[scene]")
+    assert re.search(r"^  engine/tinted\.py:\d+:\d+: error: .*Division by zero", r.stderr, re.M)
     m = _consistent(out)  # the last good set, whole
     for old, new in zip(first["permutations"], m["permutations"]):
         assert new["status"] == "stale" and new["errors"]

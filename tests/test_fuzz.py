@@ -1,9 +1,13 @@
-"""A seeded fuzz suite over the inputs (issue 10): mutated copies of the shipped bricks and the example scene.
+"""A seeded fuzz suite over the inputs (issue 10): mutated copies of the shipped bricks, the example scene and
+sample files.
 
 Every case must either load (and, for a BRDF term, compose in every language), or fail with exactly one
-located message (`path:line:col: what — what to do`,
-a SourceError or UserError) — never another exception (a traceback), and within a time bound. `make test`
-runs FUZZ_CASES of each; the `slow` marker runs FUZZ_SLOW (`pytest -m slow tests/test_fuzz.py`).
+located message (`path:line:col: what — what to do`, a SourceError or UserError) — never another exception
+(a traceback), and within a time bound. Sample files for `eval` fail with one line naming the file. Builds
+of the example scene with one of its bricks replaced by a mutated copy go through the real compilers: exit 0
+with every output valid, or exit 1 with every failure located. `make test` runs FUZZ_CASES of each
+(FUZZ_BUILDS builds); the `slow` marker runs FUZZ_SLOW (FUZZ_BUILDS_SLOW builds):
+`pytest -m slow tests/test_fuzz.py`.
 """
 from __future__ import annotations
 
@@ -18,6 +22,7 @@ REPO = Path(__file__).resolve().parent.parent
 BRICKS = sorted((REPO / "bricks").rglob("*.py"))
 SCENE = (REPO / "scenes" / "example.toml").read_text()
 FUZZ_CASES, FUZZ_SLOW = 150, 5000
+FUZZ_BUILDS, FUZZ_BUILDS_SLOW = 6, 300  # builds run the real compilers
 TIME_BOUND_S = 10.0
 LOCATED = re.compile(r"^[^\n]+:\d+:\d+: [^\n]+$")
 
@@ -123,6 +128,102 @@ def _composed(n: int, seed: int, tmp_path):
         _check(both, path)
 
 
+def _samples(n: int, seed: int, tmp_path):
+    """Mutated sample files for `eval`: flipped and inserted header and data bytes, truncation, other shapes and
+    dtypes, non-finite and non-unit rows. load_samples returns the samples or raises one line naming the file."""
+    import io as _io
+
+    import numpy as np
+
+    from generator.cli.commands.eval import _Usage, load_samples
+    rng = random.Random(seed)
+    gen = np.random.default_rng(seed)
+    tmp_path.mkdir(parents=True, exist_ok=True)
+    for k in range(n):
+        path = tmp_path / f"s{k}.npy"
+        rows = int(gen.integers(0, 6))
+        cols = rng.choice([9, 9, 12, 3, 10])
+        v = gen.normal(size=(rows, cols))
+        if cols in (9, 12):
+            w = v.reshape(rows, cols // 3, 3)
+            v = (w / np.linalg.norm(w, axis=2, keepdims=True)).reshape(rows, cols)
+        if rows and rng.random() < 0.3:
+            v[rng.randrange(rows), rng.randrange(cols)] = rng.choice([np.nan, np.inf, -np.inf, 1e300, 0.0, 2.0])
+        dtype = rng.choice(["<f8", "<f4", "<f2", ">f8", "<i4", "|u1", "<c8"])
+        buf = _io.BytesIO()
+        with np.errstate(over="ignore", invalid="ignore"):  # 1e300 as float16, NaN as an integer: whatever it gives
+            np.save(buf, v.astype(dtype) if dtype[-2] != "c" else v.astype(np.complex64))
+        data = bytearray(buf.getvalue())
+        for _ in range(rng.randint(0, 3)):
+            op, i = rng.randrange(4), rng.randrange(len(data))
+            if op == 0:
+                data[i] = rng.randrange(256)
+            elif op == 1:
+                data.insert(i, rng.choice(b"(),:'0123456789 {}Lx\n\x00\xff"))
+            elif op == 2:
+                del data[i:]
+            else:
+                data[i:i] = data[:rng.randrange(1, 16)]
+        path.write_bytes(bytes(data))
+        t = time.perf_counter()
+        try:
+            load_samples(str(path))
+        except _Usage as e:
+            text = str(e)
+            assert text.startswith(f"{path}: ") and "\n" not in text and " — " in text, text
+        assert time.perf_counter() - t < TIME_BOUND_S
+
+
+def _builds(n: int, seed: int, tmp_path):
+    """`shadermatrix build` of the example scene with one of its bricks replaced by a mutated engine copy: exit 0
+    with every permutation and the ubershader ok; or exit 1 with one located line (the brick or scene did not
+    load) or with every failure located (the scene position that asks for the permutation, then the brick lines). Never a traceback, within a bound.
+    The compilers are real: a shared cache keeps the unmutated shaders from being compiled twice."""
+    import json
+    import subprocess
+    import sys
+
+    used = [b for b in BRICKS if re.search(rf"[\"(+=]{b.stem}[\",)+]", SCENE) or f'"{b.stem}"' in SCENE]
+    rng = random.Random(seed)
+    cache = tmp_path / "cache"
+    for k in range(n):
+        src = rng.choice(used)
+        case = tmp_path / f"b{k}"
+        (case / "engine").mkdir(parents=True)
+        (case / "engine" / f"fz{src.stem}.py").write_text(_mutate(src.read_text(), rng, PY_VALUES))
+        scene = case / "scene.toml"
+        scene.write_text(re.sub(rf"(?<=[\"(+=]){src.stem}(?=[\",)+])", f"fz{src.stem}", SCENE))
+        t = time.perf_counter()
+        r = subprocess.run([sys.executable, "-m", "generator.cli", "build", str(scene), "--out", str(case / "out"),
+                            "--bricks", str(case / "engine"), "--cache-dir", str(cache), "-q"],
+                           cwd=REPO, capture_output=True, text=True, timeout=120)
+        took = time.perf_counter() - t
+        what = f"case {k} ({src.name}): exit {r.returncode}\n{r.stderr}"
+        assert "Traceback" not in r.stderr and r.returncode in (0, 1), what
+        errors = [line for line in r.stderr.splitlines() if line.startswith("error: ")]
+        if r.returncode == 0:
+            m = json.loads((case / "out" / "manifest.json").read_text())
+            assert not errors and all(p["status"] == "ok" for p in m["permutations"]), what
+            assert m["ubershader"]["status"] == "ok", what
+        elif not (case / "out" / "manifest.json").exists():  # the brick or the scene did not load: one line
+            assert len(errors) == 1 and LOCATED.match(errors[0][len("error: "):]), what
+            assert r.stderr.strip() == errors[0], what
+        else:  # compile failures: each located at the scene, then the brick lines the compilers refused
+            assert errors and all(LOCATED.match(e[len("error: "):]) and " — " in e for e in errors), what
+            detail = [line for line in r.stderr.splitlines() if line.startswith("  ") and ": error: " in line]
+            assert all(re.match(r"^  [^\n]+:\d+:\d+: error: ", line) for line in detail), what
+        assert took < 60, f"{what}: took {took:.1f} s"
+
+
+def test_mutated_sample_files_load_or_fail_with_one_message(tmp_path):
+    _samples(FUZZ_CASES, 7, tmp_path)
+
+
+@pytest.mark.toolchain
+def test_builds_with_a_mutated_brick_succeed_or_fail_located(tmp_path):
+    _builds(FUZZ_BUILDS, 8, tmp_path)
+
+
 def test_mutated_bricks_load_or_fail_with_one_located_message(tmp_path):
     _bricks(FUZZ_CASES, 1, tmp_path)
 
@@ -140,3 +241,10 @@ def test_mutated_inputs_at_full_size(tmp_path):
     _bricks(FUZZ_SLOW, 3, tmp_path / "b")
     _scenes(FUZZ_SLOW, 4, tmp_path / "s")
     _composed(FUZZ_SLOW // 5, 6, tmp_path / "c")
+    _samples(FUZZ_SLOW, 9, tmp_path / "n")
+
+
+@pytest.mark.slow
+@pytest.mark.toolchain
+def test_builds_with_a_mutated_brick_at_full_size(tmp_path):
+    _builds(FUZZ_BUILDS_SLOW, 10, tmp_path)

@@ -163,7 +163,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
             entry = {**head(h), "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
                      "uploads": uploads(scene, h, c)}
             errs = _write_all(res, out, h, c.sources, part, entry)
-            built[h] = _settle(res, entry, errs, old.get(h), out, f"{h} ({entry['id']})")
+            built[h] = _settle(res, entry, errs, old.get(h), out, _what(scene, h, users.get(h, [])))
 
     composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra,
                                               workers=workers, executor=executor, on_done=written)
@@ -177,7 +177,8 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         elif h in built:
             entries.append(built[h])
         else:  # it did not compose
-            entries.append(_settle(res, head(h), list(errors.get(h, [])), old.get(h), out, f"{h} ({perm.canonical()})"))
+            entries.append(_settle(res, head(h), list(errors.get(h, [])), old.get(h), out,
+                                   _what(scene, h, users.get(h, []))))
     if uber_kept:
         uber = old_uber
         res.unchanged += _files(uber)
@@ -209,15 +210,31 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     return res
 
 
-def _settle(res: BuildResult, entry: dict, errs: list[str], old: dict | None, out: Path, what: str) -> dict:
-    """An entry's status: ok; or, when it failed, its last good entry kept whole and marked stale."""
+def _what(scene: Scene, h: str, objs: list[dict]) -> tuple[str, str]:
+    """Where the scene asks for permutation h (its first object's material key), and which it is."""
+    line, col = scene.where.get(h, (1, 1))
+    names = [o["name"] for o in objs]
+    who = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+    first = objs[0] if objs else {"material": "?", "light_set": "?"}
+    return (f"{scene.path}:{line}:{col}: permutation {h} (material '{first['material']}', light set "
+            f"'{first['light_set']}'; objects {who}) does not build", scene.permutations[h].canonical())
+
+
+def _settle(res: BuildResult, entry: dict, errs: list[str], old: dict | None, out: Path,
+            what: tuple[str, str]) -> dict:
+    """An entry's status: ok; or, when it failed, its last good entry kept whole and marked stale.
+
+    what: the failure's located head (the scene position that asks for it) and the key it stands for."""
     if not errs:
         entry["status"] = "ok"
         entry.pop("failed_sources", None)
         return entry
-    res.failures.append(f"{what}:\n  " + "\n  ".join(errs))
     failed = entry.get("failed_sources", {})
-    if old is not None and old.get("status") in ("ok", "stale") and _intact(out, old):
+    stale = old is not None and old.get("status") in ("ok", "stale") and _intact(out, old)
+    kept = "its last good outputs stay, marked stale" if stale else "it has no outputs yet"
+    head, key = what
+    res.failures.append("\n  ".join([f"{head} — fix the errors below ({kept})", *([key] if key else []), *errs]))
+    if stale:
         return {**old, "status": "stale", "errors": errs, "failed_sources": failed}
     return {**entry, "languages": {}, "status": "failed", "errors": errs, "failed_sources": failed}
 
@@ -392,13 +409,19 @@ def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, unit, r
     if unit is None:
         return {}
     if isinstance(unit, str):
-        return _settle(res, {"input_key": key, "languages": {}}, [unit], old, out, "ubershader")
+        return _settle(res, {"input_key": key, "languages": {}}, [unit], old, out, _uber_what(scene))
     c, u = unit
     perms = [p for _, p in sorted(scene.permutations.items())]
     entry = {"input_key": key, "hash": c.hash, "languages": {}, "tables": u.tables(), "interface": c.interface.as_dict()}
     errs = [f"coverage: {p}" for p in coverage(u, perms, lib)]
     errs += _write_all(res, out, "ubershader", c.sources, results, entry)
-    return _settle(res, entry, errs, old, out, "ubershader")
+    return _settle(res, entry, errs, old, out, _uber_what(scene))
+
+
+def _uber_what(scene: Scene) -> tuple[str, str]:
+    line, col = scene.head_at
+    return (f"{scene.path}:{line}:{col}: the scene's ubershader (the fallback for all {len(scene.permutations)} "
+            "permutations) does not build", "")
 
 
 def _count(res: BuildResult, changed: bool) -> None:

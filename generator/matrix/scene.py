@@ -105,6 +105,10 @@ class Scene:
     objects: list[dict]
     permutations: dict[str, Permutation] = field(default_factory=dict)  # hash -> key
     users: dict[str, list[str]] = field(default_factory=dict)  # hash -> object names
+    # where messages about a permutation point: its first object's `material = ...` (line, col); the
+    # ubershader's, which every material feeds, points at [scene]
+    where: dict[str, tuple[int, int]] = field(default_factory=dict)
+    head_at: tuple[int, int] = (1, 1)
 
 
 def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]:
@@ -145,7 +149,7 @@ def load_scene(path, lib: Library) -> Scene:
     if lib.get("output", output) is None:
         raise loc.error(loc.find("scene", "output"), f"unknown output brick '{output}'",
                         f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
-    scene = Scene(path, head.get("name", path.stem), output, precision, {}, {}, {}, [])
+    scene = Scene(path, head.get("name", path.stem), output, precision, {}, {}, {}, [], head_at=(loc.top("scene")[0], 1))
 
     for name, m in _table(loc, data, "materials").items():
         where = loc.find(f"materials.{name}")
@@ -230,6 +234,7 @@ def load_scene(path, lib: Library) -> Scene:
         keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in names)
         perm = Permutation(m.brdf, keys, m.packing, output, precision)
         scene.permutations.setdefault(perm.hash, perm)
+        scene.where.setdefault(perm.hash, loc.find("objects", "material", nth=i))
         scene.users.setdefault(perm.hash, []).append(oname)
         scene.objects.append({"name": oname, "material": mat, "light_set": lset, "lights": names,
                               "permutation": perm.hash})

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import io
 import sys
+from tokenize import TokenError
 from pathlib import Path
 
 from ... import DTYPES, EVAL_TARGETS
@@ -65,6 +66,10 @@ UNIT_TOL = 1e-3  # |length - 1| a sample vector may have (float16 inputs round t
 MAX_SAMPLES = 50_000_000  # rows of an input (12 float64 columns: 4.8 GB)
 
 
+def _one_line(exc: Exception) -> str:
+    return " ".join(str(exc).split())
+
+
 def load_samples(path: str, checked: bool = True):
     """The (N, 9|12) sample array of an .npy file, as float64 (checked: finite unit vectors)."""
     import numpy as np
@@ -78,8 +83,8 @@ def load_samples(path: str, checked: bool = True):
             read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
             shape, _, dtype = read(f)
             start = f.tell()
-    except (ValueError, OSError, EOFError, SyntaxError) as exc:
-        raise _Usage(f"{path}: not a readable .npy array ({exc}) — save the samples with numpy.save") from None
+    except (ValueError, OSError, EOFError, SyntaxError, TokenError) as exc:  # numpy tokenizes the header dict
+        raise _Usage(f"{path}: not a readable .npy array ({_one_line(exc)}) — save the samples with numpy.save") from None
     # everything the header declares is checked before np.load allocates a byte
     if dtype.kind != "f":
         raise _Usage(f"{path}: dtype {dtype} is not a float array — save float32 or float64 samples")
@@ -92,7 +97,7 @@ def load_samples(path: str, checked: bool = True):
     try:
         a = np.load(p, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
-        raise _Usage(f"{path}: not a readable .npy array ({exc}) — save the samples with numpy.save") from None
+        raise _Usage(f"{path}: not a readable .npy array ({_one_line(exc)}) — save the samples with numpy.save") from None
     if not isinstance(a, np.ndarray) or a.dtype.kind != "f":
         raise _Usage(f"{path}: dtype {getattr(a, 'dtype', type(a).__name__)} is not a float array — "
                      "save float32 or float64 samples")
