@@ -111,3 +111,42 @@ def test_a_light_set_past_the_limit_is_one_located_error(tmp_path):
         load_scene(path, load_library())
     assert f"light set 'many' has {n} lights, more than the {MAX_LIGHTS_PER_SET}" in str(e.value)
     assert str(e.value).startswith(f"{path}:{4 + 2 * n}:")  # the line of many = [...]
+
+
+TOML_FORMS = [  # (id, what replaces what, the line:col of the error) — each was located at 1:1 before
+    ("params-sub-table", ('params = { alpha = 0.15, f0 = [1.0, 0.71, 0.29] }',
+                          '[materials.polished_gold.params]\nalpha = 0.15\nrougness = 0.3'), "22:1"),
+    ("dotted-key", ('params = { alpha = 0.15, f0 = [1.0, 0.71, 0.29] }', 'params.alpha = 0.15\nparams.rougness = 0.3'),
+     "21:8"),
+    ("quoted-table-name", ('[materials.polished_gold]\nbrdf', '[materials."polished_gold"]\nshadows = 1\nbrdf'), "19:1"),
+]
+
+
+@pytest.mark.parametrize("case", TOML_FORMS, ids=[c[0] for c in TOML_FORMS])
+def test_errors_in_other_toml_forms_are_located_at_the_key(case, tmp_path):
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+
+    _, (old, new), where = case
+    assert old in BASE
+    path = tmp_path / "scene.toml"
+    path.write_text(BASE.replace(old, new, 1))
+    with pytest.raises(SourceError) as e:
+        load_scene(path, load_library())
+    assert str(e.value).startswith(f"{path}:{where}: "), str(e.value)
+
+
+def test_the_first_error_reported_is_the_first_in_the_file(tmp_path):
+    """Two violations: the one nearer the top is reported, whatever the order of the schema's key paths."""
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+
+    path = tmp_path / "scene.toml"
+    text = BASE.replace('name = "bench"', 'name = "bench"\ncolour = 1')  # objects come after materials in the file
+    text = text.replace('shadow = "shadow_map"', 'shadows = "shadow_map"')  # [lights.sun], before the objects
+    objects_first = "[[objects]]\n" + text.split("[[objects]]\n", 1)[1]
+    text = objects_first + "\n" + text.split("[[objects]]\n", 1)[0]  # now the objects come first
+    path.write_text(text)
+    with pytest.raises(SourceError) as e:
+        load_scene(path, load_library())
+    assert "unknown key 'colour' in object 1" in str(e.value), str(e.value)

@@ -25,7 +25,11 @@ from .permutation import (PRECISIONS, LightKey, Permutation, SpecError, canonica
 
 
 class Locator:
-    """Finds line:col of tables and keys in TOML text (tomllib keeps no positions)."""
+    """Finds line:col of tables and keys in TOML text (tomllib keeps no positions).
+
+    Knows the forms a scene is written in: [a.b] and [[a]] headers (quoted parts too: [materials."m"]),
+    keys inside inline tables (params = { n = 1 }), dotted keys (params.n = 1) and sub-tables
+    ([materials.m.params]). What it cannot find is located at its table's header, or at 1:1."""
 
     _HEADER = re.compile(r"^\s*\[\[?\s*([^\[\]]*?)\s*\]\]?")
 
@@ -33,19 +37,29 @@ class Locator:
         self.path, self.lines = path, text.splitlines()
         self._headers: dict[str, list[int]] | None = None  # "a.b" -> the lines of its [a.b] / [[a.b]] headers
 
+    @staticmethod
+    def _name(header: str) -> str:
+        return ".".join(p.strip().strip("\"'") for p in header.split("."))
+
     def _header(self, header: str, nth: int = 0) -> int:
         if self._headers is None:  # one pass over the text, on the first lookup: every lookup is then O(1)
             self._headers = {}
             for i, line in enumerate(self.lines):
                 m = self._HEADER.match(line)
                 if m:
-                    name = ".".join(p.strip() for p in m[1].split("."))
-                    self._headers.setdefault(name, []).append(i)
-        hits = self._headers.get(".".join(p.strip() for p in header.split(".")), [])
+                    self._headers.setdefault(self._name(m[1]), []).append(i)
+        hits = self._headers.get(self._name(header), [])
         return hits[nth] if len(hits) > nth else -1
+
+    @staticmethod
+    def _key(k: str) -> str:
+        e = re.escape(k)
+        return rf"(?:{e}|\"{e}\"|'{e}')"
 
     def find(self, header: str, *keys: str, nth: int = 0) -> tuple[int, int]:
         """(line, col) of header's key path (keys may continue inside an inline table)."""
+        if header and keys and header != "objects" and self._header(f"{header}.{keys[0]}") >= 0:
+            return self.find(f"{header}.{keys[0]}", *keys[1:])  # a sub-table: [materials.m.params]
         start = self._header(header, nth) if header else -1
         if header and start < 0:
             return 1, 1
@@ -55,11 +69,15 @@ class Locator:
             line = self.lines[i]
             if re.match(r"^\s*\[", line):
                 break
-            m = re.match(r"^\s*" + re.escape(keys[0]) + r"\s*=", line)
+            for j in range(len(keys), 0, -1):  # the longest dotted prefix of the path: params.n = 1
+                m = re.match(r"^\s*" + r"\s*\.\s*".join(self._key(k) for k in keys[:j]) + r"\s*=", line)
+                if m:
+                    break
             if m:
-                line_no, col = i + 1, line.index(keys[0]) + 1
-                for k in keys[1:]:
-                    km = re.search(r"(?<![\w.])" + re.escape(k) + r"\s*=", line[col:])
+                last = re.search(self._key(keys[j - 1]) + r"\s*=", line[:m.end()])
+                line_no, col = i + 1, (last.start() if last else line.index(keys[0])) + 1
+                for k in keys[j:]:
+                    km = re.search(r"(?<![\w.])" + self._key(k) + r"\s*=", line[col:])
                     if km:
                         col = col + km.start() + 1
                 return line_no, col

@@ -77,13 +77,22 @@ def _where(path: list) -> str:
 
 
 def check(data: dict, loc) -> None:
-    """Raise the scene's first schema violation as a located SourceError (schema order: deterministic)."""
+    """Raise the scene's first schema violation, by position in the file, as a located SourceError."""
     from jsonschema import Draft202012Validator
 
-    errors = sorted(Draft202012Validator(SCENE_SCHEMA).iter_errors(data), key=lambda e: [str(p) for p in e.path])
-    if not errors:
-        return
-    e = errors[0]
+    first = None
+    for k, e in enumerate(Draft202012Validator(SCENE_SCHEMA).iter_errors(data)):
+        err = _located(e, loc)
+        if first is None or (err.line, err.col) < (first.line, first.col):
+            first = err
+        if k >= 10_000:  # enough to find the earliest of a hostile file's violations
+            break
+    if first is not None:
+        raise first
+
+
+def _located(e, loc):
+    """One schema violation as a SourceError at its key (a message and what to do)."""
     path = list(e.path)
     head, keys, nth = _header(path)
     if e.validator == "additionalProperties":
@@ -92,23 +101,23 @@ def check(data: dict, loc) -> None:
         pos = loc.top(extra) if not path else loc.find(head, *keys, extra, nth=nth)
         near = difflib.get_close_matches(extra, allowed, n=1)
         hint = f"did you mean '{near[0]}'?" if near else f"allowed: {', '.join(allowed)}"
-        raise loc.error(pos, f"unknown key '{extra}' in {_where(path)}", hint)
+        return loc.error(pos, f"unknown key '{extra}' in {_where(path)}", hint)
     pos = loc.find(head, *keys, nth=nth) if head else (1, 1)
     key = ".".join(str(p) for p in path) or "the scene"
     if e.validator == "required":
         missing = next(k for k in e.validator_value if k not in e.instance)
-        raise loc.error(pos, f"{_where(path)} has no '{missing}'", f"add {missing} = …")
+        return loc.error(pos, f"{_where(path)} has no '{missing}'", f"add {missing} = …")
     if e.validator == "type":
         want = _TYPES.get(e.validator_value, e.validator_value)
         example = _EXAMPLES.get(str(path[0]) if path else "", "see README, \"Scene files\"")
-        raise loc.error(pos, f"'{key}' must be {want}, not {_what(e.instance)}", f"write {example}"
-                        if len(path) <= 1 else f"give {want}")
+        return loc.error(pos, f"'{key}' must be {want}, not {_what(e.instance)}", f"write {example}"
+                         if len(path) <= 1 else f"give {want}")
     if e.validator == "anyOf":
-        raise loc.error(pos, f"'{key}' must be a number or an array of numbers, not {_what(e.instance)}",
-                        "write e.g. 0.5 or [0.8, 0.1, 0.1]")
+        return loc.error(pos, f"'{key}' must be a number or an array of numbers, not {_what(e.instance)}",
+                         "write e.g. 0.5 or [0.8, 0.1, 0.1]")
     if e.validator == "propertyNames":
-        raise loc.error(pos, f"a name in '{key}' is empty, too long or holds a control character",
-                        "give printable names of at most 256 characters")
+        return loc.error(pos, f"a name in '{key}' is empty, too long or holds a control character",
+                         "give printable names of at most 256 characters")
     if e.validator in ("minLength", "maxLength", "pattern", "minItems", "maxItems"):
         limit = e.validator_value
         what, todo = {"minLength": ("is empty", "give a value"),
@@ -116,5 +125,5 @@ def check(data: dict, loc) -> None:
                       "pattern": ("holds a control character or a line break", "give a printable name"),
                       "minItems": ("is empty", "give at least one item"),
                       "maxItems": (f"has more than {limit} items", f"keep it to {limit}")}[e.validator]
-        raise loc.error(pos, f"'{key}' {what}", todo)
-    raise loc.error(pos, f"'{key}': {e.message}", "see README, \"Scene files\"")
+        return loc.error(pos, f"'{key}' {what}", todo)
+    return loc.error(pos, f"'{key}': {e.message}", "see README, \"Scene files\"")
