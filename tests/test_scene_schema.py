@@ -150,3 +150,36 @@ def test_the_first_error_reported_is_the_first_in_the_file(tmp_path):
     with pytest.raises(SourceError) as e:
         load_scene(path, load_library())
     assert "unknown key 'colour' in object 1" in str(e.value), str(e.value)
+
+
+def test_loading_is_linear_in_the_objects(tmp_path, monkeypatch):
+    """10,000 objects over five permutations: the scene's text is indexed once, an object's position is looked up
+    only for the first object of each permutation (and for errors), and plain objects skip jsonschema (it walked
+    every object: 1 s of the 10,000). Counted, not timed: benchmarks/build.py times it."""
+    from generator.library.bricks import load_library
+    from generator.matrix import schema
+    from generator.matrix.scene import Locator, load_scene
+
+    head, rest = BASE.split("[[objects]]", 1)
+    objects = ["[[objects]]" + o for o in ("[[objects]]" + rest).split("[[objects]]")[1:]]
+    text = head + "".join(o.replace('name = "', f'name = "n{i}_', 1)
+                          for i, o in enumerate(objects[k % len(objects)] for k in range(10_000)))
+    path = tmp_path / "big.toml"
+    path.write_text(text)
+    calls = {"find": 0, "validated": 0}
+    find, plain = Locator.find, schema._plain_object
+
+    def counted_find(self, *a, **k):
+        calls["find"] += a[0] == "objects"  # the materials' and lights' keys are looked up once each
+        return find(self, *a, **k)
+
+    def counted_plain(o):
+        calls["validated"] += not plain(o)
+        return plain(o)
+    monkeypatch.setattr(Locator, "find", counted_find)
+    monkeypatch.setattr(schema, "_plain_object", counted_plain)
+    scene = load_scene(path, load_library())
+    assert len(scene.objects) == 10_000 and len(scene.permutations) == 5
+    assert calls == {"find": 5, "validated": 0}
+    assert {h: text.splitlines()[line - 1] for h, (line, _) in scene.where.items()} == {
+        o["permutation"]: f'material = "{o["material"]}"' for o in reversed(scene.objects)}

@@ -227,11 +227,11 @@ def load_scene(path, lib: Library) -> Scene:
     if not isinstance(objects, list):
         raise loc.error((1, 1), "objects must be an array of tables", "write [[objects]] sections")
     seen_names: dict[str, int] = {}
+    hashes: dict[Permutation, str] = {}
     for i, obj in enumerate(objects):
-        where = loc.find("objects", nth=i)
         oname = obj.get("name", f"object{i}")
         if oname in seen_names:
-            raise loc.error(loc.find("objects", "name", nth=i) if "name" in obj else where,
+            raise loc.error(loc.find("objects", *(["name"] if "name" in obj else []), nth=i),
                             f"object name '{oname}' is used twice (object {seen_names[oname] + 1} and {i + 1})",
                             "give every object its own name")
         seen_names[oname] = i
@@ -246,16 +246,18 @@ def load_scene(path, lib: Library) -> Scene:
                                 f"light sets: {', '.join(scene.light_sets) or 'none defined'}")
             names = scene.light_sets[lset]
         else:
-            raise loc.error(loc.find("objects", "lights", nth=i) if "lights" in obj else where,
+            raise loc.error(loc.find("objects", *(["lights"] if "lights" in obj else []), nth=i),
                             f"object '{oname}' needs lights = a light set name", 'write lights = "outdoor"')
         m = scene.materials[mat]
         keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in names)
         perm = Permutation(m.brdf, keys, m.packing, output, precision)
-        scene.permutations.setdefault(perm.hash, perm)
-        scene.where.setdefault(perm.hash, loc.find("objects", "material", nth=i))
-        scene.users.setdefault(perm.hash, []).append(oname)
-        scene.objects.append({"name": oname, "material": mat, "light_set": lset, "lights": names,
-                              "permutation": perm.hash})
+        h = hashes.get(perm)
+        if h is None:  # the first object of a permutation: where messages about it will point
+            h = hashes[perm] = perm.hash
+            scene.permutations.setdefault(h, perm)
+            scene.where.setdefault(h, loc.find("objects", "material", nth=i))
+        scene.users.setdefault(h, []).append(oname)
+        scene.objects.append({"name": oname, "material": mat, "light_set": lset, "lights": names, "permutation": h})
     return scene
 
 
