@@ -122,3 +122,117 @@ def test_slot_defaults_that_form_a_cycle_are_one_error(tmp_path):
                                      "def ndf(NdotH: float, NxH2: float, alpha: float) -> float:\n    return NdotH\n")
     with pytest.raises(SpecError, match="the slot defaults form a cycle"):
         parse_brdf("sp", load_library([tmp_path]))
+
+
+GLUE_CLASH = '''"""A diffuse term whose helper is named like the glue's functions once linked."""
+BRICK = {"kind": "diffuse", "cite": "test", "params": {"rho_d": {"type": "vec3", "default": [0.5, 0.5, 0.5]}}}
+
+
+def HELPER(x: float) -> float:
+    return 0.5 * x
+
+
+def diffuse(NdotL: float, rho_d: vec3) -> vec3:
+    return rho_d * HELPER(NdotL)
+'''
+
+
+@pytest.mark.parametrize("helper", ["lit", "switch", "lit_0"])
+def test_a_brick_whose_functions_link_as_the_glues_is_one_error_at_load(helper, tmp_path):
+    """Issue 10: a brick brdf.py with a helper `lit` was linked as `brdf_lit`, the glue's function: composing it
+    failed at `<glue>:1:1` ("generated twice when linking"), with a hint about bricks of different kinds."""
+    from generator.library.bricks import load_library
+
+    (tmp_path / "brdf.py").write_text(GLUE_CLASH.replace("HELPER", helper))
+    with pytest.raises(SourceError) as e:
+        load_library([tmp_path])
+    text = str(e.value)
+    assert text.startswith(f"{tmp_path.name}/brdf.py:5:1: function '{helper}' of brick 'brdf' would be linked as "
+                           f"'brdf_{helper}', a function of the generated glue — "), text
+
+
+def test_a_brick_named_brdf_with_other_helpers_composes(tmp_path):
+    from generator.compose import compose_eval
+    from generator.library.bricks import load_library
+
+    (tmp_path / "brdf.py").write_text(GLUE_CLASH.replace("HELPER", "half"))
+    composed = compose_eval("brdf", load_library([tmp_path]))
+    assert all("brdf_half(" in s.text for s in composed.sources)
+
+
+def test_the_glue_and_templates_generate_only_the_names_bricks_are_kept_from():
+    """GLUE_FUNCTIONS and TEMPLATE_STRUCTS (what a brick's function and struct names are checked against) cover
+    every function the link stage generates and every block or struct the templates declare."""
+    import re
+
+    from generator.lang.parse import TEMPLATE_STRUCTS, _TEMPLATE_STRUCT_FAMILIES
+    from generator.library.bricks import GLUE_FUNCTIONS, REPO, load_library
+    from generator.link import link_permutation, switch_program
+    from generator.link.uber import link_ubershader
+    from generator.matrix.scene import load_scene
+
+    lib = load_library()
+    perms = list(load_scene(REPO / "scenes" / "example.toml", lib).permutations.values())
+    programs = [switch_program(["lambert", "microfacet(ndf=beckmann)", "lambert+phong_normalized"], lib).program,
+                link_permutation(perms[0], lib).program, link_ubershader(perms, lib).program]
+    brick_structs = {n for b in lib.bricks.values() for n in b.module.structs}
+    for prog in programs:
+        glue = {f.name for f in prog.functions if f.loc.path == "<glue>"}
+        assert glue and all(GLUE_FUNCTIONS.fullmatch(n) for n in glue), glue
+        made = {st.name for st in prog.structs} - brick_structs
+        assert all(n in TEMPLATE_STRUCTS or _TEMPLATE_STRUCT_FAMILIES.fullmatch(n) for n in made), made
+    declared = {m[1] for t in (REPO / "templates").rglob("*.j2") for m in re.finditer(
+        r"\b(?:struct|uniform|buffer|cbuffer)\s+([A-Z]\w*)", t.read_text())}
+    assert declared and declared <= TEMPLATE_STRUCTS, declared - TEMPLATE_STRUCTS
+
+
+LONGEST = '''"""The longest names a brick may have: 64-character id, function, parameter, local, struct and field."""
+BRICK = {"kind": "specular", "cite": "test", "slots": {"ndf": {"kind": "ndf", "default": "ggx"}},
+         "params": {"PPPP": {"type": "float", "range": [0.0, 1.0], "default": 0.5}}}
+
+
+class SSSS:
+    FFFF: float
+
+
+def HHHH(NdotH: float, NxH2: float, PPPP: float) -> float:
+    LLLL = SSSS(ndf(NdotH, NxH2, 0.3))
+    return LLLL.FFFF * PPPP
+
+
+def specular(NdotH: float, NxH2: float, PPPP: float) -> vec3:
+    return vec3(HHHH(NdotH, NxH2, PPPP))
+'''
+
+
+def _longest(tmp_path):
+    from generator.compose import compose_eval
+    from generator.library.bricks import load_library
+
+    text = LONGEST
+    for short, ch in (("PPPP", "p"), ("SSSS", "S"), ("FFFF", "f"), ("HHHH", "h"), ("LLLL", "l")):
+        text = text.replace(short, ch * 64)
+    (tmp_path / f"{'b' * 64}.py").write_text(text)
+    return compose_eval("b" * 64, load_library([tmp_path]))
+
+
+def test_the_longest_names_stay_far_below_the_compilers_limits(tmp_path):
+    """64 characters per identifier: the longest generated name, `<id>_<6 hex>_<function>`, is 136 characters
+    (glslang takes 1,024, GLSL and HLSL alike); a 1,023-character struct name used to fail in glslang."""
+    import re
+
+    for src in _longest(tmp_path).sources:
+        longest = max(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", src.text), key=len)
+        assert len(longest) == 64 + 1 + 6 + 1 + 64 and longest.endswith("_" + "h" * 64), (src.language, longest)
+
+
+@pytest.mark.toolchain
+def test_the_longest_names_compile_in_every_language(tmp_path, require_tool):
+    from generator.toolchain import CompileJob, compile_many
+
+    for tool in ("glslc", "naga", "spirv-val", "spirv-opt"):
+        require_tool(tool)
+    jobs = [CompileJob(f"longest.comp.{s.language}", s.language, "comp", s.text, line_map=tuple(s.line_map))
+            for s in _longest(tmp_path).sources]
+    results = compile_many(jobs)
+    assert all(r.ok for r in results.values()), [e for r in results.values() for e in r.errors()]

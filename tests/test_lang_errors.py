@@ -33,6 +33,17 @@ CASES = [
     ("def f(x: float) -> float:\n    x\n    return x\n", 5, 5, "does nothing"),
     ("x = 3\n", 4, 1, "not a constant"),
     ("def f(x: float) -> float:\n    return x +\n", 5, 15, "syntax error"),
+    # identifiers: ASCII, at most 64 characters (a 1,023-character name failed in glslang, past its 1,024 with the prefix)
+    ("class " + "S" * 1023 + ":\n    a: float\n", 4, 1, "is 1023 characters long, more than the 64 allowed"),
+    ("def " + "f" * 65 + "(x: float) -> float:\n    return x\n", 4, 1, "is 65 characters long"),
+    ("def f(" + "x" * 100 + ": float) -> float:\n    return 1.0\n", 4, 7, "is 100 characters long"),
+    ("def f(x: float) -> float:\n    " + "y" * 200 + " = x\n    return x\n", 5, 5, "is 200 characters long"),
+    ("class S:\n    " + "a" * 70 + ": float\n", 5, 5, "is 70 characters long"),
+    ("def f(x: float) -> float:\n    \u00e9t\u00e9 = x\n    return x\n", 5, 5, "not an ASCII letter, digit or _"),
+    # struct names: CamelCase (generated functions hold a '_'), none of the templates' blocks and structs
+    ("class lobe_data:\n    a: float\n", 4, 1, "must start with a capital letter and hold no '_'"),
+    ("class Material:\n    a: float\n", 4, 1, "is a block or struct name of the generated code"),
+    ("class LightData0:\n    a: vec4\n", 4, 1, "is a block or struct name of the generated code"),
 ]
 
 
@@ -45,6 +56,13 @@ def test_rejected_with_location_and_hint(body, line, col, words):
     assert words in str(err)
     assert err.hint, "every language error says what to do instead"
     assert str(err).startswith(f"bricks/test.py:{line}:{col}: ")
+
+
+def test_identifiers_of_64_characters_are_allowed():
+    f, x, y, field = "f" * 64, "x" * 64, "y" * 64, "a" * 64
+    m = parse_module(brick(f"class {'S' * 64}:\n    {field}: float\n\n\n"
+                           f"def {f}({x}: float) -> float:\n    {y} = {x}\n    return {y}\n"), "b.py")
+    assert f in m.functions and "S" * 64 in m.structs
 
 
 def test_metadata_must_be_literal():

@@ -10,6 +10,7 @@
 from __future__ import annotations
 
 import ast
+import re
 
 from .errors import SourceError
 from .types import ARRAY_ELEMENT_KINDS, BUILTIN_TYPES, Type, array, buffer_layout_error, storage_buffer, uniform_buffer
@@ -21,7 +22,23 @@ def node_error(path: str, node, message: str, hint: str = "") -> SourceError:
     return SourceError(path, getattr(node, "lineno", 1), getattr(node, "col_offset", 0) + 1, message, hint)
 
 
+MAX_IDENTIFIER = 64  # characters in a brick identifier: README, "The brick language"
+# Generated names add at most a brick id, 6 hex digits and a few characters to one (`<id>_<6 hex>_<fn>`:
+# 64 + 8 + 64), far below the shader compilers' limits (glslang: 1024 characters, GLSL and HLSL alike).
+_ASCII_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
 def check_identifier(path: str, node, name: str) -> None:
+    """A name the brick declares (function, parameter, local, struct, field, buffer, loop variable): ASCII,
+    at most MAX_IDENTIFIER characters, never starting with '_' nor holding '__' (the generator's own names)."""
+    if not _ASCII_IDENTIFIER.fullmatch(name):
+        bad = next(c for c in name if not (c.isascii() and (c.isalnum() or c == "_")))
+        raise node_error(path, node, f"identifier '{name}' holds {bad!r} (U+{ord(bad):04X}), not an ASCII letter, "
+                         "digit or _", "rename it: GLSL and HLSL take ASCII names only")
+    if len(name) > MAX_IDENTIFIER:
+        raise node_error(path, node, f"identifier '{name[:24]}…' is {len(name)} characters long, more than the "
+                         f"{MAX_IDENTIFIER} allowed", f"shorten it to at most {MAX_IDENTIFIER} characters (generated "
+                         "names add the brick id and a hash to it; shader compilers limit names to 1024)")
     if name.startswith("_") or "__" in name:
         raise node_error(path, node, f"identifier '{name}' starts with or contains '__' / '_'",
                          "names beginning with '_' or containing '__' are reserved for the generator; rename it")

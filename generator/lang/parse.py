@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ast
 import hashlib
+import re
 from dataclasses import dataclass
 
 from . import ir
@@ -199,8 +200,23 @@ def _module_constant(path, node, name, value) -> ir.Const:
     raise _err(path, value, f"constant {name} must be a number literal", "write e.g. K = 0.5 or N = 4")
 
 
+# Struct and block names of the templates and the glue (templates/*/*.j2, link/glue.py LightData<i>, link/uber.py,
+# link/__init__.py): a brick's struct is emitted under its own name beside them, so it may be none of them.
+TEMPLATE_STRUCTS = frozenset({"Draw", "Frame", "Info", "LightEntry", "Lights", "Material", "MaterialBuffer",
+                              "MaterialEntry", "Object", "PSIn", "Params", "Result", "Samples", "VSIn", "VSOut"})
+_TEMPLATE_STRUCT_FAMILIES = re.compile(r"(LightData|LightBuffer)[0-9]*")
+_STRUCT_NAME = re.compile(r"[A-Z][A-Za-z0-9]*")
+
+
 def _parse_struct(path, node: ast.ClassDef, structs, constants) -> Type:
     check_identifier(path, node, node.name)
+    if not _STRUCT_NAME.fullmatch(node.name):  # every generated function name holds a '_' (`<brick>_<function>`)
+        raise _err(path, node, f"struct name '{node.name}' must start with a capital letter and hold no '_'",
+                   "name structs in CamelCase (Lobe, LightSample): function names in generated code hold a '_', "
+                   "so a struct never meets one")
+    if node.name in TEMPLATE_STRUCTS or _TEMPLATE_STRUCT_FAMILIES.fullmatch(node.name):
+        raise _err(path, node, f"struct name '{node.name}' is a block or struct name of the generated code "
+                   "(templates and glue)", "rename the struct")
     if node.bases or node.keywords or node.decorator_list:
         raise _err(path, node, "a struct is a plain class with annotated fields", "remove base classes and decorators")
     fields = []

@@ -197,6 +197,12 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]{0,63}", path.stem):
         raise SourceError(shown, 1, 1, f"the brick id '{path.stem}' (its file name) is not a name of the brick language",
                           "rename the file: letters, digits and _, starting with a letter or _, at most 64 characters")
+    for fname, f in module.functions.items():
+        linked = f"{path.stem}_{fname}"  # link/program.py: the name of a brick without fillers
+        if GLUE_FUNCTIONS.fullmatch(linked):
+            raise SourceError(shown, f.loc.line, f.loc.col, f"function '{fname}' of brick '{path.stem}' would be "
+                              f"linked as '{linked}', a function of the generated glue",
+                              f"rename the function, or the brick file ('{path.stem}' is its id)")
     if kind == "packing" and "normal" not in slots:
         raise _meta_error(shown, loc, "a packing brick needs a 'normal' slot (the shading normal it provides)",
                           '"slots": {"normal": {"kind": "normal", "default": "vertex"}}')
@@ -204,6 +210,10 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     _check_entries(brick, loc)
     return brick
 
+
+# Functions the link stage and the templates generate (link/glue.py brdf_lit<suffix>, brdf<suffix>, brdf_switch,
+# shade; link/uber.py shade; every template's main): a brick function linked as `<id>_<function>` must never be one.
+GLUE_FUNCTIONS = re.compile(r"(brdf|brdf_lit|shade|main)(_[0-9]+)?|brdf_switch")
 
 PARAM_KEYS = {"type", "range", "default", "doc", "count"}
 MAX_ARRAY = 16
