@@ -40,6 +40,18 @@ CASES = [  # (id, replace, with, line, words)
      "the first is at line 2"),
     ("count-not-an-integer", '"default": 8.0', '"default": 8.0, "count": 2.5', 5,
      "BRICK['params']['n']['count'] must be an integer, not a number"),
+    # non-finite (1e400 is inf to literal_eval) or past float32: parameters are float32 in every shader
+    ("default-inf", '"range": [1.0, 100.0], "default": 8.0', '"default": 1e400', 5,
+     "BRICK['params']['n']['default'] holds inf, outside the float32 range", "write a finite number"),
+    ("default-minus-inf", '"range": [1.0, 100.0], "default": 8.0', '"default": -1e400', 5, "holds -inf"),
+    ("default-past-float32", '"range": [1.0, 100.0], "default": 8.0', '"default": 1e39', 5, "holds 1e+39"),
+    ("vector-default-inf", '"type": "float", "range": [1.0, 100.0], "default": 8.0',
+     '"type": "vec3", "default": [0.5, 1e400, 0.5]', 5, "BRICK['params']['n']['default'] holds inf"),
+    ("array-default-inf", '"range": [1.0, 100.0], "default": 8.0', '"count": 2, "default": [1.0, -1e400]', 5,
+     "holds -inf"),
+    ("range-bound-inf", '"range": [1.0, 100.0]', '"range": [1.0, 1e400]', 5,
+     "BRICK['params']['n']['range'][1] holds inf, outside the float32 range"),
+    ("range-bound-minus-inf", '"range": [1.0, 100.0]', '"range": [-1e400, 100.0]', 5, "['range'][0] holds -inf"),
 ]
 
 
@@ -122,6 +134,15 @@ def test_slot_defaults_that_form_a_cycle_are_one_error(tmp_path):
                                      "def ndf(NdotH: float, NxH2: float, alpha: float) -> float:\n    return NdotH\n")
     with pytest.raises(SpecError, match="the slot defaults form a cycle"):
         parse_brdf("sp", load_library([tmp_path]))
+
+
+def test_a_default_of_inf_is_at_its_key(tmp_path):
+    from generator.library.bricks import load_brick
+
+    path = tmp_path / "t.py"
+    path.write_text(GOOD.replace('"range": [1.0, 100.0], "default": 8.0', '"default": 1e400'))
+    with pytest.raises(SourceError, match=r"t\.py:5:39: BRICK\['params'\]\['n'\]\['default'\] holds inf"):
+        load_brick(path)
 
 
 GLUE_CLASH = '''"""A diffuse term whose helper is named like the glue's functions once linked."""

@@ -32,6 +32,10 @@ CASES = [  # (id, what replaces what, line of the error, words of the message)
     ("param-is-a-boolean", ("alpha = 0.15", "alpha = true"), 20, "must be a number or an array of numbers"),
     ("light-set-not-a-list", ('outdoor = ["sun", "lamp"]', "outdoor = 3"), 45, "'light_sets.outdoor' must be an array"),
     ("control-character-in-a-name", ('name = "bench"', 'name = "be\\u2028nch"'), 49, "holds a control character"),
+    ("param-is-nan", ("alpha = 0.15", "alpha = nan"), 20, "parameter 'alpha': nan is not a finite float32 number"),
+    ("param-holds-inf", ("f0 = [1.0, 0.71, 0.29]", "f0 = [1.0, inf, 0.29]"), 20,
+     "parameter 'f0': inf is not a finite float32 number"),
+    ("param-past-float32", ("alpha = 0.15", "alpha = 1e39"), 20, "1e+39 is not a finite float32 number"),
 ]
 
 

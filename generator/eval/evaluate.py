@@ -80,6 +80,8 @@ def resolve_params(ep: EvalProgram, params: dict | None) -> dict[str, list[float
             rng = ranges[name]
             if "outside the range" in problem:
                 hint = f"give values in [{rng[0]}, {rng[1]}]"
+            elif "finite float32" in problem:
+                hint = "give finite numbers of at most 3.4e38 in magnitude"
             elif ty.kind == "vector":
                 hint = f"give {ty.components} numbers for {ty}, or one number to splat"
             else:

@@ -15,6 +15,7 @@ from ..lang import Signature, SourceError, parse_module
 from ..lang.parse import read_meta_node
 from ..lang.errors import read_text
 from ..lang import ir
+from ..lang.exprs import F32_MAX
 from ..lang.types import BUILTIN_TYPES, INT, Type, array
 from .inputs import SHADING, SURFACE
 from .kinds import KINDS
@@ -280,6 +281,9 @@ def check_value(ty: Type, rng, value) -> str:
         return f"expected {n} numbers for {ty}, got {len(vals)}"
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
         return f"expected numbers for {ty}, got {value!r}"
+    bad = [v for v in vals if not abs(v) <= F32_MAX]  # inf, nan, 1e39: what a float32 uniform cannot hold
+    if bad:
+        return f"{bad[0]!r} is not a finite float32 number (at most 3.4e38 in magnitude)"
     if rng is not None:
         bad = [v for v in vals if not rng[0] <= v <= rng[1]]
         if bad:

@@ -12,7 +12,9 @@ import ast
 import difflib
 
 IDENT = {"type": "string", "pattern": r"^[A-Za-z_][A-Za-z0-9_]{0,63}(?!\n)$"}  # Python's $ matches before a final \n
-NUMBER = {"type": "number"}
+from ..lang.exprs import F32_MAX
+
+NUMBER = {"type": "number", "minimum": -F32_MAX, "maximum": F32_MAX}  # parameters are float32 in every shader
 VALUE = {"anyOf": [NUMBER, {"type": "array", "items": NUMBER, "minItems": 1, "maxItems": 64},
                    {"type": "array", "items": {"type": "array", "items": NUMBER, "minItems": 1, "maxItems": 16},
                     "minItems": 1, "maxItems": 16}]}
@@ -113,6 +115,10 @@ def check(meta: dict, shown: str, loc, positions: dict) -> None:
     if e.validator == "required":
         missing = next(k for k in e.validator_value if k not in e.instance)
         raise SourceError(shown, line, col, f"{key} has no '{missing}'", f"add \"{missing}\": …")
+    huge = _past_float32(e.instance)
+    if e.validator in ("minimum", "maximum") or (e.validator == "anyOf" and huge is not None):
+        raise SourceError(shown, line, col, f"{key} holds {huge!r}, outside the float32 range (±3.4e38)",
+                          "write a finite number of at most 3.4e38 in magnitude (parameters are float32 in shaders)")
     if e.validator == "type":
         raise SourceError(shown, line, col, f"{key} must be {_TYPES.get(e.validator_value, e.validator_value)}, "
                           f"not {_what(e.instance)}", "see README, \"The brick language\"")
@@ -123,6 +129,15 @@ def check(meta: dict, shown: str, loc, positions: dict) -> None:
         raise SourceError(shown, line, col, f"{key} has {len(e.instance)} items", "a range is [low, high]"
                           if path and path[-1] == "range" else "give fewer items")
     raise SourceError(shown, line, col, f"{key}: {e.message}", "see README, \"The brick language\"")
+
+
+def _past_float32(v):
+    """The first number in v (a number or nested lists) that no float32 holds (1e400 is inf to literal_eval)."""
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return None if abs(v) <= F32_MAX else v
+    if isinstance(v, (list, tuple)):
+        return next((x for x in map(_past_float32, v) if x is not None), None)
+    return None
 
 
 def _walk_keys(v):
