@@ -47,6 +47,8 @@ class BuildResult:
     store: object = None  # the io.Store used, or None
     up_to_date: bool = False  # nothing at all to do: the manifest was not even read
     aliased: int = 0  # SPIR-V files another item of this build already wrote (identical modules: one file)
+    costs: dict = field(default_factory=dict)  # SPIR-V sha256 -> cost dict, from worker processes (build/parallel.py)
+    templates: set = field(default_factory=set)  # template files worker processes read
     _manifest: dict | None = None
     _done: set = field(default_factory=set)  # files this build has written or found in place
 
@@ -107,12 +109,12 @@ def _deps(scene: Scene, lib: Library, out: Path) -> list[str]:
             *(shown(_TEMPLATES / t) for t in sorted(templates))]
 
 
-def _templates_read() -> list[str]:
+def _templates_read(also=()) -> list[str]:
+    """The templates composed with, relative to templates/: this process's and `also` (workers' absolute paths)."""
     import sys
     compose = sys.modules.get("generator.compose")
-    if compose is None:
-        return []
-    return sorted(str(Path(p).resolve().relative_to(_TEMPLATES)) for p in compose.loaded_templates())
+    read = set(also) | set(compose.loaded_templates() if compose is not None else ())
+    return sorted(str(Path(p).resolve().relative_to(_TEMPLATES)) for p in read)
 
 
 def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None, executor=None,
@@ -144,6 +146,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         if e is not None and e.get("input_key") == keys[h] and e.get("status") == "ok" and _intact(out, e):
             kept[h] = e
     from ..toolchain.scenes import compile_scene  # composing (Jinja and the emitters) only when needed
+    from .parallel import MIN_PERMUTATIONS, compile_scene_parallel
     old_uber = previous.get("ubershader") or {}
     uber_kept = old_uber.get("input_key") == uber_key and old_uber.get("status") == "ok" and _intact(out, old_uber)
     uber_unit = None if uber_kept else _compose_ubershader(scene, lib, languages)
@@ -165,8 +168,14 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
             errs = _write_all(res, out, h, c.sources, part, entry)
             built[h] = _settle(res, entry, errs, old.get(h), out, _what(scene, h, users.get(h, [])))
 
-    composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra,
-                                              workers=workers, executor=executor, on_done=written)
+    n = workers or os.cpu_count() or 1
+    if executor is None and n > 1 and len(todo.permutations) >= MIN_PERMUTATIONS:  # compose and analyse there too
+        composed, errors, results = compile_scene_parallel(todo, lib, languages, store=store, stats=res.compile,
+                                                           extra=extra, workers=n, on_done=written, costs=res.costs,
+                                                           templates=res.templates)
+    else:
+        composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra,
+                                                  workers=workers, executor=executor, on_done=written)
     res.kept = len(kept)
 
     entries = []
@@ -206,7 +215,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         text = (json.dumps(res.manifest, indent=2, sort_keys=False) + "\n").encode()
         _count(res, atomic_write(out / "manifest.json", text))
     collect_garbage(out, res.manifest)  # the new manifest is in place: drop what it no longer names
-    _record(out, res.manifest, text, keys, uber_key, res.kept, scene_key)  # last: the no-op check trusts it
+    _record(out, res.manifest, text, keys, uber_key, res.kept, scene_key, res.templates)  # last: the no-op check trusts it
     return res
 
 
@@ -239,10 +248,11 @@ def _settle(res: BuildResult, entry: dict, errs: list[str], old: dict | None, ou
     return {**entry, "languages": {}, "status": "failed", "errors": errs, "failed_sources": failed}
 
 
-def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, kept: int, scene_key: str) -> None:
+def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, kept: int, scene_key: str,
+            workers_read=()) -> None:
     """What the next build checks first: every input key, the manifest's sha256, every file's size; and the
     templates composed with (for the depfile of a build that composes nothing)."""
-    templates = set(_templates_read())
+    templates = set(_templates_read(workers_read))
     if kept:
         templates.update(_state(out).get("templates", []))
     ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
@@ -386,7 +396,7 @@ def _write(res: BuildResult, out: Path, name: str, src, r) -> dict:
         res._done.add(rel_spv)
         _count(res, atomic_write(out / rel_spv, r.spirv))
     return {"source": rel_src, "source_sha256": src_sha, "spirv": rel_spv, "spirv_sha256": spv_sha,
-            "cost": cost_dict(r.spirv, res.store)}
+            "cost": res.costs.get(spv_sha) or cost_dict(r.spirv, res.store)}
 
 
 def _compose_ubershader(scene: Scene, lib: Library, languages):

@@ -63,7 +63,7 @@ import shutil
 import subprocess
 import tempfile
 from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Iterable
 
@@ -447,6 +447,7 @@ class CompileStats:
     distinct: int = 0
     cached: int = 0
     compiled: int = 0
+    fresh: set = field(default_factory=set)  # the cache keys compiled (not served by the store or the memo)
 
 
 def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate: bool = True,
@@ -504,6 +505,7 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
     run = executor.compile if executor is not None else _compile_all
     fresh = run(todo, optimize, validate, progress, workers)
     stats.compiled += len(todo)
+    stats.fresh.update(keys[job.key] for job in todo)
     again = []
     for first in todo:
         r = fresh[first.key]

@@ -1,0 +1,159 @@
+"""Compose, compile and analyse a scene's permutations in worker processes (`build -j N`, N > 1).
+
+The building process composes, compiles and analyses nothing itself: each task is one chunk of
+permutations, composed, compiled (through this build's content-addressed store, `workers=1` tool process
+per worker) and its SPIR-V analysed in a worker process; the building process writes the results, in
+chunk order, as they come back. So N processes do the Python work that one did before, and a build is
+no longer limited by the building process (benchmarks/results/build.md).
+
+Workers are started by a forkserver (never a fork of this process, which has threads), with this
+process's environment, and receive the Library pickled: every worker composes from exactly the bricks
+this build parsed, not from files that may have changed since. Results are pure functions of their
+inputs, so the output is byte-identical for any N (tested), and the build's counts are the same: a
+shader is counted distinct, cached or compiled where it first appears in chunk order.
+"""
+from __future__ import annotations
+
+import multiprocessing
+import os
+import pickle
+import sys
+import threading
+import time
+
+from ..io import Store, sha256, show_progress
+from ..lang import SourceError
+from ..lang.errors import UserError
+from ..library import bricks as _bricks
+from ..toolchain import CompileJob, CompileStats, cache_key, compile_many
+from ..toolchain.scenes import job_key
+
+MIN_PERMUTATIONS = 32  # below this, starting worker processes costs more than it saves: build in-process
+# multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted: the pool's
+# queues, which it then removes itself. Noise to whoever pressed Ctrl-C: its process starts with this filter.
+_QUIET_TRACKER = "ignore::UserWarning:multiprocessing.resource_tracker"
+_WORKER: dict = {}  # this worker's library, store and languages (set by _start)
+
+
+def chunk_size(permutations: int, workers: int) -> int:
+    """Permutations per task: about 8 tasks per worker (an even finish), 4 to 64 each."""
+    return max(4, min(64, -(-permutations // (workers * 8))))
+
+
+def _start(build: int, lib_bytes: bytes, env: dict, store_root: str | None, languages: tuple) -> None:
+    _watch(build)
+    os.environ.clear()
+    os.environ.update(env)
+    lib = pickle.loads(lib_bytes)
+    lib.memo, lib.serial = {}, next(_bricks._SERIALS)  # this process's own caches
+    _WORKER.update(lib=lib, store=Store(store_root) if store_root else None, languages=languages)
+
+
+def _watch(build: int) -> None:
+    """End this worker as soon as the build that started it is gone (killed with -9: nobody will read what the
+    worker computes, and it would print a broken pipe when it tried to send it)."""
+    def gone() -> bool:
+        try:
+            with open(f"/proc/{build}/stat", "rb") as f:  # a zombie (killed, not yet reaped) is gone too
+                return f.read().rsplit(b")", 1)[1].split()[0] == b"Z"
+        except FileNotFoundError:
+            return True
+        except OSError:  # no /proc: ask the kernel whether the pid exists
+            try:
+                os.kill(build, 0)
+            except ProcessLookupError:
+                return True
+            except PermissionError:
+                pass
+            return False
+
+    def loop() -> None:
+        while not gone():
+            time.sleep(0.25)
+        os._exit(1)
+    threading.Thread(target=loop, name="watch-build", daemon=True).start()
+
+
+def _task(items: list, extra: list) -> tuple:
+    """One chunk, in a worker: (composed, compose errors, results, costs by SPIR-V sha256, cache key by job
+    key, cache keys compiled here, templates read) — every value picklable."""
+    from ..analysis import cost_dict
+    from ..compose import compose_permutation, loaded_templates
+
+    lib, store, languages = _WORKER["lib"], _WORKER["store"], _WORKER["languages"]
+    composed, errors, jobs = {}, {}, list(extra)
+    try:
+        for h, perm in items:
+            try:
+                c = composed[h] = compose_permutation(perm, lib, languages)
+            except SourceError as e:
+                errors[h] = [str(e)]
+                continue
+            jobs += [CompileJob(job_key(h, s.stage, s.language), s.language, s.stage, s.text,
+                                line_map=tuple(s.line_map)) for s in c.sources]
+        stats = CompileStats()
+        results = compile_many(jobs, optimize=True, validate=True, store=store, stats=stats, workers=1)
+        costs = {}
+        for r in results.values():
+            if r.ok and r.spirv and sha256(r.spirv) not in costs:
+                costs[sha256(r.spirv)] = cost_dict(r.spirv, store)
+    except UserError as e:  # a missing tool: its message, re-raised as it pickles
+        raise UserError(str(e)) from None
+    keys = {j.key: cache_key(j, True, True) for j in jobs}
+    return composed, errors, results, costs, keys, stats.fresh, loaded_templates()
+
+
+def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=(), workers: int = 2,
+                           on_done=None, costs: dict | None = None, templates: set | None = None):
+    """toolchain.scenes.compile_scene's contract, in `workers` processes; also fills `costs` (SPIR-V sha256 ->
+    cost dict, for the writer) and `templates` (the template files the workers read)."""
+    from tqdm import tqdm
+
+    stats = stats if stats is not None else CompileStats()
+    costs = costs if costs is not None else {}
+    templates = templates if templates is not None else set()
+    items = sorted(scene.permutations.items())
+    size = chunk_size(len(items), workers)
+    chunks = [items[k:k + size] for k in range(0, len(items), size)]
+    composed, errors, results = {}, {}, {}
+    seen: set[str] = set()
+
+    def take(task) -> dict:
+        c, errs, part, cost, keys, fresh, read = task.get()
+        composed.update(c)
+        errors.update(errs)
+        results.update(part)
+        costs.update(cost)
+        templates.update(read)
+        stats.jobs += len(keys)
+        for ck in keys.values():  # counted where it first appears: the same counts for any N
+            if ck not in seen:
+                seen.add(ck)
+                stats.distinct += 1
+                stats.compiled += ck in fresh
+                stats.cached += ck not in fresh
+        return part
+
+    if _QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its resource tracker
+        sys.warnoptions.append(_QUIET_TRACKER)
+    lib_bytes = pickle.dumps(type(lib)(bricks=lib.bricks, errors=lib.errors))  # no memo: workers link their own
+    # a Pool, not a ProcessPoolExecutor: a failure or Ctrl-C terminates the workers instead of running every
+    # queued chunk first
+    pool = multiprocessing.get_context("forkserver").Pool(
+        workers, initializer=_start,
+        initargs=(os.getpid(), lib_bytes, dict(os.environ), str(store.root) if store else None, tuple(languages)))
+    try:
+        with tqdm(total=len(items), disable=not show_progress(), unit="permutation", leave=False) as bar:
+            uber = pool.apply_async(_task, ([], list(extra))) if extra else None  # its large shaders first
+            tasks = [pool.apply_async(_task, (chunk, [])) for chunk in chunks]
+            if uber is not None:
+                take(uber)
+            for chunk, task in zip(chunks, tasks):  # written in chunk order, each as soon as it is back
+                part = take(task)
+                if on_done is not None:
+                    on_done([(h, composed[h]) for h, _ in chunk if h in composed], part)
+                bar.update(len(chunk))
+    finally:
+        pool.terminate()
+        pool.join()  # the workers are gone before this returns (or raises)
+    return composed, errors, results

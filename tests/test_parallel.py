@@ -1,0 +1,124 @@
+"""`build -j N` with N > 1 (issue 9): permutations are composed, compiled and analysed in N worker processes
+(generator/build/parallel.py); the output is byte-identical to an in-process build, the counts are the same,
+the depfile names the templates the workers read, and a worker's compose error or missing tool is reported as
+in-process."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+EXAMPLE_SMALL = REPO / "scenes" / "example.toml"
+pytestmark = pytest.mark.toolchain
+
+
+def _tree(root: Path) -> dict:
+    return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()
+            and p.name != ".shadermatrix-lock"}
+
+
+def _cli(*args, env=None):
+    return subprocess.run([sys.executable, "-m", "generator.cli", *map(str, args)], cwd=REPO, capture_output=True,
+                          text=True, timeout=600, env=env)
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory) -> Path:
+    from generator.build.parallel import MIN_PERMUTATIONS
+    path = tmp_path_factory.mktemp("gen") / "gen.toml"
+    n = MIN_PERMUTATIONS + 4
+    r = subprocess.run([sys.executable, "benchmarks/scenegen.py", str(n), str(path)], cwd=REPO, capture_output=True,
+                       text=True)
+    assert r.returncode == 0, r.stderr
+    return path
+
+
+def test_worker_processes_build_what_one_process_builds(scene, tmp_path):
+    one = _cli("build", scene, "--out", tmp_path / "one", "--no-cache", "-j", "1",
+               "--depfile", tmp_path / "one.d")
+    assert one.returncode == 0, one.stderr
+    # a fresh cache: the workers compose, compile and analyse everything themselves
+    two = _cli("build", scene, "--out", tmp_path / "two", "--cache-dir", tmp_path / "cache", "-j", "2",
+               "--depfile", tmp_path / "two.d")
+    assert two.returncode == 0, two.stderr
+    assert _tree(tmp_path / "one") == _tree(tmp_path / "two")
+    summary = [line.split("→")[0] for r in (one, two) for line in r.stdout.splitlines() if "shaders," in line]
+    assert summary[0] == summary[1]  # shaders, distinct, merged, compiled, files: counted the same way
+    deps = [(tmp_path / d).read_text().replace(str(tmp_path / "one"), "OUT").replace(str(tmp_path / "two"), "OUT")
+            for d in ("one.d", "two.d")]
+    assert deps[0] == deps[1] and "fragment.glsl.j2" in deps[1]  # the templates the workers read
+
+
+def test_a_permutation_that_fails_in_a_worker_is_reported_located(scene, tmp_path):
+    engine = tmp_path / "engine"
+    engine.mkdir()
+    good = (REPO / "bricks" / "output" / "linear.py").read_text()
+    (engine / "tinted.py").write_text(good.replace("return vec4(color, 1.0)", "k = 1\n    q = k / 0\n"
+                                                   "    return vec4(color * float(q), 1.0)"))
+    text = scene.read_text()
+    assert "[scene]" in text
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("[scene]", '[scene]\noutput = "tinted"', 1))
+    r = _cli("build", bad, "--out", tmp_path / "out", "--bricks", engine, "--no-cache", "-j", "2")
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    heads = [line for line in r.stderr.splitlines() if line.startswith("error: ")]
+    assert heads and all(line.startswith(f"error: {bad}:") and "does not build" in line for line in heads)
+    assert "engine/tinted.py:" in r.stderr and "Division by zero" in r.stderr
+
+
+def test_a_worker_without_the_tools_is_one_line(scene, tmp_path):
+    env = {**os.environ, "PATH": "/nonexistent"}  # no glslc, no spirv-tools
+    r = _cli("build", scene, "--out", tmp_path / "out", "--no-cache", "-j", "2", env=env)
+    assert r.returncode == 1 and "Traceback" not in r.stderr
+    errors = [line for line in r.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and "not found" in errors[0] and "make setup" in errors[0], r.stderr
+
+
+def _session_pythons(sid: int) -> list[int]:
+    """The Python processes (the build, its forkserver and workers) still alive in session `sid`."""
+    alive = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            text = stat.read_bytes()
+        except OSError:
+            continue
+        comm, rest = text.split(b"(", 1)[1].rsplit(b")", 1)
+        fields = rest.split()
+        if b"python" in comm and int(fields[3]) == sid and fields[0] != b"Z":
+            alive.append(int(stat.parent.name))
+    return alive
+
+
+def test_kill_9_of_a_parallel_build_loses_nothing_and_leaves_no_worker(scene, tmp_path):
+    import signal
+    import time
+
+    from tests.test_build_system import _consistent
+    out = tmp_path / "out"
+    assert _cli("build", EXAMPLE_SMALL, "--out", out, "-j", "1").returncode == 0
+    before = _consistent(out)
+    p = subprocess.Popen([sys.executable, "-m", "generator.cli", "build", str(scene), "--out", str(out),
+                          "--no-cache", "-j", "2"], cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         start_new_session=True)
+    names = {str(p.relative_to(out)) for p in out.glob("*/*")}
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and p.poll() is None:  # until the first chunk is being written
+        if {str(p.relative_to(out)) for p in out.glob("*/*")} - names:
+            break
+        time.sleep(0.05)
+    assert p.poll() is None, "the build ended before it could be killed"
+    p.send_signal(signal.SIGKILL)
+    p.wait()
+    assert _consistent(out, exact=False) == before  # the old manifest, every file it names intact
+    deadline = time.monotonic() + 10
+    while _session_pythons(p.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _session_pythons(p.pid) == []  # the workers went with the build
+    assert p.stderr.read() == b""  # and said nothing (no broken pipe from a worker sending to the dead build)
+    r = _cli("build", scene, "--out", out, "--no-cache", "-j", "2")
+    assert r.returncode == 0, r.stderr
+    assert all(e["status"] == "ok" for e in _consistent(out)["permutations"])
