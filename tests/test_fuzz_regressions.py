@@ -1,0 +1,61 @@
+"""Regression cases of the coverage-guided fuzzer, benchmarks/fuzz_parsers.py (issue 10; results in
+benchmarks/results/fuzz_parsers.md): each case is the exact input a campaign reported, and the message the
+parser now gives for it — one line, `path: …` (the samples reader) or `path:line:col: …`, with ` — what to do`,
+and nothing printed besides it."""
+from __future__ import annotations
+
+import base64
+import re
+import warnings
+
+import pytest
+
+LOCATED = re.compile(r"^[^\n]+:\d+:\d+: [^\n]+$")
+
+# samples target, seed 1: numpy's .npy header parser tokenizes a header it cannot literal_eval, and its
+# tokenize.TokenError ("EOF in multi-line statement") escaped load_samples as a traceback (found by the first
+# campaign; fixed in generator/cli/commands/eval.py by aa8f717, which catches TokenError).
+TOKEN_ERROR = base64.b64decode(
+    "k05VTVBZAQB2AHsnZGVzY3InOiAnPGY0JywgJ2ZvcnRyYW5fb3JkZXInOiBGYWxzZSwgJ3NoYXBlJzogKDAsIDkpLCB9ICAgICAgICAgICAg"
+    "/yB9ICAgICAgICAgICAgICAgICAgICAgICAgICAgIKQgICAgICAgICAgICAgICAgICAgICAgICAgICAgICAK")
+# samples target: a header numpy compiles makes Python print a warning before `shadermatrix eval`'s one-line error:
+# "<unknown>:1: SyntaxWarning: invalid decimal literal" (twice: seen on stderr during an early campaign, before the
+# harness checked warnings; this input is rebuilt by hand), or, as the campaign recorded in
+# benchmarks/results/fuzz_parsers.md found (samples, seed 1, --keep-going, every warning counted), "DeprecationWarning:
+# invalid escape sequence '\['" (not printed by Python 3.11's default filters; a SyntaxWarning, printed, from 3.12).
+# The cause is in generator/cli/commands/eval.py (not changed here): it should read the header and np.load under
+# warnings.catch_warnings() ignoring SyntaxWarning and DeprecationWarning, as generator/lang/parse.py does for bricks.
+SYNTAX_WARNING = (b"\x93NUMPY\x01\x00v\x00{'descr': '<f8', 'fortran_order': False, 'shape': (1or, 9), }"
+                  + b" " * 58 + b"\n" + b"\x00" * 72)
+ESCAPE_WARNING = base64.b64decode(
+    "k05VTVBZAQB2AHsnZGVzY3InOiAnPGY4JywgJ2ZvcnRyMqSkpKRcW1tbW1tbZKSkpKSkpKSkpKSkpKSkpKSkpKSkpKSkpKSkpKSkpKSkpKSk"
+    "pKSkpKSkpKSkpKSkpKSkYW5fb3JkZXInOiBGYWxzZSwgJ3NoYXBlJzogKCAgICAgICAgICAgICAgICAgICAgICAgICAgIKSkpKSkCg==")
+
+
+def _samples_message(tmp_path, data: bytes) -> tuple[str, list]:
+    from generator.cli.commands.eval import _Usage, load_samples
+
+    path = tmp_path / "case.npy"
+    path.write_bytes(data)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(_Usage) as e:
+            load_samples(str(path))
+    text = str(e.value)
+    assert text.startswith(f"{path}: ") and " — " in text and "\n" not in text, text
+    return text, [f"{w.category.__name__}: {w.message}" for w in caught]
+
+
+def test_a_header_numpy_cannot_tokenize_is_one_line(tmp_path):
+    text, printed = _samples_message(tmp_path, TOKEN_ERROR)
+    assert "not a readable .npy array" in text and "EOF in multi-line statement" in text, text
+    assert not printed, printed
+
+
+@pytest.mark.xfail(reason="generator/cli/commands/eval.py lets numpy's header warnings through (see SYNTAX_WARNING)",
+                   strict=False)
+@pytest.mark.parametrize("data", [SYNTAX_WARNING, ESCAPE_WARNING], ids=["SyntaxWarning", "invalid-escape"])
+def test_a_header_numpy_compiles_prints_no_warning(data, tmp_path):
+    text, printed = _samples_message(tmp_path, data)
+    assert "not a readable .npy array" in text, text
+    assert not printed, printed
