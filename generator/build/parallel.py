@@ -17,7 +17,9 @@ from __future__ import annotations
 import multiprocessing
 import os
 import pickle
+import shutil
 import sys
+import tempfile
 import threading
 import time
 
@@ -28,10 +30,11 @@ from ..library import bricks as _bricks
 from ..toolchain import CompileJob, CompileStats, cache_key, compile_many
 from ..toolchain.scenes import job_key
 
-MIN_PERMUTATIONS = 32  # below this, starting worker processes costs more than it saves: build in-process
+MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than it saves (measured: ~1.4 s at 36)
 # multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted: the pool's
 # queues, which it then removes itself. Noise to whoever pressed Ctrl-C: its process starts with this filter.
 _QUIET_TRACKER = "ignore::UserWarning:multiprocessing.resource_tracker"
+_PRELOAD = ["generator.build.parallel", "generator.compose", "generator.analysis", "jinja2"]
 _WORKER: dict = {}  # this worker's library, store and languages (set by _start)
 
 
@@ -116,44 +119,54 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     size = chunk_size(len(items), workers)
     chunks = [items[k:k + size] for k in range(0, len(items), size)]
     composed, errors, results = {}, {}, {}
-    seen: set[str] = set()
+    seen: set[str] = set()  # the cache keys of every job
+    fresh: set[str] = set()  # those some worker compiled (the others came from the cache)
 
     def take(task) -> dict:
-        c, errs, part, cost, keys, fresh, read = task.get()
+        c, errs, part, cost, keys, compiled, read = task.get()
         composed.update(c)
         errors.update(errs)
         results.update(part)
         costs.update(cost)
         templates.update(read)
         stats.jobs += len(keys)
-        for ck in keys.values():  # counted where it first appears: the same counts for any N
-            if ck not in seen:
-                seen.add(ck)
-                stats.distinct += 1
-                stats.compiled += ck in fresh
-                stats.cached += ck not in fresh
+        seen.update(keys.values())
+        fresh.update(compiled)
         return part
 
-    if _QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its resource tracker
-        sys.warnoptions.append(_QUIET_TRACKER)
+    # without a cache (--no-cache), the workers share a private one for this build alone, so that a shader is
+    # compiled once whichever chunks have it (the in-process build's memo); named like the toolchain's temp dirs, a
+    # killed build's is removed by the next
+    private = None if store is not None else tempfile.mkdtemp(prefix=f"shadermatrix-{os.getpid()}-build-")
     lib_bytes = pickle.dumps(type(lib)(bricks=lib.bricks, errors=lib.errors))  # no memo: workers link their own
     # a Pool, not a ProcessPoolExecutor: a failure or Ctrl-C terminates the workers instead of running every
     # queued chunk first
-    pool = multiprocessing.get_context("forkserver").Pool(
+    if _QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its resource tracker
+        sys.warnoptions.append(_QUIET_TRACKER)
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(_PRELOAD)  # imported once, by the forkserver: each worker starts as a fork of it
+    pool = context.Pool(
         workers, initializer=_start,
-        initargs=(os.getpid(), lib_bytes, dict(os.environ), str(store.root) if store else None, tuple(languages)))
+        initargs=(os.getpid(), lib_bytes, dict(os.environ), str(store.root) if store else private, tuple(languages)))
     try:
         with tqdm(total=len(items), disable=not show_progress(), unit="permutation", leave=False) as bar:
-            uber = pool.apply_async(_task, ([], list(extra))) if extra else None  # its large shaders first
+            # the ubershader's large shaders first, one task each: they spread over the workers
+            uber = [pool.apply_async(_task, ([], [job])) for job in extra]
             tasks = [pool.apply_async(_task, (chunk, [])) for chunk in chunks]
-            if uber is not None:
-                take(uber)
             for chunk, task in zip(chunks, tasks):  # written in chunk order, each as soon as it is back
                 part = take(task)
                 if on_done is not None:
                     on_done([(h, composed[h]) for h, _ in chunk if h in composed], part)
                 bar.update(len(chunk))
+            for task in uber:
+                take(task)
     finally:
         pool.terminate()
         pool.join()  # the workers are gone before this returns (or raises)
+        if private is not None:
+            shutil.rmtree(private, ignore_errors=True)
+    # counted once per distinct shader, whichever worker got it first: the same counts for any N and any timing
+    stats.distinct += len(seen)
+    stats.compiled += len(seen & fresh)
+    stats.cached += len(seen - fresh)
     return composed, errors, results
