@@ -23,9 +23,8 @@ TOKEN_ERROR = base64.b64decode(
 # `.npy` or `.npz` file required additional header parsing as it was created on Python 2" for one it has to filter
 # (both found by the campaign of benchmarks/results/fuzz_parsers.md: samples, seed 1), and "DeprecationWarning:
 # invalid escape sequence '\['" (found while the harness counted every warning: Python 3.11 does not print it by
-# default; 3.12 makes it a SyntaxWarning, printed). The cause is in generator/cli/commands/eval.py (not changed
-# here): it should read the header and np.load under warnings.catch_warnings() with those warnings ignored (or
-# turned into its one-line error), as generator/lang/parse.py does for a brick's SyntaxWarning.
+# default; 3.12 makes it a SyntaxWarning, printed). load_samples now reads the header and np.load under
+# warnings.catch_warnings() with them ignored: its one-line error says what is wrong.
 SYNTAX_WARNING = base64.b64decode(
     "k05VTVBZAQB2AHsnZGVzY3InOigwLCA5KSwgJ2ZvcnRyYW5fb3JkZXInOiBGYWxzZSwgJ3NoYXBlJzogKDEsIDlvcigzLCA5KSAgICAgICAg"
     "ICAgICAgICAgICA6KDAsIDkpLCAnZm9ydHJhbl9vcmRlcic6IEZhbHNlLCAnc2hhcGUnOiAoMSwgOW9ydH0gICAgICAgICAgICAgICAgICAg"
@@ -60,8 +59,6 @@ def test_a_header_numpy_cannot_tokenize_is_one_line(tmp_path):
     assert not printed, printed
 
 
-@pytest.mark.xfail(reason="generator/cli/commands/eval.py lets numpy's header warnings through (see SYNTAX_WARNING)",
-                   strict=False)
 @pytest.mark.parametrize("data", [SYNTAX_WARNING, PYTHON2_WARNING, ESCAPE_WARNING],
                          ids=["SyntaxWarning", "Python-2-header", "invalid-escape"])
 def test_a_header_numpy_compiles_prints_no_warning(data, tmp_path):

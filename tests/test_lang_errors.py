@@ -93,3 +93,41 @@ def test_valid_constructs_type_check():
     f = m.functions["f"]
     assert f.calls == ["g"]
     assert str(f.ret) == "vec3"
+
+
+def test_a_long_call_chain_is_one_error_and_recursion_still_is_named():
+    """A 3,000-deep chain of helpers overflowed Python's stack in the recursion check (a traceback); chains are
+    limited to MAX_CALL_DEPTH, checked without recursion, and recursion is still named with its cycle."""
+    from generator.lang.parse import MAX_CALL_DEPTH
+
+    def chain(n: int) -> str:
+        src = 'BRICK = {"kind": "test"}\n'
+        for i in range(n):
+            src += f"def f{i}(x: float) -> float:\n    return {f'f{i + 1}(x)' if i < n - 1 else 'x'}\n"
+        return src
+    parse_module(chain(MAX_CALL_DEPTH), "ok.py")
+    with pytest.raises(SourceError, match=rf"long\.py:\d+:1: function 'f\d+' starts a chain of {MAX_CALL_DEPTH + 1} "
+                                          rf"nested calls, more than the {MAX_CALL_DEPTH} allowed — "):
+        parse_module(chain(3000), "long.py")
+    cyc = 'BRICK = {"kind": "test"}\ndef a(x: float) -> float:\n    return b(x)\n' \
+          'def b(x: float) -> float:\n    return a(x)\n'
+    with pytest.raises(SourceError, match=r"recursion: a -> b -> a — "):
+        parse_module(cyc, "cyc.py")
+
+
+def test_two_bricks_declaring_one_struct_differently_is_one_error(tmp_path):
+    """Both structs reached the shader (a redefinition to every compiler); now it is an error naming both."""
+    from generator.compose import compose_eval
+    from generator.library.bricks import load_library
+
+    (tmp_path / "dl.py").write_text('"""D."""\nBRICK = {"kind": "diffuse", "cite": "x"}\n\n\nclass Lobe:\n'
+                                    '    k: float\n\n\ndef diffuse(NdotL: float) -> vec3:\n'
+                                    '    lo = Lobe(NdotL)\n    return vec3(lo.k)\n')
+    (tmp_path / "sl.py").write_text('"""S."""\nBRICK = {"kind": "specular", "cite": "x"}\n\n\nclass Lobe:\n'
+                                    '    c: vec3\n\n\ndef specular(NdotH: float) -> vec3:\n'
+                                    '    lo = Lobe(vec3(NdotH))\n    return lo.c\n')
+    lib = load_library([tmp_path])
+    compose_eval("dl", lib)  # each alone is fine
+    with pytest.raises(SourceError, match=r"sl\.py:5:1: struct 'Lobe' is also declared, differently, by "
+                                          r"\S*dl\.py:5, and both bricks are linked into one shader — rename"):
+        compose_eval("dl+sl", lib)

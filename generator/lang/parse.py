@@ -256,22 +256,39 @@ def _signature(path, f: ast.FunctionDef, structs, constants) -> Signature:
     return Signature(tuple(params), ret)
 
 
+MAX_CALL_DEPTH = 32  # a brick's functions calling each other in a chain: README, "The brick language"
+
+
 def _reject_recursion(path, functions: dict[str, ir.Function], fdefs) -> None:
+    """No function reaches itself (shading languages forbid recursion), and no chain of calls within the brick is
+    longer than MAX_CALL_DEPTH (the linker and the emitters walk it; a 3,000-deep chain overflowed Python's stack
+    here). An explicit stack, so that the check itself has no depth limit."""
     nodes = {f.name: f for f in fdefs}
-    state: dict[str, int] = {}
+    state: dict[str, int] = {}  # 1: on the current chain, 2: done
+    depth: dict[str, int] = {}
 
-    def visit(name, stack):
-        state[name] = 1
-        for callee in functions[name].calls:
-            if callee not in functions:
-                continue
-            if state.get(callee) == 1:
-                raise _err(path, nodes[callee], f"recursion: {' -> '.join(stack + [callee])}",
+    def callees(name: str) -> list[str]:
+        return [c for c in functions[name].calls if c in functions]
+
+    for root in functions:
+        if root in state:
+            continue
+        state[root] = 1
+        chain, todo = [root], [iter(callees(root))]
+        while todo:
+            callee = next(todo[-1], None)
+            if callee is None:
+                name = chain.pop()
+                todo.pop()
+                state[name] = 2
+                depth[name] = 1 + max((depth[c] for c in callees(name)), default=0)
+                if depth[name] > MAX_CALL_DEPTH:
+                    raise _err(path, nodes[name], f"function '{name}' starts a chain of {depth[name]} nested calls, "
+                               f"more than the {MAX_CALL_DEPTH} allowed", "call fewer functions in a row")
+            elif state.get(callee) == 1:
+                raise _err(path, nodes[callee], f"recursion: {' -> '.join(chain + [callee])}",
                            "shading languages do not allow recursion; unroll it or use a loop")
-            if callee not in state:
-                visit(callee, stack + [callee])
-        state[name] = 2
-
-    for name in functions:
-        if name not in state:
-            visit(name, [name])
+            elif callee not in state:
+                state[callee] = 1
+                chain.append(callee)
+                todo.append(iter(callees(callee)))

@@ -14,7 +14,9 @@ the host's entry, which the glue binds by name.
 from __future__ import annotations
 
 import hashlib
+import re
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from ..lang import SourceError, ir
 from ..lang.types import Type
@@ -58,6 +60,7 @@ class Program:
     by_name: dict[str, ir.Function] = field(default_factory=dict)
     _linked: dict = field(default_factory=dict)  # (kind, canonical) -> {function: linked name}
     lib_memo: dict | None = None  # Library.memo: linked nodes shared between programs of one library
+    _struct_from: dict = field(default_factory=dict)  # struct name -> the brick that declared it first
 
     def add(self, f: ir.Function, brick: Brick | None = None) -> ir.Function:
         """Append one function (callees must already be in the program)."""
@@ -91,9 +94,7 @@ class Program:
             functions, structs, rename = hit
             for f in functions:
                 self.add(f, b)
-            for st in structs:
-                if st not in self.structs:
-                    self.structs.append(st)
+            self._add_structs(structs, b)
             self._linked[key] = rename
             return
         rename = {name: function_name(node, name) for name in b.module.functions}
@@ -119,12 +120,25 @@ class Program:
             f.calls = [c if c not in rename else rename[c] for c in f.calls]
             f.name = rename[name]
             self.add(f, b)
-        for st in b.module.structs.values():
-            if st not in self.structs:
-                self.structs.append(st)
+        self._add_structs(b.module.structs.values(), b)
         self._linked[key] = rename
         if self.lib_memo is not None:
             self.lib_memo[memo_key] = (list(fns.values()), list(b.module.structs.values()), rename)
+
+    def _add_structs(self, structs, brick: Brick) -> None:
+        """A brick's structs, once each; two bricks declaring one struct name differently is an error (both would
+        reach the shader: a redefinition to every compiler)."""
+        for st in structs:
+            other = next((s for s in self.structs if s.name == st.name), None)
+            if other is None:
+                self.structs.append(st)
+                self._struct_from[st.name] = brick
+            elif other != st:
+                first, declared = self._struct_from[st.name], rf"class\s+{st.name}\b"
+                raise SourceError(brick.display_path, _line_of(brick, declared), 1,
+                                  f"struct '{st.name}' is also declared, differently, by {first.display_path}:"
+                                  f"{_line_of(first, declared)}, and both bricks are linked into one shader",
+                                  "rename the struct in one of them")
 
     def _bind_slot(self, host: Brick, call: ir.Call, filler: Node) -> dict[str, Type]:
         """Point a slot call at the filler's entry, its parameters bound by name; returns the threaded ones."""
@@ -162,3 +176,12 @@ class Program:
             f.params.append(ir.Param(name, ty, f.loc))
             added[name] = ty
         return added
+
+
+def _line_of(brick: Brick, pattern: str) -> int:
+    """The first line of a brick's file that matches `pattern` (1 when none does): for messages."""
+    try:
+        lines = Path(brick.path).read_text(errors="replace").splitlines()
+    except OSError:
+        return 1
+    return next((i + 1 for i, line in enumerate(lines) if re.match(pattern, line)), 1)

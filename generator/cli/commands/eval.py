@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import io
 import sys
+import warnings
 from tokenize import TokenError
 from pathlib import Path
 
@@ -78,7 +79,10 @@ def load_samples(path: str, checked: bool = True):
     if not p.is_file():
         raise _Usage(f"{path}: no such file — pass an .npy file of samples with --input")
     try:
-        with open(p, "rb") as f:  # the header alone first: a declared shape past the limit allocates nothing
+        # numpy compiles a malformed header dict, and Python warns of what it finds (SyntaxWarning, numpy's
+        # Python-2 header note): the one-line error below says it all, so nothing else is printed
+        with warnings.catch_warnings(), open(p, "rb") as f:  # the header first: a shape past the limit allocates nothing
+            warnings.simplefilter("ignore")
             version = np.lib.format.read_magic(f)
             read = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
             shape, _, dtype = read(f)
@@ -95,7 +99,9 @@ def load_samples(path: str, checked: bool = True):
     if p.stat().st_size - start < shape[0] * shape[1] * dtype.itemsize:
         raise _Usage(f"{path}: the header declares {shape[0]} samples, but the file is shorter — save it again")
     try:
-        a = np.load(p, allow_pickle=False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            a = np.load(p, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
         raise _Usage(f"{path}: not a readable .npy array ({_one_line(exc)}) — save the samples with numpy.save") from None
     if not isinstance(a, np.ndarray) or a.dtype.kind != "f":
