@@ -47,7 +47,7 @@ class BuildResult:
     store: object = None  # the io.Store used, or None
     up_to_date: bool = False  # nothing at all to do: the manifest was not even read
     aliased: int = 0  # SPIR-V files another item of this build already wrote (identical modules: one file)
-    costs: dict = field(default_factory=dict)  # SPIR-V sha256 -> cost dict, from worker processes (build/parallel.py)
+    costs: dict = field(default_factory=dict)  # SPIR-V sha256 -> cost dict: each module analysed once per build
     templates: set = field(default_factory=set)  # template files worker processes read
     _manifest: dict | None = None
     _done: set = field(default_factory=set)  # files this build has written or found in place
@@ -396,7 +396,15 @@ def _write(res: BuildResult, out: Path, name: str, src, r) -> dict:
         res._done.add(rel_spv)
         _count(res, atomic_write(out / rel_spv, r.spirv))
     return {"source": rel_src, "source_sha256": src_sha, "spirv": rel_spv, "spirv_sha256": spv_sha,
-            "cost": res.costs.get(spv_sha) or cost_dict(r.spirv, res.store)}
+            "cost": _cost(res, spv_sha, r.spirv)}
+
+
+def _cost(res: BuildResult, sha: str, spirv: bytes) -> dict:
+    """A module's cost, analysed once per build (a worker's, or here) whatever the store holds."""
+    cost = res.costs.get(sha)
+    if cost is None:
+        cost = res.costs[sha] = cost_dict(spirv, res.store)
+    return cost
 
 
 def _compose_ubershader(scene: Scene, lib: Library, languages):
