@@ -16,6 +16,10 @@ One run, on this machine, side by side (benchmarks/scenegen.py makes the scene o
   a Dask LocalCluster of 1 and 2 workers; the building process's own CPU time in each mode;
 - scene loading: 1,000 and 10,000 objects over five permutations.
 
+Every command runs with bytecode caching as on an ordinary installation (PYTHONDONTWRITEBYTECODE is removed
+from the environment: where it is set, as on the machine these results came from, each run compiles the
+package again, +0.3 s on the no-op).
+
 Targets (issue 9): cold ≤ 1.5 × floor; no-op ≤ 0.5 s with 0 files written; a one-brick change rebuilds
 only what reads it. Writes benchmarks/results/build.md and build.json.
 """
@@ -43,10 +47,13 @@ from generator import __version__  # noqa: E402
 from generator.toolchain import TARGET_ENV, find_tool, tool_versions  # noqa: E402
 
 
+ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+
+
 def cli(*args, env=None) -> tuple[float, subprocess.CompletedProcess]:
     t = time.perf_counter()
     r = subprocess.run([sys.executable, "-m", "generator.cli", *map(str, args)], cwd=REPO, capture_output=True,
-                       text=True, env=env)
+                       text=True, env=env or ENV)
     if r.returncode != 0:
         raise SystemExit(f"{' '.join(map(str, args))} failed:\n{r.stderr[-2000:]}")
     return time.perf_counter() - t, r
@@ -70,7 +77,7 @@ def measured(*args, in_process: bool = False) -> tuple[float, float]:
     builds without worker processes (composition and analysis in the building process)."""
     code = _MEASURED.format(in_process=in_process, argv=[str(a) for a in args])
     t = time.perf_counter()
-    r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True)
+    r = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, env=ENV)
     wall = time.perf_counter() - t
     if r.returncode != 0:
         raise SystemExit(f"{' '.join(map(str, args))} failed:\n{r.stderr[-2000:]}")

@@ -18,7 +18,7 @@ from .. import __version__
 from ..library.bricks import Library
 from ..io import atomic_write, content_key, sha256
 from ..analysis import cost_dict
-from ..matrix.permutation import SpecError, resolve
+from ..matrix.permutation import SpecError, parse_brdf, parse_spec
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
 from ..lang import SourceError
@@ -124,9 +124,9 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     users: dict[str, list[dict]] = {}
     for o in scene.objects:
         users.setdefault(o["permutation"], []).append(o)
-    keys, shapes = {}, {}
+    keys, shapes, parts = {}, {}, {}
     for h, perm in sorted(scene.permutations.items()):
-        keys[h], shapes[h] = _perm_key(base, scene, lib, perm, users.get(h, []))
+        keys[h], shapes[h] = _perm_key(base, scene, lib, perm, users.get(h, []), parts)
     # the ubershader reads no scene values: its key is the permutations' keys without them
     uber_key = content_key(base, "ubershader", [shapes[h] for h in sorted(shapes)])
     # what the manifest's scene-wide tables hold beyond the permutations: name, light sets, objects in order
@@ -283,8 +283,9 @@ def _up_to_date(out: Path, keys: dict, uber_key: str, scene_key: str) -> int | N
             return None
         if sha256((out / "manifest.json").read_bytes()) != state["manifest_sha256"]:
             return None
+        root = os.fspath(out)  # os.path, not pathlib: 10,000 Path objects cost more than the stat calls
         for rel, size in state["files"].items():
-            if os.stat(out / rel).st_size != size:
+            if os.stat(os.path.join(root, rel)).st_size != size:
                 return None
         return len(state["files"])
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
@@ -306,14 +307,19 @@ def _globals(languages) -> str:
     return content_key("build-v1", __version__, _own_sources(), tool_versions(), list(languages))
 
 
-def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> tuple[str, str]:
+def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict], memo: dict) -> tuple[str, str]:
     """(Everything a permutation's outputs depend on (see build_scene), the same without the scene values);
-    objs: the objects drawn with it."""
+    objs: the objects drawn with it; memo: the bricks of each part, shared by the calls of one build (the
+    permutations of a scene share their materials' BRDFs, their packings and their lights)."""
     try:
-        r = resolve(perm, lib)
-        nodes = [*r.brdf, r.packing, *(n for _, n in r.lights)]
-        bricks = {b.display_path: b.module.source_hash
-                  for b in [*(x.brick for n in nodes for x in n.walk()), *(lb for lb, _ in r.lights), r.output]}
+        bricks = {}
+        for part in (("brdf", perm.brdf), ("packing", perm.packing), ("output", perm.output),
+                     *(("light", lk) for lk in perm.lights)):
+            if part not in memo:
+                memo[part] = _bricks_of(part, lib)
+            if isinstance(memo[part], Exception):
+                raise memo[part]
+            bricks.update(memo[part])
     except (SourceError, SpecError) as e:  # it will fail to compose too: key it by the error
         bricks = {"error": str(e)}
     mats = sorted({o["material"] for o in objs})
@@ -322,6 +328,22 @@ def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> 
               "materials": [repr(scene.materials[m]) for m in mats], "lights": [repr(scene.lights[ln]) for ln in lights]}
     shape = content_key(base, perm.canonical(), sorted(bricks.items()))
     return content_key(shape, values), shape
+
+
+def _bricks_of(part: tuple, lib: Library):
+    """{display path: source hash} of the bricks one part of a permutation key reads, or the error it raises."""
+    kind, value = part
+    try:
+        if kind in ("light", "output"):  # a light brick (and its shadow filter's spec), an output brick
+            brick = lib.get(kind, value.light if kind == "light" else value)
+            if brick is None:
+                raise SourceError("<key>", 1, 1, f"unknown {kind} brick in {value}", f"name a known {kind} brick")
+            nodes, extra = parse_spec(value.shadow, lib, ("shadow",)) if kind == "light" else [], [brick]
+        else:
+            nodes, extra = (parse_brdf(value, lib) if kind == "brdf" else parse_spec(value, lib, ("packing",))), []
+    except (SourceError, SpecError) as e:
+        return e
+    return {b.display_path: b.module.source_hash for b in [*(x.brick for n in nodes for x in n.walk()), *extra]}
 
 
 def _previous(out: Path) -> dict:
