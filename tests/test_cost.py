@@ -304,7 +304,7 @@ def test_manifest_carries_the_same_costs(scene_json, tmp_path):
 def test_bricks_table_markdown_shows_course_figures():
     for t in COMPILERS:
         require_tool(t)
-    r = cli("--bricks")
+    r = cli("--per-brick")
     assert r.returncode == 0, r.stderr
     assert re.search(r"\| Blinn-Phong \| direct \| shift-invariant \| `lambert\+blinn_phong_normalized` \| 0 \| 7 \|",
                      r.stdout)
@@ -314,14 +314,15 @@ def test_bricks_table_markdown_shows_course_figures():
 
 def test_cli_usage_errors(tmp_path):
     assert cli().returncode == 2
-    assert cli(EXAMPLE, "--bricks").returncode == 2
+    assert cli(EXAMPLE, "--per-brick").returncode == 2
+    assert cli(EXAMPLE, "--brick-dir", tmp_path).returncode == 2  # one spelling: --bricks DIR
     assert cli(EXAMPLE, "--format", "xml").returncode == 2
     missing = cli(tmp_path / "nope.toml")
     assert missing.returncode == 1 and "nope.toml" in missing.stderr
     bad = tmp_path / "bad"
     bad.mkdir()
     (bad / "broken.py").write_text('"""Broken."""\nBRICK = {"kind": "nonsense", "cite": "x"}\n')
-    r = cli("--bricks", "--brick-dir", bad)
+    r = cli("--per-brick", "--bricks", bad)
     assert r.returncode == 1 and "broken.py" in r.stderr
 
 

@@ -33,6 +33,7 @@ PLACEHOLDER = re.compile(r"\b(SCENE|DIR|SPEC|FILE|NAME|VALUE|S\.npy|F\.npy)\b|\[
 
 def test_readme_shows_commands():
     assert "make demo" in COMMANDS and "make test" in COMMANDS
+    assert any(c.startswith(". .venv/bin/activate && shadermatrix") for c in COMMANDS)  # how to run the CLI
     assert any(c.startswith("shadermatrix costs scenes/example.toml") for c in COMMANDS)
 
 
@@ -41,7 +42,9 @@ def test_readme_shows_commands():
 @pytest.mark.parametrize("cmd", [c for c in COMMANDS if not PLACEHOLDER.search(c)])
 def test_concrete_readme_command_runs(cmd, tmp_path):
     argv = shlex.split(cmd)
-    if argv[0] == "make":
+    if argv[0] == "." or "&&" in argv:  # a shell line (`. .venv/bin/activate && shadermatrix …`): bash runs it
+        argv = ["bash", "-c", cmd]
+    elif argv[0] == "make":
         targets = re.findall(r"^([a-z]+):", (REPO / "Makefile").read_text(), re.M)
         assert argv[1] in targets, f"README shows `{cmd}` but the Makefile has no such target"
         if argv[1] in ("test", "goldens"):  # test runs this file; goldens would rewrite the goldens
@@ -53,6 +56,12 @@ def test_concrete_readme_command_runs(cmd, tmp_path):
     env.pop("SHADERMATRIX_FORBID_DEVICE", None)
     r = subprocess.run(argv, cwd=REPO, capture_output=True, text=True, timeout=600, env=env)
     assert r.returncode == 0, f"`{cmd}` exited {r.returncode}:\n{r.stderr[-2000:]}"
+
+
+def test_readme_links_stay_inside_the_repository():
+    for target in re.findall(r"\]\(([^)#]+)", README):
+        if not re.match(r"https?://", target):
+            assert (REPO / target).resolve().is_relative_to(REPO) and (REPO / target).exists(), target
 
 
 @pytest.mark.parametrize("cmd", [c for c in COMMANDS if PLACEHOLDER.search(c) and c.startswith("shadermatrix ")])

@@ -170,7 +170,7 @@ def test_bad_arguments_are_one_line_errors(tmp_path):
     for args, what in [(["--size", "12"], "is not WxH"), (["--frames", "0"], "at least one frame")]:
         r = subprocess.run([sys.executable, "-m", "generator.cli", "render", str(EXAMPLE), "--out", str(tmp_path / "x"),
                             *args], capture_output=True, text=True, timeout=120, cwd=REPO)
-        assert r.returncode == 1 and what in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+        assert r.returncode == 2 and what in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
 
 
 def test_the_specialization_constant_ubershader_renders_the_same_image(renders, tmp_path, monkeypatch):

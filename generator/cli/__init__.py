@@ -9,7 +9,7 @@ import sys
 
 from .. import __version__
 from . import commands
-from ..lang.errors import UserError
+from ..lang.errors import EnvironmentMissing, UsageError, UserError
 
 
 def _command_names() -> list[str]:
@@ -17,15 +17,27 @@ def _command_names() -> list[str]:
     return [n for n in commands.ORDER if n in found] + sorted(found - set(commands.ORDER))
 
 
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_ENVIRONMENT, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+EXIT_CODES = f"""exit codes (the same for every command):
+  {EXIT_OK}    done
+  {EXIT_FAILED}    a failure in the inputs or the shaders (a brick, a scene, a sample file, a compiler's error)
+  {EXIT_USAGE}    a usage error: an unknown option, an option's value out of its range
+  {EXIT_ENVIRONMENT}    the environment lacks what the command needs: a pinned tool or the Vulkan device
+       (`make setup`; `shadermatrix doctor` says what is missing) — never skipped silently
+  {EXIT_INTERRUPTED}  interrupted (Ctrl-C, SIGTERM): earlier outputs are intact"""
+
+
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="shadermatrix", description=__doc__)
+    p = argparse.ArgumentParser(prog="shadermatrix", description=__doc__, epilog=EXIT_CODES,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--version", action="version", version=f"shadermatrix {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for name in _command_names():
         mod = importlib.import_module(f"{commands.__name__}.{name}")
-        sp = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
+        sp = sub.add_parser(name, help=mod.HELP, description=mod.HELP, epilog=EXIT_CODES,
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
         mod.add_arguments(sp)
-        sp.set_defaults(func=mod.run)
+        sp.set_defaults(func=mod.run, parser=sp)
     return p
 
 
@@ -35,17 +47,26 @@ def _terminate(signum, frame):
 
 
 def main(argv=None) -> int:
-    args = parser().parse_args(argv)
+    args, unknown = parser().parse_known_args(argv)
+    if unknown:  # the subcommand's own usage, not the top level's
+        args.parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     signal.signal(signal.SIGTERM, _terminate)
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `shadermatrix bricks | head`: end quietly, as Unix tools do
     try:
         return args.func(args)
-    except UserError as e:  # a bad input, a missing tool, a brick a compiler rejects
+    except UsageError as e:  # an option's value that cannot mean anything: one line, with what to write instead
         print(f"error: {e}", file=sys.stderr)
-        return 1
+        return EXIT_USAGE
+    except EnvironmentMissing as e:  # a pinned tool or the Vulkan device is not there
+        print(f"error: {e}", file=sys.stderr)
+        return EXIT_ENVIRONMENT
+    except UserError as e:  # a bad input, a brick a compiler rejects
+        print(f"error: {e}", file=sys.stderr)
+        return EXIT_FAILED
     except OSError as e:  # an output path that is a file, a full disk, no permission
         where = f"{e.filename}: " if e.filename else ""
         print(f"error: {where}{e.strerror or e} — check the path, its permissions and free space", file=sys.stderr)
-        return 1
+        return EXIT_FAILED
     except KeyboardInterrupt:
         print("interrupted; earlier outputs are intact", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED

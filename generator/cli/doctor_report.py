@@ -76,7 +76,7 @@ def run_doctor(out=None) -> int:
     for row in [header] + rows:
         print("  " + "  ".join(str(c).ljust(w) for c, w in zip(row, widths)) + "  " + row[4], file=out)
     print("all tools present" if not failed else "some tools are missing or wrong: run `make setup`", file=out)
-    return 1 if failed else 0
+    return 3 if failed else 0  # the CLI's exit code for an environment that lacks a tool or the device
 
 
 if __name__ == "__main__":

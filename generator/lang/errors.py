@@ -6,6 +6,14 @@ class UserError(Exception):
     """An error the user can fix; the message says what is wrong and what to do."""
 
 
+class UsageError(UserError):
+    """A command line that cannot mean anything: an option's value out of its range or not of its form (exit 2)."""
+
+
+class EnvironmentMissing(UserError):
+    """A tool or the Vulkan device a command needs is not on this machine (exit 3): never silently skipped."""
+
+
 class SourceError(UserError):
     """An error in a brick, scene or other input file, with its location."""
 

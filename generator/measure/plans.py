@@ -414,6 +414,6 @@ def _slot_standin(kind: str) -> str:
     params = ", ".join(f"{a.name}: {a.ty}" for a in e.args)
     same = [a.name for a in e.args if a.ty == e.ret]
     value = same[-1] if same else f"{e.ret}({e.args[-1].name})"
-    return (f'"""Cost stand-in {kind}: returns {value} (not a model; the baseline of `costs --bricks`)."""\n'
+    return (f'"""Cost stand-in {kind}: returns {value} (not a model; the baseline of `costs --per-brick`)."""\n'
             f'BRICK = {{"kind": "{kind}", "cite": "{STANDIN_CITE}"}}\n\n\n'
             f"def {e.name}({params}) -> {e.ret}:\n    return {value}\n")

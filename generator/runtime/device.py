@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..lang.errors import EnvironmentMissing
+
 if TYPE_CHECKING:
     from .images import Image, Sampler
 
@@ -36,7 +38,7 @@ STATISTICS_EXTENSION = "VK_KHR_pipeline_executable_properties"
 VALIDATION_LAYER = "VK_LAYER_KHRONOS_validation"
 
 
-class VulkanUnavailable(RuntimeError):
+class VulkanUnavailable(EnvironmentMissing, RuntimeError):
     """No usable Vulkan loader, lavapipe device or validation layer; the message says why and what to do."""
 
 

@@ -68,7 +68,7 @@ from pathlib import Path
 from typing import Iterable
 
 from ..io import content_key
-from ..lang.errors import UserError
+from ..lang.errors import EnvironmentMissing
 from ..targets import LANGUAGES
 
 __all__ = ["Diagnostic", "CompileJob", "CompileResult", "CompileStats", "ToolMissing",
@@ -130,7 +130,7 @@ class CompileResult:
         return lines or ([] if self.ok else [f"{self.key}: compile failed"])
 
 
-class ToolMissing(UserError):
+class ToolMissing(EnvironmentMissing):
     """A required external tool is not installed."""
 
     def __init__(self, name: str):

@@ -4,8 +4,9 @@
                           [--format md|json] [--out FILE] [--samples K] [--fail-above TOL]
 
 Without SPECs: every BRDF brick (each diffuse term, each specular term with
-every combination of slot fillers). Without --targets: numpy, plus GLSL, HLSL
-and WGSL when a lavapipe device is present. Two sample sets per spec: a
+every combination of slot fillers). Without --targets: numpy, GLSL, HLSL and
+WGSL; without a lavapipe device that is an error (exit 3), never a silent
+numpy-only report: pass --targets numpy to run without one. Two sample sets per spec: a
 stratified hemisphere (K⁴ samples) and the stress set (see generator/eval/accuracy.py).
 Exit status 1 when any float32 evaluation gives NaN or Inf (or, with
 --fail-above, a float32 hemisphere error exceeds TOL), or on bad input.
@@ -17,6 +18,7 @@ import sys
 from pathlib import Path
 
 from ... import DTYPES, GPU_TARGETS
+from ...lang.errors import UsageError
 
 HELP = "error of every target × dtype against the float64 references: hemisphere and stress set (Markdown/JSON)"
 ACCURACY_TARGETS = ("numpy",) + GPU_TARGETS
@@ -26,8 +28,8 @@ MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 
 def add_arguments(p) -> None:
     p.add_argument("specs", nargs="*", metavar="SPEC", help="BRDF specs (default: every BRDF brick)")
     p.add_argument("--targets", metavar="LIST",
-                   help=f"comma-separated, from {', '.join(ACCURACY_TARGETS)} (default: numpy, plus the GPU "
-                        "languages when lavapipe is present)")
+                   help=f"comma-separated, from {', '.join(ACCURACY_TARGETS)} (default: all; the GPU languages "
+                        "need a lavapipe device: without one, exit 3 unless --targets leaves them out)")
     p.add_argument("--dtypes", default=",".join(DTYPES), metavar="LIST",
                    help="comma-separated, from float64, float32, float16 (GPU targets run float32 only)")
     p.add_argument("--format", choices=("md", "json"), default="md", help="report format (default md)")
@@ -43,7 +45,7 @@ def _list(value: str, allowed: tuple, what: str) -> list[str]:
     items = [v.strip() for v in value.split(",") if v.strip()]
     bad = [v for v in items if v not in allowed]
     if bad or not items:
-        raise ValueError(f"unknown {what} {', '.join(map(repr, bad)) or '(none given)'} — "
+        raise UsageError(f"unknown {what} {', '.join(map(repr, bad)) or '(none given)'} — "
                          f"use a comma-separated list from {', '.join(allowed)}")
     return items
 
@@ -59,7 +61,7 @@ def run(args) -> int:
 
     try:
         if not 1 <= args.samples <= MAX_STRATA:
-            raise ValueError(f"--samples {args.samples} is outside 1 … {MAX_STRATA} (K⁴ sample pairs) — "
+            raise UsageError(f"--samples {args.samples} is outside 1 … {MAX_STRATA} (K⁴ sample pairs) — "
                              f"give a number of strata in that range (default 12)")
         dtypes = _list(args.dtypes, DTYPES, "dtype")
         notes = []
@@ -68,14 +70,15 @@ def run(args) -> int:
         else:
             targets = accuracy.default_targets()
             if targets == ["numpy"]:
-                notes.append("GPU targets skipped: no lavapipe Vulkan device (see `shadermatrix doctor`)")
+                raise VulkanUnavailable("no lavapipe Vulkan device for the GPU targets (`shadermatrix doctor` says "
+                                        "why; `make setup` installs it) — or pass --targets numpy to run without")
         lib = load_library(args.bricks or ())
         specs = args.specs or accuracy.default_specs(lib)
         if not accuracy.runs(targets, dtypes):
-            raise ValueError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
+            raise UsageError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
                              "GPU targets run float32 only; add float32 or the numpy target")
         report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples)
-    except (ValueError, EvalError, SpecError, ReferenceMissing, VulkanUnavailable) as exc:
+    except (EvalError, SpecError, ReferenceMissing) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
     report["notes"] = notes

@@ -7,7 +7,7 @@ HELP = "list every brick: kind, slots, parameters (type, range, default), citati
 
 
 def add_arguments(p) -> None:
-    p.add_argument("--bricks", "--brick-dir", dest="bricks", action="append", metavar="DIR",
+    p.add_argument("--bricks", action="append", metavar="DIR",
                    help="an extra brick directory (repeatable)")
     p.add_argument("--json", action="store_true", help="machine-readable output")
 

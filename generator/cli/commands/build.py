@@ -1,6 +1,7 @@
 """`shadermatrix build`: a scene's shader matrix in every language, validated, with manifest.json."""
 from __future__ import annotations
 
+import json
 import os
 import sys
 from pathlib import Path
@@ -11,7 +12,7 @@ HELP = "build a scene's shader matrix: sources + SPIR-V per language and manifes
 def add_arguments(p) -> None:
     p.add_argument("scene", help="scene file (TOML)")
     p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--bricks", "--brick-dir", dest="bricks", action="append", metavar="DIR",
+    p.add_argument("--bricks", action="append", metavar="DIR",
                    help="an extra brick directory (repeatable)")
     p.add_argument("--cache-dir", metavar="DIR",
                    help="the content-addressed compile cache (default: $SHADERMATRIX_CACHE_DIR, else "
@@ -26,8 +27,26 @@ def add_arguments(p) -> None:
                         "\"removed\" (default: they are deleted)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
+    p.add_argument("--json", action="store_true",
+                   help="print the summary as one JSON object on stdout (counts, seconds, failures) instead of text")
     p.add_argument("--depfile", metavar="PATH",
                    help="write a Make-syntax depfile (Ninja: deps = gcc): OUT/manifest.json and every file read")
+
+
+def summary(scene, res, out, seconds: float) -> dict:
+    """`build --json`: what the summary line says, as data (an engine's build reads it instead of parsing text)."""
+    c = res.compile
+    perms = [] if res.up_to_date else res.manifest["permutations"]
+    status = {s: sum(1 for p in perms if p["status"] == s) for s in ("ok", "failed", "stale")}
+    n = len(scene.permutations)
+    return {"scene": scene.name, "manifest": f"{out}/manifest.json", "permutations": n,
+            "up_to_date": n if res.up_to_date else res.kept,
+            "built": 0 if res.up_to_date else status["ok"] - res.kept,
+            "failed": status["failed"], "stale": status["stale"],
+            "shaders": c.jobs, "distinct": c.distinct, "merged": c.jobs - c.distinct, "from_cache": c.cached,
+            "compiled": c.compiled, "files_written": res.written, "files_unchanged": res.unchanged,
+            "spirv_shared": res.aliased, "seconds": round(seconds, 3), "ok": res.ok,
+            "failures": list(res.failures)}
 
 
 def run(args) -> int:
@@ -70,6 +89,11 @@ def run(args) -> int:
         if args.quiet and quiet_before is None:
             os.environ.pop("SHADERMATRIX_QUIET", None)
     seconds = time.perf_counter() - started
+    if args.json:
+        print(json.dumps(summary(scene, res, args.out, seconds), indent=2))
+        for f in res.failures:
+            print(f"error: {f}", file=sys.stderr)
+        return 0 if res.ok else 1
     if res.up_to_date:
         print(f"{scene.name}: {len(scene.permutations)} permutations up to date: 0 composed, 0 compiled; "
               f"0 files written, {res.unchanged} unchanged → {args.out}/manifest.json ({seconds:.2f} s)")

@@ -1,7 +1,7 @@
 """`shadermatrix cache stats|clear`: the content-addressed compile cache that `build` reads and fills."""
 from __future__ import annotations
 
-import sys
+from ...lang.errors import UsageError
 
 HELP = "the content-addressed compile cache: what it holds (stats) or empty it (clear)"
 
@@ -17,8 +17,7 @@ def run(args) -> int:
     from ...io import Store, default_cache_dir
     root = args.cache_dir or default_cache_dir()
     if root is None:
-        print("error: no cache directory: there is no home directory — give --cache-dir DIR", file=sys.stderr)
-        return 1
+        raise UsageError("no cache directory: there is no home directory — give --cache-dir DIR")
     store = Store(root)
     if args.action == "clear":
         print(f"{store.clear()} entries removed from {store.root}")

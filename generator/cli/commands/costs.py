@@ -3,14 +3,16 @@ from __future__ import annotations
 
 import sys
 
+from ...lang.errors import EnvironmentMissing, UsageError
+
 HELP = "cost tables (texture, ALU, transcendental, branches, registers) per permutation of a scene, or per brick"
 
 
 def add_arguments(p) -> None:
     p.add_argument("scene", nargs="?", help="scene file (TOML): one row per permutation and stage")
-    p.add_argument("--bricks", action="store_true",
+    p.add_argument("--per-brick", action="store_true",
                    help="per-brick table instead: each brick's cost against a trivial stand-in, and the course's models")
-    p.add_argument("--brick-dir", action="append", metavar="DIR", default=[],
+    p.add_argument("--bricks", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
     p.add_argument("--format", choices=("md", "csv", "json"), default="md", help="output format (default md)")
     p.add_argument("--cache-dir", metavar="DIR", help="the compile cache (default: as `build`'s)")
@@ -19,15 +21,48 @@ def add_arguments(p) -> None:
     p.add_argument("--gpu", nargs="?", const="default", metavar="FAMILIES",
                    help="add AMD compiler statistics from Mesa RADV's null device (no GPU needed) for these "
                         "comma-separated families; alone: polaris10,navi21,vangogh,navi31")
+    p.add_argument("--budget", metavar="NAME=MAX,...",
+                   help=f"per-shader limits, e.g. alu=60,texture=4,registers=32 (names: {', '.join(BUDGET_NAMES)}): "
+                        "every shader over one is listed and the exit code is 1 (a CI holds the budget)")
     p.add_argument("--gpu-ir", metavar="DIR",
                    help="with --gpu: save each shader's NIR, ACO IR and disassembly as DIR/<family>/<key>.<stage>.txt")
 
 
+BUDGET_NAMES = ("texture", "alu", "transcendental", "alu_t", "branches", "registers", "instructions", "loads",
+                "alu_scalar")
+
+
+def parse_budget(text: str) -> dict[str, int]:
+    """--budget alu=60,texture=4 → {"alu": 60, "texture": 4}."""
+    out = {}
+    for item in text.split(","):
+        name, eq, value = (x.strip() for x in item.partition("="))
+        if name not in BUDGET_NAMES or not eq or not value.isdigit() or name in out:
+            raise UsageError(f"--budget {text!r}: {item.strip()!r} is not NAME=MAX with NAME one of "
+                             f"{', '.join(BUDGET_NAMES)} (each once) and MAX a whole number — write e.g. "
+                             "--budget alu=60,texture=4,registers=32")
+        out[name] = int(value)
+    return out
+
+
+def over_budget(rows, budget: dict[str, int]) -> list[str]:
+    """One line per shader over a limit: what it is (permutation, objects, stage, language) and by how much."""
+    from ...measure.report import _value
+    lines = []
+    for r in rows:
+        over = [f"{name} {_value(r, name)} > {limit}" for name, limit in budget.items()
+                if r.cost is not None and _value(r, name) > limit]
+        if over:
+            who = f" ({', '.join(r.objects)})" if r.objects else ""
+            lines.append(f"over budget: {r.table} {r.subject}{who} {r.stage} {r.language}: {', '.join(over)}")
+    return lines
+
+
 def run(args) -> int:
-    if bool(args.scene) == bool(args.bricks):
-        print("error: give a SCENE or --bricks (one of them) — e.g. `shadermatrix costs scenes/example.toml` "
-              "or `shadermatrix costs --bricks`", file=sys.stderr)
-        return 2
+    budget = parse_budget(args.budget) if args.budget else None
+    if bool(args.scene) == bool(args.per_brick):
+        raise UsageError("give a SCENE or --per-brick (one of them) — e.g. `shadermatrix costs scenes/example.toml` "
+                         "or `shadermatrix costs --per-brick`")
     from ...measure.plans import brick_rows, course_models, load_cost_library, scene_rows
     from ...measure.report import markdown, to_csv, to_json
 
@@ -39,26 +74,23 @@ def run(args) -> int:
         from ...measure.gpu import GpuRequest
         from ...runtime.gpu_stats import DEFAULT_FAMILIES, check_families
         if "/" in args.gpu or args.gpu.endswith(".toml"):  # `costs --gpu SCENE`: the scene taken for families
-            print(f"error: --gpu {args.gpu}: that is a file, not AMD families — put the scene first "
-                  f"(`costs SCENE --gpu`) or write `--gpu=navi21,...`", file=sys.stderr)
-            return 2
+            raise UsageError(f"--gpu {args.gpu}: that is a file, not AMD families — put the scene first "
+                             f"(`costs SCENE --gpu`) or write `--gpu=navi21,...`")
         try:
             families = check_families(DEFAULT_FAMILIES if args.gpu == "default" else args.gpu.split(","))
         except ValueError as e:
-            print(f"error: --gpu {args.gpu}: {e}", file=sys.stderr)
-            return 2
+            raise UsageError(f"--gpu {args.gpu}: {e}") from None
         gpu = GpuRequest(families, args.gpu_ir)
     elif args.gpu_ir:
-        print("error: --gpu-ir needs --gpu — e.g. `--gpu navi21 --gpu-ir out/isa`", file=sys.stderr)
-        return 2
+        raise UsageError("--gpu-ir needs --gpu — e.g. `--gpu navi21 --gpu-ir out/isa`")
     models = None
-    if args.bricks:
-        rows = brick_rows(load_cost_library(args.brick_dir), gpu=gpu, store=store)
+    if args.per_brick:
+        rows = brick_rows(load_cost_library(args.bricks), gpu=gpu, store=store)
         subject, title, models = "bricks", "Costs per brick", course_models()[0]
     else:
         from ...library.bricks import load_library
         from ...matrix.scene import load_scene
-        lib = load_library(args.brick_dir)
+        lib = load_library(args.bricks)
         scene = load_scene(args.scene, lib)
         rows = scene_rows(scene, lib, gpu=gpu, store=store)
         subject, title = scene.name, f"Costs of scene {scene.name}"
@@ -68,11 +100,22 @@ def run(args) -> int:
         sys.stdout.write(to_csv(rows))
     else:
         sys.stdout.write(to_json(rows, subject, models, gpu))
-    if gpu is not None and gpu.note:  # the columns are absent: say why, in one line
-        print(f"note: {gpu.note}", file=sys.stderr)
     for why in sorted((gpu.errors or {}).values()) if gpu is not None else ():
         print(f"error: {why}", file=sys.stderr)
     failed = sorted({f"{r.subject} ({r.language}): {r.error}" for r in rows if r.error})
     for f in failed:
         print(f"error: {f}", file=sys.stderr)
-    return 1 if failed or (gpu is not None and gpu.errors) else 0
+    if failed or (gpu is not None and gpu.errors):
+        return 1
+    if budget:
+        over = over_budget(rows, budget)
+        for line in over:
+            print(f"error: {line}", file=sys.stderr)
+        shaders = sum(1 for r in rows if r.cost is not None)
+        print(f"budget {', '.join(f'{k} ≤ {v}' for k, v in budget.items())}: {len(over)} of {shaders} shaders over",
+              file=sys.stderr)
+        if over:
+            return 1
+    if gpu is not None and gpu.note:  # asked for and not there: the table came without them, and the exit says so
+        raise EnvironmentMissing(f"{gpu.note} (the tables above leave the AMD columns out)")
+    return 0

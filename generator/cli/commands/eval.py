@@ -22,6 +22,7 @@ from tokenize import TokenError
 from pathlib import Path
 
 from ... import DTYPES, EVAL_TARGETS
+from ...lang.errors import UsageError
 
 HELP = "evaluate a BRDF spec on samples (.npy in, float64 f_r .npy out): reference, numpy or a GPU kernel"
 
@@ -52,13 +53,13 @@ def parse_params(items: list[str]) -> dict[str, list[float]]:
         name, eq, value = item.partition("=")
         name = name.strip()
         if not eq or not name or not value.strip():
-            raise _Usage(f"--param {item!r} is not NAME=VALUE — write e.g. --param alpha=0.2 or --param f0=0.9,0.6,0.3")
+            raise UsageError(f"--param {item!r} is not NAME=VALUE — write e.g. --param alpha=0.2 or --param f0=0.9,0.6,0.3")
         if name in out:
-            raise _Usage(f"--param {name} is given twice — give each parameter once")
+            raise UsageError(f"--param {name} is given twice — give each parameter once")
         try:
             out[name] = [float(v) for v in value.split(",")]
         except ValueError:
-            raise _Usage(f"--param {item!r}: {value!r} is not a number or a comma-separated list of numbers — "
+            raise UsageError(f"--param {item!r}: {value!r} is not a number or a comma-separated list of numbers — "
                          "write e.g. --param f0=0.9,0.6,0.3") from None
     return out
 
@@ -134,16 +135,15 @@ def run(args) -> int:
     from ...io import atomic_write
     from ...eval.evaluate import EvalError, evaluate
     from ...matrix.permutation import SpecError
-    from ...runtime.device import VulkanUnavailable
 
+    params = parse_params(args.param)  # a usage error: the CLI's exit 2
     try:
-        params = parse_params(args.param)
         s = load_samples(args.input, checked=not args.unchecked)
         lib = load_library(args.bricks or ())
         T = s[:, 9:12] if s.shape[1] == 12 else None
         f = evaluate(args.spec, s[:, 0:3], s[:, 3:6], s[:, 6:9], T=T, params=params,
                      target=args.target, dtype=args.dtype, lib=lib)
-    except (_Usage, EvalError, SpecError, VulkanUnavailable) as exc:
+    except (_Usage, EvalError, SpecError) as exc:  # no Vulkan device: the CLI's exit 3
         print(f"error: {exc}", file=sys.stderr)
         return 1
     buf = io.BytesIO()

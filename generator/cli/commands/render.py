@@ -5,7 +5,7 @@ import re
 import sys
 from pathlib import Path
 
-from ...lang.errors import UserError
+from ...lang.errors import UsageError
 
 HELP = "render a scene offscreen on lavapipe: specialized, ubershader or hybrid; PNG frames and report.json"
 
@@ -28,9 +28,9 @@ def run(args) -> int:
 
     m = re.fullmatch(r"(\d+)x(\d+)", args.size)
     if not m or not (1 <= int(m[1]) <= 4096 and 1 <= int(m[2]) <= 4096):
-        raise UserError(f"--size {args.size!r} is not WxH — write e.g. --size 256x160 (1 to 4096 each)")
+        raise UsageError(f"--size {args.size!r} is not WxH — write e.g. --size 256x160 (1 to 4096 each)")
     if args.frames < 1:
-        raise UserError(f"--frames {args.frames} — draw at least one frame")
+        raise UsageError(f"--frames {args.frames} — draw at least one frame")
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)
     from ...runtime.device import VulkanUnavailable
@@ -38,7 +38,7 @@ def run(args) -> int:
         report = render_scene(scene, lib, args.mode, args.frames, Path(args.out), (int(m[1]), int(m[2])),
                               args.language, progress=progress())
     except VulkanUnavailable as e:
-        raise UserError(f"no Vulkan device to render on: {e} — install Mesa lavapipe (`make setup`)") from None
+        raise VulkanUnavailable(f"no Vulkan device to render on: {e} — install Mesa lavapipe (`make setup`)") from None
     if report.cache_problem:
         print(f"warning: {report.cache_problem}", file=sys.stderr)
     last = report.steady
