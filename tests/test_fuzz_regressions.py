@@ -40,13 +40,13 @@ ESCAPE_WARNING = base64.b64decode(
 
 
 def _samples_message(tmp_path, data: bytes) -> tuple[str, list]:
-    from generator.cli.commands.eval import _Usage, load_samples
+    from generator.cli.commands.eval import _BadInput, load_samples
 
     path = tmp_path / "case.npy"
     path.write_bytes(data)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        with pytest.raises(_Usage) as e:
+        with pytest.raises(_BadInput) as e:
             load_samples(str(path))
     text = str(e.value)
     assert text.startswith(f"{path}: ") and " — " in text and "\n" not in text, text

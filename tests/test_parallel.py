@@ -73,7 +73,7 @@ def test_a_permutation_that_fails_in_a_worker_is_reported_located(scene, tmp_pat
 def test_a_worker_without_the_tools_is_one_line(scene, tmp_path):
     env = {**os.environ, "PATH": "/nonexistent"}  # no glslc, no spirv-tools
     r = _cli("build", scene, "--out", tmp_path / "out", "--no-cache", "-j", "2", env=env)
-    assert r.returncode == 1 and "Traceback" not in r.stderr
+    assert r.returncode == 3 and "Traceback" not in r.stderr  # the environment's exit code, as in-process
     errors = [line for line in r.stderr.splitlines() if line.startswith("error:")]
     assert len(errors) == 1 and "not found" in errors[0] and "make setup" in errors[0], r.stderr
 
@@ -122,3 +122,43 @@ def test_kill_9_of_a_parallel_build_loses_nothing_and_leaves_no_worker(scene, tm
     r = _cli("build", scene, "--out", out, "--no-cache", "-j", "2")
     assert r.returncode == 0, r.stderr
     assert all(e["status"] == "ok" for e in _consistent(out)["permutations"])
+
+
+def _start_build(scene: Path, out: Path) -> subprocess.Popen:
+    """A -j 2 build in a session of its own, once its workers are composing (its first shader being compiled)."""
+    import time
+    p = subprocess.Popen([sys.executable, "-m", "generator.cli", "build", str(scene), "--out", str(out), "--no-cache",
+                          "-j", "2"], cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and p.poll() is None and len(_session_pythons(p.pid)) < 4:
+        time.sleep(0.05)  # the build, the forkserver and two workers
+    time.sleep(1.0)
+    assert p.poll() is None, "the build ended before it could be interrupted"
+    return p
+
+
+def test_ctrl_c_of_a_parallel_build_is_one_line_and_ends_the_workers(scene, tmp_path):
+    import signal
+    import time
+    p = _start_build(scene, tmp_path / "out")
+    os.killpg(p.pid, signal.SIGINT)  # as a terminal does: the whole process group
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130 and err == "interrupted; earlier outputs are intact\n", err
+    deadline = time.monotonic() + 10  # the forkserver and the resource tracker follow the build out
+    while _session_pythons(p.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _session_pythons(p.pid) == []
+
+
+def test_a_worker_that_dies_fails_the_build_instead_of_hanging_it(scene, tmp_path):
+    import signal
+    p = _start_build(scene, tmp_path / "out")
+    workers = [pid for pid in _session_pythons(p.pid) if pid != p.pid
+               and b"forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes()
+               and int(Path(f"/proc/{pid}/stat").read_bytes().rsplit(b")", 1)[1].split()[1]) != p.pid]
+    assert workers, "no worker process found"
+    os.kill(workers[0], signal.SIGKILL)  # as the kernel's OOM killer would
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 1 and "Traceback" not in err, err
+    assert "error: a worker process of the build died" in err and err.count("error:") == 1, err

@@ -166,7 +166,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
             entry = {**head(h), "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
                      "uploads": uploads(scene, h, c)}
             errs = _write_all(res, out, h, c.sources, part, entry)
-            built[h] = _settle(res, entry, errs, old.get(h), out, _what(scene, h, users.get(h, [])))
+            built[h] = _settle(res, entry, errs, old.get(h), out, _failure_head(scene, h, users.get(h, [])))
 
     n = workers or os.cpu_count() or 1
     if executor is None and n > 1 and len(todo.permutations) >= MIN_PERMUTATIONS:  # compose and analyse there too
@@ -187,7 +187,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
             entries.append(built[h])
         else:  # it did not compose
             entries.append(_settle(res, head(h), list(errors.get(h, [])), old.get(h), out,
-                                   _what(scene, h, users.get(h, []))))
+                                   _failure_head(scene, h, users.get(h, []))))
     if uber_kept:
         uber = old_uber
         res.unchanged += _files(uber)
@@ -219,7 +219,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     return res
 
 
-def _what(scene: Scene, h: str, objs: list[dict]) -> tuple[str, str]:
+def _failure_head(scene: Scene, h: str, objs: list[dict]) -> tuple[str, str]:
     """Where the scene asks for permutation h (its first object's material key), and which it is."""
     line, col = scene.where.get(h, (1, 1))
     names = [o["name"] for o in objs]
@@ -338,7 +338,7 @@ def _bricks_of(part: tuple, lib: Library):
             brick = lib.get(kind, value.light if kind == "light" else value)
             if brick is None:
                 raise SourceError("<key>", 1, 1, f"unknown {kind} brick in {value}", f"name a known {kind} brick")
-            nodes, extra = parse_spec(value.shadow, lib, ("shadow",)) if kind == "light" else [], [brick]
+            nodes, extra = (parse_spec(value.shadow, lib, ("shadow",)) if kind == "light" else []), [brick]
         else:
             nodes, extra = (parse_brdf(value, lib) if kind == "brdf" else parse_spec(value, lib, ("packing",))), []
     except (SourceError, SpecError) as e:
@@ -449,16 +449,16 @@ def _ubershader(res: BuildResult, scene: Scene, lib: Library, out: Path, unit, r
     if unit is None:
         return {}
     if isinstance(unit, str):
-        return _settle(res, {"input_key": key, "languages": {}}, [unit], old, out, _uber_what(scene))
+        return _settle(res, {"input_key": key, "languages": {}}, [unit], old, out, _uber_failure_head(scene))
     c, u = unit
     perms = [p for _, p in sorted(scene.permutations.items())]
     entry = {"input_key": key, "hash": c.hash, "languages": {}, "tables": u.tables(), "interface": c.interface.as_dict()}
     errs = [f"coverage: {p}" for p in coverage(u, perms, lib)]
     errs += _write_all(res, out, "ubershader", c.sources, results, entry)
-    return _settle(res, entry, errs, old, out, _uber_what(scene))
+    return _settle(res, entry, errs, old, out, _uber_failure_head(scene))
 
 
-def _uber_what(scene: Scene) -> tuple[str, str]:
+def _uber_failure_head(scene: Scene) -> tuple[str, str]:
     line, col = scene.head_at
     return (f"{scene.path}:{line}:{col}: the scene's ubershader (the fallback for all {len(scene.permutations)} "
             "permutations) does not build", "")

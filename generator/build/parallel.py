@@ -15,6 +15,8 @@ shader is counted distinct, cached or compiled where it first appears in chunk o
 from __future__ import annotations
 
 import multiprocessing
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 import os
 import pickle
 import shutil
@@ -25,7 +27,7 @@ import time
 
 from ..io import Store, sha256, show_progress
 from ..lang import SourceError
-from ..lang.errors import UserError
+from ..lang.errors import EnvironmentMissing, UserError
 from ..library import bricks as _bricks
 from ..toolchain import CompileJob, CompileStats, cache_key, compile_many
 from ..toolchain.scenes import job_key
@@ -44,6 +46,8 @@ def chunk_size(permutations: int, workers: int) -> int:
 
 
 def _start(build: int, lib_bytes: bytes, env: dict, store_root: str | None, languages: tuple) -> None:
+    import signal
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole process group: the build ends the workers
     _watch(build)
     os.environ.clear()
     os.environ.update(env)
@@ -100,10 +104,21 @@ def _task(items: list, extra: list) -> tuple:
         for r in results.values():
             if r.ok and r.spirv and sha256(r.spirv) not in costs:
                 costs[sha256(r.spirv)] = cost_dict(r.spirv, store)
-    except UserError as e:  # a missing tool: its message, re-raised as it pickles
-        raise UserError(str(e)) from None
+    except UserError as e:  # a missing tool (exit 3) or another error: its class and message, as they pickle
+        raise (EnvironmentMissing if isinstance(e, EnvironmentMissing) else UserError)(str(e)) from None
     keys = {j.key: cache_key(j, True, True) for j in jobs}
     return composed, errors, results, costs, keys, stats.fresh, loaded_templates()
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """End the workers now: done, failed or interrupted, no queued chunk runs (shutdown alone would let the running
+    ones finish, and an error or Ctrl-C should not wait for them)."""
+    workers = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle on them
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in workers:
+        p.terminate()
+    for p in workers:
+        p.join()
 
 
 def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=(), workers: int = 2,
@@ -123,7 +138,11 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     fresh: set[str] = set()  # those some worker compiled (the others came from the cache)
 
     def take(task) -> dict:
-        c, errs, part, cost, keys, compiled, read = task.get()
+        try:
+            c, errs, part, cost, keys, compiled, read = task.result()
+        except BrokenProcessPool:
+            raise UserError("a worker process of the build died (killed, or out of memory) — build again, or with "
+                            "fewer jobs (-j)") from None
         composed.update(c)
         errors.update(errs)
         results.update(part)
@@ -139,20 +158,19 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     # killed build's is removed by the next
     private = None if store is not None else tempfile.mkdtemp(prefix=f"shadermatrix-{os.getpid()}-build-")
     lib_bytes = pickle.dumps(type(lib)(bricks=lib.bricks, errors=lib.errors))  # no memo: workers link their own
-    # a Pool, not a ProcessPoolExecutor: a failure or Ctrl-C terminates the workers instead of running every
-    # queued chunk first
     if _QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its resource tracker
         sys.warnoptions.append(_QUIET_TRACKER)
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(_PRELOAD)  # imported once, by the forkserver: each worker starts as a fork of it
-    pool = context.Pool(
-        workers, initializer=_start,
+    # an executor, so that a worker that dies fails the build (BrokenProcessPool) instead of losing its task
+    pool = ProcessPoolExecutor(
+        workers, mp_context=context, initializer=_start,
         initargs=(os.getpid(), lib_bytes, dict(os.environ), str(store.root) if store else private, tuple(languages)))
     try:
         with tqdm(total=len(items), disable=not show_progress(), unit="permutation", leave=False) as bar:
             # the ubershader's large shaders first, one task each: they spread over the workers
-            uber = [pool.apply_async(_task, ([], [job])) for job in extra]
-            tasks = [pool.apply_async(_task, (chunk, [])) for chunk in chunks]
+            uber = [pool.submit(_task, [], [job]) for job in extra]
+            tasks = [pool.submit(_task, chunk, []) for chunk in chunks]
             for chunk, task in zip(chunks, tasks):  # written in chunk order, each as soon as it is back
                 part = take(task)
                 if on_done is not None:
@@ -161,11 +179,11 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
             for task in uber:
                 take(task)
     finally:
-        pool.terminate()
-        pool.join()  # the workers are gone before this returns (or raises)
+        _stop(pool)
         if private is not None:
             shutil.rmtree(private, ignore_errors=True)
     # counted once per distinct shader, whichever worker got it first: the same counts for any N and any timing
+    # (when every shader compiles: in-process, a failing one is compiled, and counted, again per chunk)
     stats.distinct += len(seen)
     stats.compiled += len(seen & fresh)
     stats.cached += len(seen - fresh)

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import signal
 import sys
@@ -17,14 +18,15 @@ def _command_names() -> list[str]:
     return [n for n in commands.ORDER if n in found] + sorted(found - set(commands.ORDER))
 
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_ENVIRONMENT, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_ENVIRONMENT, EXIT_INTERRUPTED, EXIT_PIPE = 0, 1, 2, 3, 130, 141
 EXIT_CODES = f"""exit codes (the same for every command):
   {EXIT_OK}    done
   {EXIT_FAILED}    a failure in the inputs or the shaders (a brick, a scene, a sample file, a compiler's error)
   {EXIT_USAGE}    a usage error: an unknown option, an option's value out of its range
   {EXIT_ENVIRONMENT}    the environment lacks what the command needs: a pinned tool or the Vulkan device
        (`make setup`; `shadermatrix doctor` says what is missing) — never skipped silently
-  {EXIT_INTERRUPTED}  interrupted (Ctrl-C, SIGTERM): earlier outputs are intact"""
+  {EXIT_INTERRUPTED}  interrupted (Ctrl-C, SIGTERM): earlier outputs are intact
+  {EXIT_PIPE}  the reader of its output went away (`| head`): ended quietly, as Unix tools do"""
 
 
 def parser() -> argparse.ArgumentParser:
@@ -51,7 +53,6 @@ def main(argv=None) -> int:
     if unknown:  # the subcommand's own usage, not the top level's
         args.parser.error(f"unrecognized arguments: {' '.join(unknown)}")
     signal.signal(signal.SIGTERM, _terminate)
-    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `shadermatrix bricks | head`: end quietly, as Unix tools do
     try:
         return args.func(args)
     except UsageError as e:  # an option's value that cannot mean anything: one line, with what to write instead
@@ -63,6 +64,9 @@ def main(argv=None) -> int:
     except UserError as e:  # a bad input, a brick a compiler rejects
         print(f"error: {e}", file=sys.stderr)
         return EXIT_FAILED
+    except BrokenPipeError:  # `shadermatrix bricks | head`: the reader went away; end quietly, as Unix tools do
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
+        return EXIT_PIPE
     except OSError as e:  # an output path that is a file, a full disk, no permission
         where = f"{e.filename}: " if e.filename else ""
         print(f"error: {where}{e.strerror or e} — check the path, its permissions and free space", file=sys.stderr)

@@ -388,7 +388,6 @@ def markdown(report: dict) -> str:
              "is a Dirac peak, alpha = 0), ill-cond. (values whose reference moves by more than "
              f"{ILL_CONDITIONED:g} when the inputs are rounded to the dtype) and ref. Inf (values where the "
              "reference is infinite in other batches).", ""]
-    lines += [f"Note: {n}" for n in report.get("notes", [])]
     lines += ["## NaN / Inf per run (every spec, both sample sets)", "", "| run | NaN | Inf |", "|---|---|---|"]
     for run_ in report["runs"]:
         rows = [r for r in res if f"{r['target']}/{r['dtype']}" == run_]

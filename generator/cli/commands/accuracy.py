@@ -64,7 +64,6 @@ def run(args) -> int:
             raise UsageError(f"--samples {args.samples} is outside 1 … {MAX_STRATA} (K⁴ sample pairs) — "
                              f"give a number of strata in that range (default 12)")
         dtypes = _list(args.dtypes, DTYPES, "dtype")
-        notes = []
         if args.targets:
             targets = _list(args.targets, ACCURACY_TARGETS, "target")
         else:
@@ -81,7 +80,6 @@ def run(args) -> int:
     except (EvalError, SpecError, ReferenceMissing) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
-    report["notes"] = notes
     text = accuracy.markdown(report) if args.format == "md" else json.dumps(report, indent=1) + "\n"
     if args.out:
         atomic_write(Path(args.out), text.encode())
@@ -98,8 +96,6 @@ def run(args) -> int:
     if too_big:
         print(f"error: {worst['spec']} {worst['target']}/float32: hemisphere max relative error "
               f"{worst['max_rel']:.3g} exceeds --fail-above {args.fail_above:g}", file=sys.stderr)
-    for n in notes:
-        print(f"note: {n}", file=sys.stderr)
     print(f"{len(specs)} specs × {', '.join(report['runs'])}: "
           f"{'no' if not bad else len(bad)} float32 NaN/Inf"
           + (f"; worst float32 hemisphere error {worst['max_rel']:.2e} ({worst['spec']}, {worst['target']})"

@@ -6,6 +6,8 @@ import os
 import sys
 from pathlib import Path
 
+from ...lang.errors import UsageError, UserError
+
 HELP = "build a scene's shader matrix: sources + SPIR-V per language and manifest.json"
 
 
@@ -17,9 +19,12 @@ def add_arguments(p) -> None:
     p.add_argument("--cache-dir", metavar="DIR",
                    help="the content-addressed compile cache (default: $SHADERMATRIX_CACHE_DIR, else "
                         "$XDG_CACHE_HOME/shadermatrix, else ~/.cache/shadermatrix)")
-    p.add_argument("--no-cache", action="store_true", help="compile everything; read and write no cache")
+    p.add_argument("--no-cache", action="store_true",
+                   help="compile everything; read and write no cache (worker processes share a private one for "
+                        "this build only, removed when it ends)")
     p.add_argument("-j", "--jobs", type=int, metavar="N",
-                   help="tool processes at once (default: the core count); the output is the same for any N")
+                   help="worker processes composing, compiling and analysing (default: the core count; from 64 "
+                        "permutations, else N tool processes); the output is the same for any N")
     p.add_argument("--executor", metavar="dask://HOST:PORT",
                    help="compile on a Dask distributed cluster (its workers need the pinned tools: README)")
     p.add_argument("--keep-removed", action="store_true",
@@ -61,24 +66,26 @@ def run(args) -> int:
     if args.quiet:
         os.environ["SHADERMATRIX_QUIET"] = "1"  # io.show_progress: no bar (restored when the build ends)
     if args.no_cache and args.cache_dir:
-        print("error: --no-cache and --cache-dir contradict each other — give one", file=sys.stderr)
-        return 2
-    lib = load_library(args.bricks or ())
-    scene = load_scene(args.scene, lib)
+        raise UsageError("--no-cache and --cache-dir contradict each other — give one")
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError(f"-j {args.jobs}: give at least one job")
+    if args.executor and not args.executor.startswith("dask://"):
+        raise UsageError(f"--executor {args.executor}: write dask://HOST:PORT")
+    try:
+        lib = load_library(args.bricks or ())
+        scene = load_scene(args.scene, lib)
+    except UserError as e:
+        if args.json:  # a script reading stdout gets its answer too
+            print(json.dumps({"ok": False, "failures": [str(e)]}, indent=2))
+        raise
     root = args.cache_dir or default_cache_dir()
     if root is None and not args.no_cache:
         print("note: no home directory for the compile cache — building without it (--cache-dir DIR to keep one)",
               file=sys.stderr)
     store = None if args.no_cache or root is None else Store(root)
-    if args.jobs is not None and args.jobs < 1:
-        print(f"error: -j {args.jobs}: give at least one job", file=sys.stderr)
-        return 2
     executor = None
     if args.executor:
-        from ...toolchain.dask import SCHEME, DaskExecutor
-        if not args.executor.startswith(SCHEME):
-            print(f"error: --executor {args.executor}: write dask://HOST:PORT", file=sys.stderr)
-            return 2
+        from ...toolchain.dask import DaskExecutor
         executor = DaskExecutor(args.executor)
     try:
         res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile, workers=args.jobs,

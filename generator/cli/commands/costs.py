@@ -1,6 +1,7 @@
 """`shadermatrix costs`: measured cost tables per permutation of a scene, or per brick."""
 from __future__ import annotations
 
+import re
 import sys
 
 from ...lang.errors import EnvironmentMissing, UsageError
@@ -37,7 +38,7 @@ def parse_budget(text: str) -> dict[str, int]:
     out = {}
     for item in text.split(","):
         name, eq, value = (x.strip() for x in item.partition("="))
-        if name not in BUDGET_NAMES or not eq or not value.isdigit() or name in out:
+        if name not in BUDGET_NAMES or not eq or not re.fullmatch(r"[0-9]+", value) or name in out:
             raise UsageError(f"--budget {text!r}: {item.strip()!r} is not NAME=MAX with NAME one of "
                              f"{', '.join(BUDGET_NAMES)} (each once) and MAX a whole number — write e.g. "
                              "--budget alu=60,texture=4,registers=32")
@@ -105,17 +106,17 @@ def run(args) -> int:
     failed = sorted({f"{r.subject} ({r.language}): {r.error}" for r in rows if r.error})
     for f in failed:
         print(f"error: {f}", file=sys.stderr)
-    if failed or (gpu is not None and gpu.errors):
-        return 1
+    over = over_budget(rows, budget) if budget else []
+    for line in over:
+        print(f"error: {line}", file=sys.stderr)
     if budget:
-        over = over_budget(rows, budget)
-        for line in over:
-            print(f"error: {line}", file=sys.stderr)
         shaders = sum(1 for r in rows if r.cost is not None)
         print(f"budget {', '.join(f'{k} ≤ {v}' for k, v in budget.items())}: {len(over)} of {shaders} shaders over",
               file=sys.stderr)
-        if over:
-            return 1
+    if failed or over or (gpu is not None and gpu.errors):
+        if gpu is not None and gpu.note:
+            print(f"error: {gpu.note}", file=sys.stderr)
+        return 1
     if gpu is not None and gpu.note:  # asked for and not there: the table came without them, and the exit says so
         raise EnvironmentMissing(f"{gpu.note} (the tables above leave the AMD columns out)")
     return 0

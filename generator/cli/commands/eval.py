@@ -42,8 +42,8 @@ def add_arguments(p) -> None:
                    help="pass non-finite and non-unit sample vectors through as they are (default: an error)")
 
 
-class _Usage(Exception):
-    pass
+class _BadInput(Exception):
+    """A sample file that cannot be evaluated (exit 1; a malformed option is a UsageError, exit 2)."""
 
 
 def parse_params(items: list[str]) -> dict[str, list[float]]:
@@ -78,7 +78,7 @@ def load_samples(path: str, checked: bool = True):
 
     p = Path(path)
     if not p.is_file():
-        raise _Usage(f"{path}: no such file — pass an .npy file of samples with --input")
+        raise _BadInput(f"{path}: no such file — pass an .npy file of samples with --input")
     try:
         # numpy compiles a malformed header dict, and Python warns of what it finds (SyntaxWarning, numpy's
         # Python-2 header note): the one-line error below says it all, so nothing else is printed
@@ -89,33 +89,33 @@ def load_samples(path: str, checked: bool = True):
             shape, _, dtype = read(f)
             start = f.tell()
     except (ValueError, OSError, EOFError, SyntaxError, TokenError) as exc:  # numpy tokenizes the header dict
-        raise _Usage(f"{path}: not a readable .npy array ({_one_line(exc)}) — save the samples with numpy.save") from None
+        raise _BadInput(f"{path}: not a readable .npy array ({_one_line(exc)}) — save the samples with numpy.save") from None
     # everything the header declares is checked before np.load allocates a byte
     if dtype.kind != "f":
-        raise _Usage(f"{path}: dtype {dtype} is not a float array — save float32 or float64 samples")
+        raise _BadInput(f"{path}: dtype {dtype} is not a float array — save float32 or float64 samples")
     if len(shape) != 2 or shape[1] not in (9, 12):
-        raise _Usage(f"{path}: shape {shape} — samples are (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T]")
+        raise _BadInput(f"{path}: shape {shape} — samples are (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T]")
     if shape[0] > MAX_SAMPLES:
-        raise _Usage(f"{path}: {shape[0]} samples declared, more than the {MAX_SAMPLES} allowed — split the file")
+        raise _BadInput(f"{path}: {shape[0]} samples declared, more than the {MAX_SAMPLES} allowed — split the file")
     if p.stat().st_size - start < shape[0] * shape[1] * dtype.itemsize:
-        raise _Usage(f"{path}: the header declares {shape[0]} samples, but the file is shorter — save it again")
+        raise _BadInput(f"{path}: the header declares {shape[0]} samples, but the file is shorter — save it again")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             a = np.load(p, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
-        raise _Usage(f"{path}: not a readable .npy array ({_one_line(exc)}) — save the samples with numpy.save") from None
+        raise _BadInput(f"{path}: not a readable .npy array ({_one_line(exc)}) — save the samples with numpy.save") from None
     if not isinstance(a, np.ndarray) or a.dtype.kind != "f":
-        raise _Usage(f"{path}: dtype {getattr(a, 'dtype', type(a).__name__)} is not a float array — "
+        raise _BadInput(f"{path}: dtype {getattr(a, 'dtype', type(a).__name__)} is not a float array — "
                      "save float32 or float64 samples")
     if a.ndim != 2 or a.shape[1] not in (9, 12):
-        raise _Usage(f"{path}: shape {a.shape} — samples are (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T]")
+        raise _BadInput(f"{path}: shape {a.shape} — samples are (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T]")
     a = a.astype(np.float64)
     if checked and len(a):
         bad = ~np.isfinite(a).all(axis=1)
         if bad.any():
             row = int(np.argmax(bad))
-            raise _Usage(f"{path}: row {row} holds a NaN or infinity ({a[row].tolist()}) — fix the samples, or pass "
+            raise _BadInput(f"{path}: row {row} holds a NaN or infinity ({a[row].tolist()}) — fix the samples, or pass "
                          "--unchecked to evaluate them as they are")
         names = ["L", "V", "N", "T"][:a.shape[1] // 3]
         with np.errstate(over="ignore", invalid="ignore"):  # huge finite values: an overflowed length is "not 1"
@@ -123,7 +123,7 @@ def load_samples(path: str, checked: bool = True):
         off = np.abs(lengths - 1.0) > UNIT_TOL
         if off.any():
             row, col = (int(x) for x in np.argwhere(off)[0])
-            raise _Usage(f"{path}: row {row}: {names[col]} has length {lengths[row, col]:.6g}, not 1 — normalize the "
+            raise _BadInput(f"{path}: row {row}: {names[col]} has length {lengths[row, col]:.6g}, not 1 — normalize the "
                          "sample vectors, or pass --unchecked to evaluate them as they are")
     return a
 
@@ -143,7 +143,7 @@ def run(args) -> int:
         T = s[:, 9:12] if s.shape[1] == 12 else None
         f = evaluate(args.spec, s[:, 0:3], s[:, 3:6], s[:, 6:9], T=T, params=params,
                      target=args.target, dtype=args.dtype, lib=lib)
-    except (_Usage, EvalError, SpecError) as exc:  # no Vulkan device: the CLI's exit 3
+    except (_BadInput, EvalError, SpecError) as exc:  # in the inputs: exit 1 (no device: the CLI's exit 3)
         print(f"error: {exc}", file=sys.stderr)
         return 1
     buf = io.BytesIO()
