@@ -110,3 +110,21 @@ def test_a_cost_budget_lists_the_shaders_over_it_and_exits_1(tmp_path):
     assert any("(" in line for line in over)  # a permutation's row names the objects drawn with it
     assert run("costs", EXAMPLE, "--budget", "alu=lots").returncode == 2
     assert run("costs", EXAMPLE, "--budget", "speed=3").returncode == 2
+
+
+@pytest.mark.toolchain
+def test_cost_rows_name_materials_and_objects_sort_and_mean_one_thing_per_column(tmp_path):
+    import csv
+    import io
+    cache = ("--cache-dir", tmp_path / "cache")
+    r = run("costs", EXAMPLE, "--format", "csv", "--sort", "alu", *cache)
+    assert r.returncode == 0, r.stderr
+    rows = list(csv.DictReader(io.StringIO(r.stdout)))
+    shaders = [x for x in rows if x["table"] == "permutation"]
+    assert all(x["kind"] == "" and x["measured"] == "" and x["key"].startswith("brdf=") for x in shaders)
+    assert {x["materials"] for x in shaders if "statue" in x["objects"]} == {"polished_gold"}
+    alu = [int(x["alu"]) for x in rows if x["alu"]]
+    assert alu == sorted(alu, reverse=True)  # --sort alu: the costliest first
+    md = run("costs", EXAMPLE, *cache)
+    assert "| permutation | materials | objects | stage |" in md.stdout
+    assert run("costs", EXAMPLE, "--sort", "speed").returncode == 2

@@ -258,7 +258,7 @@ def test_scene_costs_json_rows_and_stability(scene_json):
             assert r[key] is not None, key
     course = {(r["subject"], r["course_model"], r["course_table"]) for r in rows if r["course_model"]}
     rows = [r for r in rows if r["table"] == "permutation"]
-    ids = {r["subject"]: r["measured"] for r in rows}
+    ids = {r["subject"]: r["key"] for r in rows}
     for subject, model, table in course:
         assert model in ("Blinn-Phong", "Cook-Torrance")
         assert (table == "shift-variant") == ("albedo_texture" in ids[subject])
@@ -272,7 +272,7 @@ def test_scene_costs_json_rows_and_stability(scene_json):
 def test_scene_costs_markdown_and_csv(scene_json):
     md = cli(EXAMPLE)
     assert md.returncode == 0, md.stderr
-    assert "| permutation | objects | stage | tex | ALU |" in md.stdout
+    assert "| permutation | materials | objects | stage | tex | ALU |" in md.stdout
     assert "## Where the languages differ" in md.stdout
     csv_out = cli(EXAMPLE, "--format", "csv")
     assert csv_out.returncode == 0

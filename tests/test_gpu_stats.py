@@ -142,4 +142,4 @@ def test_without_radv_the_columns_are_absent_with_one_line(monkeypatch, capsys):
     out, err = capsys.readouterr()
     notes = [line for line in err.splitlines() if line.startswith("error:")]
     assert len(notes) == 1 and "install mesa-vulkan-drivers" in notes[0], err
-    assert "## AMD compiler statistics" not in out and "| permutation | objects | stage | tex |" in out
+    assert "## AMD compiler statistics" not in out and "| permutation | materials | objects | stage | tex |" in out

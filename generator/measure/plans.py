@@ -115,6 +115,7 @@ class Row:
     course: CourseFigure | None = None
     error: str = ""
     objects: tuple = ()  # permutation rows: the scene objects using it
+    materials: tuple = ()  # permutation rows: the materials of those objects, in scene order
     lights: int = 0      # permutation rows: light count (the course's figures are per light)
     gpu: dict | None = None  # {AMD family: {RADV statistic: value}} with --gpu (measure/gpu.py)
 
@@ -352,8 +353,14 @@ def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None,
     composed, errors, results = compile_scene(scene, lib, languages, store=store)
     rows, pairs = [], []
 
+    materials: dict[str, list[str]] = {}
+    for o in scene.objects:
+        if o["material"] not in materials.setdefault(o["permutation"], []):
+            materials[o["permutation"]].append(o["material"])
+
     def row_of(table, subject, perm_key, stage, lang, c_hash, course=None, objects=(), lights=0, error=None):
-        row = Row(table, subject, stage, lang, stage, perm_key, course=course, objects=objects, lights=lights)
+        row = Row(table, subject, table, lang, stage, perm_key, course=course, objects=objects, lights=lights,
+                  materials=tuple(materials.get(subject, ())))
         r = results.get(job_key(c_hash, stage, lang)) if error is None else None
         if error is not None:
             row.error = error

@@ -26,7 +26,7 @@ MD_COLUMNS = [("tex", "texture"), ("ALU", "alu"), ("transc.", "transcendental"),
 DIFF_FIELDS = ("texture", "alu", "transcendental", "branches", "registers", "instructions", "loads", "stores",
                "alu_scalar", "transcendental_scalar")
 CSV_FIELDS = ["table", "subject", "kind", "stage", "language", *COUNT_FIELDS, "course_model", "course_table",
-              "course_texture", "course_alu", "lights", "objects", "measured", "baseline", "error"]
+              "course_texture", "course_alu", "lights", "materials", "objects", "key", "measured", "baseline", "error"]
 
 # Why the languages differ: (key, applies(language, stage, opcode delta vs the reference language,
 # {count: {language: value}} of the counts that differ), explanation).
@@ -170,9 +170,9 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
         lines = []
         for (_, subject, stage, _), by_lang in perm:
             r = next(iter(by_lang.values()))
-            lines.append([f"`{subject}`", ", ".join(r.objects), stage, *_metric_cells(by_lang),
+            lines.append([f"`{subject}`", ", ".join(r.materials), ", ".join(r.objects), stage, *_metric_cells(by_lang),
                           _course_cell(r, per_light=True) if stage == "frag" else ""])
-        out += _md_table(["permutation", "objects", "stage", *head, "course tex / ALU"], lines)
+        out += _md_table(["permutation", "materials", "objects", "stage", *head, "course tex / ALU"], lines)
         uber = [(k, v) for k, v in groups.items() if k[0] == "ubershader"]
         if uber:
             out += ["", "The scene's ubershader (every permutation in one shader; NOTES.md, \"Ubershader\"):", ""]
@@ -230,13 +230,18 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
 
 
 def _flat(r: Row) -> dict:
-    d = {"table": r.table, "subject": r.subject, "kind": r.kind, "stage": r.stage, "language": r.language}
+    """One row as columns that each mean one thing: `kind` a brick's kind (none for a shader of the scene),
+    `key` a permutation's key, `measured` what a per-brick or model row compiled."""
+    shader = r.table in ("permutation", "ubershader")
+    d = {"table": r.table, "subject": r.subject, "kind": None if shader else r.kind, "stage": r.stage,
+         "language": r.language}
     d.update({f: getattr(r.cost, f) if r.cost else None for f in COUNT_FIELDS})
     c = r.course
     d.update({"course_model": c.model if c else None, "course_table": c.table if c else None,
               "course_texture": c.texture if c else None, "course_alu": c.alu if c else None,
-              "lights": r.lights or None, "objects": list(r.objects) or None,
-              "measured": r.measured, "baseline": r.baseline or None, "error": r.error or None})
+              "lights": r.lights or None, "materials": list(r.materials) or None, "objects": list(r.objects) or None,
+              "key": r.measured if shader else None, "measured": None if shader else r.measured,
+              "baseline": r.baseline or None, "error": r.error or None})
     return d
 
 
@@ -249,6 +254,7 @@ def to_csv(rows: list[Row]) -> str:
     for r in rows:
         d = _flat(r) | radv.csv_values(r)
         d["objects"] = " ".join(d["objects"] or [])
+        d["materials"] = " ".join(d["materials"] or [])
         w.writerow({k: ("" if v is None else v) for k, v in d.items()})
     return buf.getvalue()
 

@@ -9,6 +9,10 @@ from ...lang.errors import EnvironmentMissing, UsageError
 HELP = "cost tables (texture, ALU, transcendental, branches, registers) per permutation of a scene, or per brick"
 
 
+BUDGET_NAMES = ("texture", "alu", "transcendental", "alu_t", "branches", "registers", "instructions", "loads",
+                "alu_scalar")  # the counts a budget or a sort names (measure/report.py MD_COLUMNS)
+
+
 def add_arguments(p) -> None:
     p.add_argument("scene", nargs="?", help="scene file (TOML): one row per permutation and stage")
     p.add_argument("--per-brick", action="store_true",
@@ -22,6 +26,8 @@ def add_arguments(p) -> None:
     p.add_argument("--gpu", nargs="?", const="default", metavar="FAMILIES",
                    help="add AMD compiler statistics from Mesa RADV's null device (no GPU needed) for these "
                         "comma-separated families; alone: polaris10,navi21,vangogh,navi31")
+    p.add_argument("--sort", metavar="NAME", choices=BUDGET_NAMES,
+                   help="rows in descending order of this count (the same names as --budget); default: by hash")
     p.add_argument("--budget", metavar="NAME=MAX,...",
                    help=f"per-shader limits, e.g. alu=60,texture=4,registers=32 (names: {', '.join(BUDGET_NAMES)}): "
                         "every shader over one is listed and the exit code is 1 (a CI holds the budget)")
@@ -29,8 +35,6 @@ def add_arguments(p) -> None:
                    help="with --gpu: save each shader's NIR, ACO IR and disassembly as DIR/<family>/<key>.<stage>.txt")
 
 
-BUDGET_NAMES = ("texture", "alu", "transcendental", "alu_t", "branches", "registers", "instructions", "loads",
-                "alu_scalar")
 
 
 def parse_budget(text: str) -> dict[str, int]:
@@ -95,6 +99,9 @@ def run(args) -> int:
         scene = load_scene(args.scene, lib)
         rows = scene_rows(scene, lib, gpu=gpu, store=store)
         subject, title = scene.name, f"Costs of scene {scene.name}"
+    if args.sort:  # the costliest first (stable: equal rows keep their order); rows without a cost last
+        from ...measure.report import _value
+        rows.sort(key=lambda r: -_value(r, args.sort) if r.cost is not None else float("inf"))
     if args.format == "md":
         sys.stdout.write(markdown(rows, title, models, gpu))
     elif args.format == "csv":
