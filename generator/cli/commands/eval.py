@@ -110,7 +110,8 @@ def load_samples(path: str, checked: bool = True):
                      "save float32 or float64 samples")
     if a.ndim != 2 or a.shape[1] not in (9, 12):
         raise _BadInput(f"{path}: shape {a.shape} — samples are (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T]")
-    a = a.astype(np.float64)
+    with np.errstate(invalid="ignore", over="ignore"):  # a float128 past float64: inf/nan, caught by the check below
+        a = a.astype(np.float64)
     if checked and len(a):
         bad = ~np.isfinite(a).all(axis=1)
         if bad.any():
