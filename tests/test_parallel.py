@@ -11,14 +11,11 @@ from pathlib import Path
 
 import pytest
 
+from tests.test_dask import _tree  # an output tree's files and bytes
+
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLE_SMALL = REPO / "scenes" / "example.toml"
 pytestmark = pytest.mark.toolchain
-
-
-def _tree(root: Path) -> dict:
-    return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()
-            and p.name != ".shadermatrix-lock"}
 
 
 def _cli(*args, env=None):
