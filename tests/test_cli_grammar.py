@@ -128,3 +128,30 @@ def test_cost_rows_name_materials_and_objects_sort_and_mean_one_thing_per_column
     md = run("costs", EXAMPLE, *cache)
     assert "| permutation | materials | objects | stage |" in md.stdout
     assert run("costs", EXAMPLE, "--sort", "speed").returncode == 2
+
+
+@pytest.mark.toolchain
+def test_a_cost_diff_shows_what_a_change_cost_shader_by_shader(tmp_path):
+    cache = ("--cache-dir", tmp_path / "cache")
+    before = run("costs", EXAMPLE, "--format", "json", *cache)
+    assert before.returncode == 0, before.stderr
+    same = tmp_path / "same.json"
+    same.write_text(before.stdout)
+    r = run("costs", EXAMPLE, "--diff", same, *cache)
+    assert r.returncode == 0 and "0 shaders changed, 0 new or gone" in r.stdout, r.stdout
+    doc = json.loads(before.stdout)  # an earlier report in which one shader was cheaper and one did not exist
+    rows = [x for x in doc["rows"] if x["table"] == "permutation"]
+    rows[0]["alu"] -= 5
+    gone = doc["rows"].pop(doc["rows"].index(rows[1]))
+    doc["rows"].append({**rows[2], "subject": "0123456789ab"})
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(doc))
+    r = run("costs", EXAMPLE, "--diff", old, *cache)
+    assert r.returncode == 0, r.stderr
+    assert "1 shaders changed, 2 new or gone" in r.stdout, r.stdout
+    assert f"| {rows[0]['stage']} | {rows[0]['language']} | alu | {rows[0]['alu']} | {rows[0]['alu'] + 5} | +5 |" \
+        in r.stdout
+    assert f"- new: permutation `{gone['subject']}`" in r.stdout and "- gone: permutation `0123456789ab`" in r.stdout
+    (tmp_path / "junk.json").write_text("{}")
+    bad = run("costs", EXAMPLE, "--diff", tmp_path / "junk.json", *cache)
+    assert bad.returncode == 1 and "not a `costs --format json` report" in bad.stderr

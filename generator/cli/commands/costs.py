@@ -4,7 +4,7 @@ from __future__ import annotations
 import re
 import sys
 
-from ...lang.errors import EnvironmentMissing, UsageError
+from ...lang.errors import EnvironmentMissing, UsageError, UserError
 
 HELP = "cost tables (texture, ALU, transcendental, branches, registers) per permutation of a scene, or per brick"
 
@@ -28,6 +28,9 @@ def add_arguments(p) -> None:
                         "comma-separated families; alone: polaris10,navi21,vangogh,navi31")
     p.add_argument("--sort", metavar="NAME", choices=BUDGET_NAMES,
                    help="rows in descending order of this count (the same names as --budget); default: by hash")
+    p.add_argument("--diff", metavar="OLD.json",
+                   help="instead of the tables: what changed against an earlier `costs --format json` report, "
+                        "shader by shader and count by count (Markdown)")
     p.add_argument("--budget", metavar="NAME=MAX,...",
                    help=f"per-shader limits, e.g. alu=60,texture=4,registers=32 (names: {', '.join(BUDGET_NAMES)}): "
                         "every shader over one is listed and the exit code is 1 (a CI holds the budget)")
@@ -50,6 +53,22 @@ def parse_budget(text: str) -> dict[str, int]:
     return out
 
 
+def read_report(path: str) -> list[dict]:
+    """The rows of an earlier `costs --format json` report (a bad file: one error line, exit 1)."""
+    import json
+    from pathlib import Path
+
+    from ...lang.errors import read_text
+    try:
+        rows = json.loads(read_text(Path(path), "costs report"))["rows"]
+        if not all(isinstance(r, dict) and {"table", "subject", "stage", "language"} <= r.keys() for r in rows):
+            raise TypeError
+    except (ValueError, KeyError, TypeError):
+        raise UserError(f"{path}: not a `costs --format json` report — write one with "
+                        "`shadermatrix costs SCENE --format json > OLD.json` before the change") from None
+    return rows
+
+
 def over_budget(rows, budget: dict[str, int]) -> list[str]:
     """One line per shader over a limit: what it is (permutation, objects, stage, language) and by how much."""
     from ...measure.report import _value
@@ -59,17 +78,19 @@ def over_budget(rows, budget: dict[str, int]) -> list[str]:
                 if r.cost is not None and _value(r, name) > limit]
         if over:
             who = f" ({', '.join(r.objects)})" if r.objects else ""
-            lines.append(f"over budget: {r.table} {r.subject}{who} {r.stage} {r.language}: {', '.join(over)}")
+            what = r.table if r.table == r.subject else f"{r.table} {r.subject}"  # "ubershader", not twice
+            lines.append(f"over budget: {what}{who} {r.stage} {r.language}: {', '.join(over)}")
     return lines
 
 
 def run(args) -> int:
     budget = parse_budget(args.budget) if args.budget else None
+    old_rows = read_report(args.diff) if args.diff else None
     if bool(args.scene) == bool(args.per_brick):
         raise UsageError("give a SCENE or --per-brick (one of them) — e.g. `shadermatrix costs scenes/example.toml` "
                          "or `shadermatrix costs --per-brick`")
     from ...measure.plans import brick_rows, course_models, load_cost_library, scene_rows
-    from ...measure.report import markdown, to_csv, to_json
+    from ...measure.report import diff, markdown, to_csv, to_json
 
     from ...io import Store, default_cache_dir
     root = args.cache_dir or default_cache_dir()
@@ -102,7 +123,9 @@ def run(args) -> int:
     if args.sort:  # the costliest first (stable: equal rows keep their order); rows without a cost last
         from ...measure.report import _value
         rows.sort(key=lambda r: -_value(r, args.sort) if r.cost is not None else float("inf"))
-    if args.format == "md":
+    if args.diff:
+        sys.stdout.write(diff(rows, old_rows, BUDGET_NAMES, args.diff))
+    elif args.format == "md":
         sys.stdout.write(markdown(rows, title, models, gpu))
     elif args.format == "csv":
         sys.stdout.write(to_csv(rows))
