@@ -44,6 +44,8 @@ RESULTS = REPO / "benchmarks" / "results"
 sys.path.insert(0, str(REPO))
 
 from generator import __version__  # noqa: E402
+sys.path.insert(0, str(REPO / "benchmarks"))
+from cliargs import positive  # noqa: E402
 from generator.toolchain import TARGET_ENV, find_tool, tool_versions  # noqa: E402
 
 
@@ -179,7 +181,7 @@ def dask_build(scene: Path, out: Path, workers: int) -> float:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--n", type=int, default=1000, help="distinct permutations of the generated scene")
+    ap.add_argument("--n", type=positive, default=1000, help="distinct permutations of the generated scene")
     ap.add_argument("--report-only", action="store_true", help="rewrite build.md from the recorded build.json")
     args = ap.parse_args()
     if args.report_only:

@@ -13,12 +13,16 @@ A picture for a person checking the bricks by eye; the assertions live in tests/
 from __future__ import annotations
 
 import argparse
+import sys
 import tomllib
 from pathlib import Path
 
 import numpy as np
 
 REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+from cliargs import folder, positive  # noqa: E402
 LIGHT = np.array([0.45, 0.55, 0.70])
 
 
@@ -40,9 +44,11 @@ def display(radiance: np.ndarray) -> np.ndarray:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--size", type=int, default=160)
-    ap.add_argument("--target", default="glsl", choices=("glsl", "hlsl", "wgsl", "numpy"))
-    ap.add_argument("--out", default=str(REPO / "benchmarks" / "results"))
+    ap.add_argument("--size", type=positive, default=160, help="pixels per sphere (default 160)")
+    ap.add_argument("--target", default="glsl", choices=("glsl", "hlsl", "wgsl", "numpy"),
+                    help="the eval kernel's language, or numpy (default glsl)")
+    ap.add_argument("--out", type=folder, default=str(REPO / "benchmarks" / "results"),
+                    help="the folder contact_sheet_<target>.png goes into (default benchmarks/results)")
     args = ap.parse_args()
 
     import matplotlib

@@ -41,6 +41,8 @@ sys.path.insert(0, str(REPO))
 import numpy as np  # noqa: E402
 
 from generator import __version__  # noqa: E402
+sys.path.insert(0, str(REPO / "benchmarks"))
+from cliargs import positive, size as size_arg  # noqa: E402
 from generator.analysis import entry_cost  # noqa: E402
 from generator.build import build_scene  # noqa: E402
 from generator.library.bricks import load_library  # noqa: E402
@@ -146,10 +148,10 @@ def contact_sheet(scene, images: dict, size, path: Path) -> None:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--frames", type=int, default=30)
-    ap.add_argument("--size", default="320x160")
-    ap.add_argument("--pairs", type=int, default=15, help="paired short runs for the frame-time ratios")
-    ap.add_argument("--repeats", type=int, default=5, help="cold / persisted renders per mode")
+    ap.add_argument("--frames", type=positive, default=30, help="frames per render (default 30)")
+    ap.add_argument("--size", type=size_arg, default="320x160", help="WxH (default 320x160)")
+    ap.add_argument("--pairs", type=positive, default=15, help="paired short runs for the frame-time ratios")
+    ap.add_argument("--repeats", type=positive, default=5, help="cold / persisted renders per mode")
     args = ap.parse_args()
     size = tuple(int(x) for x in args.size.split("x"))
     lib = load_library()

@@ -93,6 +93,9 @@ def plot(rows, families, path: Path) -> None:
 
 
 def main() -> int:
+    import argparse
+    argparse.ArgumentParser(description=__doc__.splitlines()[0], epilog="No options: it measures the example "
+                            "scene and every BRDF's eval kernel.").parse_args()
     lib = load_library()
     families = DEFAULT_FAMILIES
     request = GpuRequest(families)

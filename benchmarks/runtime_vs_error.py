@@ -48,6 +48,9 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+from cliargs import folder, positive  # noqa: E402
 
 from generator import GPU_TARGETS as LANGS  # noqa: E402 (after the path)
 from generator.eval.accuracy import REL_FLOOR, default_specs, hemisphere, rounded_inputs  # noqa: E402
@@ -325,12 +328,13 @@ def plot(report: dict, path: Path) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--samples", type=int, default=1 << 20, help="samples per dispatch (default 2^20)")
-    ap.add_argument("--repeats", type=int, default=31, help="timed dispatches per kernel (default 31)")
+    ap.add_argument("--samples", type=positive, default=1 << 20, help="samples per dispatch (default 2^20)")
+    ap.add_argument("--repeats", type=positive, default=31, help="timed dispatches per kernel (default 31)")
     ap.add_argument("--languages", default=",".join(LANGS), help="comma-separated, first one is plotted")
     ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="as in shadermatrix eval")
-    ap.add_argument("--grid", type=int, default=12, help="k of the k⁴ error grid (default 12)")
-    ap.add_argument("--out", default=str(REPO / "benchmarks" / "results"))
+    ap.add_argument("--grid", type=positive, default=12, help="k of the k⁴ error grid (default 12)")
+    ap.add_argument("--out", type=folder, default=str(REPO / "benchmarks" / "results"),
+                    help="the folder the table, JSON and plot go into (default benchmarks/results)")
     args = ap.parse_args(argv)
 
     from generator import __version__

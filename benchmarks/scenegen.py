@@ -23,6 +23,9 @@ sys.path.insert(0, str(REPO))
 from generator.library.bricks import load_library  # noqa: E402
 from generator.library.kinds import BRDF_KINDS  # noqa: E402
 
+sys.path.insert(0, str(REPO / "benchmarks"))
+from cliargs import positive  # noqa: E402
+
 
 def _terms(lib, kind) -> list[str]:
     out = []
@@ -91,9 +94,9 @@ def scene_text(n: int, per: int = 1) -> str:
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("n", type=int)
-    ap.add_argument("out")
-    ap.add_argument("--objects-per-permutation", type=int, default=1)
+    ap.add_argument("n", type=positive, help="distinct permutations")
+    ap.add_argument("out", help="the scene file to write (TOML)")
+    ap.add_argument("--objects-per-permutation", type=positive, default=1, help="objects using each (default 1)")
     args = ap.parse_args()
     Path(args.out).write_text(scene_text(args.n, args.objects_per_permutation))
     return 0
