@@ -7,6 +7,7 @@ and WGSL where a Vulkan device is present. float16 is reported, not required.
 from __future__ import annotations
 
 import json
+import re
 import math
 
 import numpy as np
@@ -175,12 +176,17 @@ def test_command_json_report_and_exit_code(tmp_path, capsys):
 
 def test_command_markdown_to_stdout(capsys):
     rc = main(["accuracy", "phong_normalized", "--targets", "numpy", "--dtypes", "float32", "--samples", "2"])
-    out = capsys.readouterr().out
+    cap = capsys.readouterr()
+    out = cap.out
     assert rc == 0
     assert out.startswith("# Accuracy against the float64 references")
-    for heading in ("## hemisphere", "## stress", "by parameter value", "| numpy/float32 | 0 | 0 |"):
+    assert "## Verdict per spec" in out and re.search(r"\| `phong_normalized` \| pass \| \S+ \(numpy\) \| 0 \|", out)
+    assert "| numpy/float32 | 0 | 0 |" in out and "## hemisphere" not in out  # the detail only with --detail
+    assert "Result: no NaN or Inf in float32." in out and "1 of 1 specs pass" in cap.err
+    main(["accuracy", "phong_normalized", "--targets", "numpy", "--dtypes", "float32", "--samples", "2", "--detail"])
+    out = capsys.readouterr().out
+    for heading in ("## Verdict per spec", "## hemisphere", "## stress", "by parameter value"):
         assert heading in out
-    assert "Result: no NaN or Inf in float32." in out
 
 
 NAN_PROBE = '''"""A diffuse term that is NaN for grazing views (a test probe): 0/0 below n.v = 1e-3."""
@@ -231,4 +237,7 @@ def test_command_errors(tmp_path, capsys):
 def test_command_fail_above(capsys):
     rc = main(["accuracy", "blinn_phong_normalized", "--targets", "numpy", "--dtypes", "float32",
                "--samples", "3", "--fail-above", "1e-9", "--format", "json"])
-    assert rc == 1 and "exceeds --fail-above 1e-09" in capsys.readouterr().err
+    cap = capsys.readouterr()
+    assert rc == 1 and "exceeds the tolerance 1e-09 (--fail-above)" in cap.err and "0 of 1 specs pass" in cap.err
+    verdict = json.loads(cap.out)["verdicts"][0]
+    assert not verdict["pass"] and verdict["hemisphere_max_rel"] > 1e-9 and verdict["hemisphere_target"] == "numpy"
