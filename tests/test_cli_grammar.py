@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -127,6 +128,8 @@ def test_cost_rows_name_materials_and_objects_sort_and_mean_one_thing_per_column
     assert alu == sorted(alu, reverse=True)  # --sort alu: the costliest first
     md = run("costs", EXAMPLE, *cache)
     assert "| permutation | materials | objects | stage |" in md.stdout
+    assert re.search(r"^Totals of the 5 frag shaders: tex \d+, ALU \d+, .*; the most registers: \d+ \(`\w{12}`, ",
+                     md.stdout, re.M)
     assert run("costs", EXAMPLE, "--sort", "speed").returncode == 2
 
 

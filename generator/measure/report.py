@@ -173,6 +173,7 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
             lines.append([f"`{subject}`", ", ".join(r.materials), ", ".join(r.objects), stage, *_metric_cells(by_lang),
                           _course_cell(r, per_light=True) if stage == "frag" else ""])
         out += _md_table(["permutation", "materials", "objects", "stage", *head, "course tex / ALU"], lines)
+        out += ["", *_totals(perm)]
         uber = [(k, v) for k, v in groups.items() if k[0] == "ubershader"]
         if uber:
             out += ["", "The scene's ubershader (every permutation in one shader; NOTES.md, \"Ubershader\"):", ""]
@@ -227,6 +228,26 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
     if errors:
         out += ["## Errors", ""] + [f"- `{r.subject}` {r.language}: {r.error}" for r in errors] + [""]
     return "\n".join(out)
+
+
+def _totals(perm: list) -> list[str]:
+    """Per stage, over the scene's permutations (in the first language that has each): the counts summed, and
+    the shader with the most registers."""
+    out = []
+    for stage in ("frag", "vert"):
+        firsts = []
+        for (_, subject, st, _), by_lang in perm:
+            r = next((by_lang[lang] for lang in REPORT_LANGUAGES if lang in by_lang and by_lang[lang].cost), None)
+            if st == stage and r is not None:
+                firsts.append(r)
+        if not firsts:
+            continue
+        sums = ", ".join(f"{h} {sum(_value(r, name) for r in firsts)}" for h, name in MD_COLUMNS
+                         if name in ("texture", "alu", "transcendental", "branches", "instructions"))
+        top = max(firsts, key=lambda r: _value(r, "registers"))
+        out.append(f"Totals of the {len(firsts)} {stage} shaders: {sums}; the most registers: "
+                   f"{_value(top, 'registers')} (`{top.subject}`, {top.language}).")
+    return out + [""] if out else []
 
 
 def _flat(r: Row) -> dict:
