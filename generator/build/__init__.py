@@ -23,8 +23,8 @@ from ..matrix.scene import Scene
 from ..targets import LANGUAGES
 from ..lang import SourceError
 from ..link.uber import coverage
-from ..toolchain import CompileJob, CompileStats, compile_many, tool_versions
-from ..toolchain.scenes import job_key
+from ..toolchain import CompileStats, tool_versions
+from ..toolchain.scenes import job_key, source_jobs
 from ..link.values import uploads
 from .outputs import clean_leftovers, collect_garbage, locked, shown, write_depfile
 from .reflection import scene_tables
@@ -150,9 +150,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     old_uber = previous.get("ubershader") or {}
     uber_kept = old_uber.get("input_key") == uber_key and old_uber.get("status") == "ok" and _intact(out, old_uber)
     uber_unit = None if uber_kept else _compose_ubershader(scene, lib, languages)
-    extra = [] if not isinstance(uber_unit, tuple) else [
-        CompileJob(job_key("ubershader", s.stage, s.language), s.language, s.stage, s.text,
-                   line_map=tuple(s.line_map)) for s in uber_unit[0].sources]
+    extra = source_jobs("ubershader", uber_unit[0].sources) if isinstance(uber_unit, tuple) else []
     todo = Scene(**{**scene.__dict__, "permutations": {h: p for h, p in scene.permutations.items() if h not in kept}})
     built: dict[str, dict] = {}
 
@@ -164,7 +162,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     def written(pairs, part):  # a compiled chunk: written and analysed while the next chunks compile
         for h, c in pairs:
             entry = {**head(h), "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
-                     "uploads": uploads(scene, h, c)}
+                     "uploads": uploads(scene, h, c, users.get(h, []))}
             errs = _write_all(res, out, h, c.sources, part, entry)
             built[h] = _settle(res, entry, errs, old.get(h), out, _failure_head(scene, h, users.get(h, [])))
 

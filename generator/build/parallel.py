@@ -29,8 +29,8 @@ from ..io import Store, sha256, show_progress
 from ..lang import SourceError
 from ..lang.errors import EnvironmentMissing, UserError
 from ..library import bricks as _bricks
-from ..toolchain import CompileJob, CompileStats, cache_key, compile_many
-from ..toolchain.scenes import job_key
+from ..toolchain import CompileStats, cache_key, compile_many
+from ..toolchain.scenes import source_jobs
 
 MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than it saves (measured: ~1.4 s at 36)
 # multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted: the pool's
@@ -96,14 +96,15 @@ def _task(items: list, extra: list) -> tuple:
             except SourceError as e:
                 errors[h] = [str(e)]
                 continue
-            jobs += [CompileJob(job_key(h, s.stage, s.language), s.language, s.stage, s.text,
-                                line_map=tuple(s.line_map)) for s in c.sources]
+            jobs += source_jobs(h, c.sources)
         stats = CompileStats()
         results = compile_many(jobs, optimize=True, validate=True, store=store, stats=stats, workers=1)
         costs = {}
         for r in results.values():
-            if r.ok and r.spirv and sha256(r.spirv) not in costs:
-                costs[sha256(r.spirv)] = cost_dict(r.spirv, store)
+            if r.ok and r.spirv:
+                digest = sha256(r.spirv)
+                if digest not in costs:
+                    costs[digest] = cost_dict(r.spirv, store)
     except UserError as e:  # a missing tool (exit 3) or another error: its class and message, as they pickle
         raise (EnvironmentMissing if isinstance(e, EnvironmentMissing) else UserError)(str(e)) from None
     keys = {j.key: cache_key(j, True, True) for j in jobs}

@@ -22,11 +22,13 @@ def light_values(scene: Scene, name: str, specs: dict) -> dict:
     return {k: given.get(k, s.default) for k, s in specs.items()}
 
 
-def uploads(scene: Scene, h: str, c) -> list[dict]:
-    """Per (material, light set) drawn with permutation `h`: the Material and Lights blocks, ready to upload."""
+def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None) -> list[dict]:
+    """Per (material, light set) drawn with permutation `h`: the Material and Lights blocks, ready to upload.
+    objects: the scene's objects drawn with `h`, when the caller has them grouped (else every object is looked at)."""
+    mine = [o for o in scene.objects if o["permutation"] == h] if objects is None else objects
     out, seen = [], set()
-    for obj in scene.objects:
-        if obj["permutation"] != h or (obj["material"], obj["light_set"]) in seen:
+    for obj in mine:
+        if (obj["material"], obj["light_set"]) in seen:
             continue
         seen.add((obj["material"], obj["light_set"]))
         mvals = material_values(scene, obj["material"], {s.param: s.spec for s in c.material if s.spec is not None})
@@ -44,8 +46,8 @@ def uploads(scene: Scene, h: str, c) -> list[dict]:
             item["Lights"] = pack([s for ls in c.lights for s in ls], lvals, lb.members[-1]["size"] // 16).hex()
         out.append(item)
     for item in out:
-        item["objects"] = [o["name"] for o in scene.objects if o["permutation"] == h
-                           and (o["material"], o["light_set"]) == (item["material"], item["light_set"])]
+        item["objects"] = [o["name"] for o in mine
+                           if (o["material"], o["light_set"]) == (item["material"], item["light_set"])]
     return out
 
 

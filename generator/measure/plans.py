@@ -37,7 +37,7 @@ from pathlib import Path
 from ..library.bricks import Brick, Library, load_brick, load_library
 from ..library.kinds import BRDF_KINDS, KINDS
 from ..io import show_progress
-from ..toolchain.scenes import compile_scene, job_key
+from ..toolchain.scenes import compile_scene, job_key, source_jobs
 from ..compose import Composed, compose_eval, compose_permutation
 from ..analysis import Cost, entry_cost
 from ..lang import SourceError
@@ -384,8 +384,7 @@ def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None,
     if perms:  # the scene's ubershader: one shader for every permutation (NOTES.md, "Ubershader")
         try:
             uber, _ = compose_ubershader(perms, lib, languages)
-            jobs = [CompileJob(job_key("ubershader", src.stage, src.language), src.language, src.stage, src.text,
-                               line_map=tuple(src.line_map)) for src in uber.sources]
+            jobs = source_jobs("ubershader", uber.sources)
             results.update(compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store))
             failed = None
         except (SourceError, SpecError) as e:

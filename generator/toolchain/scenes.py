@@ -18,6 +18,12 @@ def job_key(h: str, stage: str, lang: str) -> str:
     return f"{h}.{stage}.{lang}"
 
 
+def source_jobs(name: str, sources) -> list[CompileJob]:
+    """One compile job per composed source of unit `name` (a permutation hash, "ubershader")."""
+    return [CompileJob(job_key(name, s.stage, s.language), s.language, s.stage, s.text, line_map=tuple(s.line_map))
+            for s in sources]
+
+
 CHUNK = 64  # permutations composed per compile batch when pipelining
 
 
@@ -68,9 +74,7 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
                     continue
                 composed[h] = c
                 hashes.append(h)
-                for src in c.sources:
-                    jobs.append(CompileJob(job_key(h, src.stage, src.language), src.language, src.stage, src.text,
-                                           line_map=tuple(src.line_map)))
+                jobs += source_jobs(h, c.sources)
             waiting.append((hashes, pool.submit(compile_many, jobs, optimize=True, validate=True,
                                                 progress=show_progress(), store=store, stats=stats, workers=workers,
                                                 executor=executor, memo=memo)))
