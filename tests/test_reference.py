@@ -27,7 +27,10 @@ from generator.reference import (d_beckmann, d_blinn_phong, d_ggx, exact, fresne
                                  smith_g1_beckmann, smith_g1_ggx)
 
 LIB = load_library()
-SPECS = accuracy.default_specs(LIB)
+SPECS = accuracy.default_specs(LIB)  # every slot filler at least once
+# The whole filler product, the combinations beyond SPECS under the `slow` marker.
+ALL_SPECS = SPECS + [pytest.param(s, marks=pytest.mark.slow)
+                     for s in accuracy.default_specs(LIB, full=True) if s not in SPECS]
 EPS32 = float(np.finfo(np.float32).eps)
 EPS64 = float(np.finfo(np.float64).eps)
 PARAMS = [{}, {"alpha": 0.02, "f0": [1.0, 0.5, 0.0]}, {"alpha": 1.0}, {"n": 1000.0}, {"n": 1.0, "rho_d": [0.2, 0.9, 0.0]}]
@@ -62,7 +65,7 @@ def _kappa(spec: str, p: dict) -> float:
     return 2.0 / q["alpha"] ** 2 if "alpha" in q else 0.0
 
 
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", ALL_SPECS)
 def test_reference_equals_the_float64_emission_of_the_brick(spec, hemi):
     # |f64 - ref| <= max(1e-12, 8 ulp kappa) |ref| + 1e-15 max|ref|: the absolute term covers
     # values 1e-15 below the peak, where cancelling differences (1 - v·h in Schlick's
@@ -80,7 +83,7 @@ def test_reference_equals_the_float64_emission_of_the_brick(spec, hemi):
         assert worst <= 1.0, (spec, p, float(worst))
 
 
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", ALL_SPECS)
 def test_float32_emission_is_within_a_stated_tolerance_of_the_reference(spec, hemi):
     # |f32 - ref| <= 64 ulp (1 + kappa/16) |ref| + 2^-20 max|ref|: a ~30-operation chain
     # amplified by the lobe (see the module docstring); the absolute term covers dot
@@ -96,7 +99,7 @@ def test_float32_emission_is_within_a_stated_tolerance_of_the_reference(spec, he
         assert worst <= 1.0, (spec, p, float(worst))
 
 
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", ALL_SPECS)
 def test_reciprocity(spec):
     # Every brick present is reciprocal (ACCURACY-FACTS §4.6); the n·v clamp of the
     # shading policy is not, so both cosines stay above 1e-3.

@@ -289,14 +289,32 @@ def _plain(params: dict) -> dict:
 
 # ------------------------------------------------------------------ running
 
-def default_specs(lib) -> list[str]:
-    """Every BRDF brick: each diffuse term alone, each specular term with every combination of slot fillers."""
+def default_specs(lib, full: bool = False) -> list[str]:
+    """Every BRDF brick: each diffuse term alone, and each specular term with its slot fillers.
+
+    full: every combination of slot fillers (the product grows as the library does: a `slow`
+    sweep and `accuracy --all-combinations`). Otherwise the fillers are sampled one factor at
+    a time: the host with its default fillers, then each other filler of each slot in turn with
+    the other slots at their defaults, so every filler is measured at least once.
+    """
     from itertools import product
     specs = [b.id for b in lib.of_kind("diffuse")]
     for b in lib.of_kind("specular"):
-        choices = [[f"{s}={f.id}" for f in lib.of_kind(slot["kind"])] for s, slot in b.slots.items()]
-        for combo in product(*choices):
-            specs.append(f"{b.id}({','.join(combo)})" if combo else b.id)
+        if not b.slots:
+            specs.append(b.id)
+            continue
+        slots = list(b.slots.items())
+        choices = [[f.id for f in lib.of_kind(slot["kind"])] for _s, slot in slots]
+        if full:
+            combos = list(product(*choices))
+        else:
+            default = tuple(slot.get("default") if slot.get("default") in ids else ids[0]
+                            for (_s, slot), ids in zip(slots, choices))
+            combos = [default]
+            for i, ids in enumerate(choices):
+                combos += [default[:i] + (f,) + default[i + 1:] for f in ids if f != default[i]]
+        for combo in combos:
+            specs.append(f"{b.id}({','.join(f'{s}={f}' for (s, _slot), f in zip(slots, combo))})")
     return specs
 
 

@@ -11,6 +11,10 @@ Signatures per kind (a new brick adds one function with @reference(kind, id)):
   ndf:                f(cos_h, sin2_h, alpha) -> (N,) D
   fresnel:            f(f0 (N, 3), cos_d) -> (N, 3) F, cos_d = v·h
   visibility:         f(g: Geometry, alpha) -> (N,) the geometry factor G (not G/(4 n·l n·v))
+A slot filler that reads more than its contract's arguments (a tangent-frame row, its own
+parameters: an anisotropic NDF's alpha_u, alpha_v; a conductor's eta, k) declares keyword-only
+parameters `g` (the Geometry) and/or `p` (the spec's parameter values); the host's reference
+calls it through the slot with both bound (slot_function()).
 """
 from __future__ import annotations
 
@@ -167,8 +171,18 @@ def _param_values(declared: dict, given: dict | None, count: int) -> dict:
     return out
 
 
+def slot_function(fn: Callable, g: Geometry, p: dict) -> Callable:
+    """A slot filler's reference with its keyword-only `g` / `p` bound, when it declares them."""
+    import inspect
+    kw = {name: value for name, value in (("g", g), ("p", p))
+          if (param := inspect.signature(fn).parameters.get(name)) is not None
+          and param.kind is inspect.Parameter.KEYWORD_ONLY}
+    return (lambda *args: fn(*args, **kw)) if kw else fn
+
+
 def _term(node, g: Geometry, p: dict) -> np.ndarray:
-    slots = {slot: lookup(filler.brick.kind, filler.brick.id) for slot, filler in node.fillers}
+    slots = {slot: slot_function(lookup(filler.brick.kind, filler.brick.id), g, p)
+             for slot, filler in node.fillers}
     return lookup(node.brick.kind, node.brick.id)(g, p, slots)
 
 

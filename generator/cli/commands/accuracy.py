@@ -26,7 +26,10 @@ MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 
 
 
 def add_arguments(p) -> None:
-    p.add_argument("specs", nargs="*", metavar="SPEC", help="BRDF specs (default: every BRDF brick)")
+    p.add_argument("specs", nargs="*", metavar="SPEC", help="BRDF specs (default: every BRDF brick, each slot "
+                   "filler at least once; see --all-combinations)")
+    p.add_argument("--all-combinations", action="store_true",
+                   help="by default, every combination of slot fillers instead of each filler once")
     p.add_argument("--targets", metavar="LIST",
                    help=f"comma-separated, from {', '.join(ACCURACY_TARGETS)} (default: all; the GPU languages "
                         "need a lavapipe device: without one, exit 3 unless --targets leaves them out)")
@@ -76,7 +79,7 @@ def run(args) -> int:
                 raise VulkanUnavailable("no lavapipe Vulkan device for the GPU targets (`shadermatrix doctor` says "
                                         "why; `make setup` installs it) — or pass --targets numpy to run without")
         lib = load_library(args.bricks or ())
-        specs = args.specs or accuracy.default_specs(lib)
+        specs = args.specs or accuracy.default_specs(lib, full=args.all_combinations)
         if not accuracy.runs(targets, dtypes):
             raise UsageError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
                              "GPU targets run float32 only; add float32 or the numpy target")
