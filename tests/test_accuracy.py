@@ -247,3 +247,63 @@ def test_command_fail_above(capsys):
     assert rc == 1 and "exceeds the tolerance 1e-09 (--fail-above)" in cap.err and "0 of 1 specs pass" in cap.err
     verdict = json.loads(cap.out)["verdicts"][0]
     assert not verdict["pass"] and verdict["hemisphere_max_rel"] > 1e-9 and verdict["hemisphere_target"] == "numpy"
+
+
+SCENE = '''[scene]
+name = "acc"
+
+[materials.sharp_gold]
+brdf = "microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick)"
+params = { alpha = 0.001, f0 = [1.0, 0.71, 0.29] }
+
+[materials.chalk]
+brdf = "lambert"
+packing = "albedo_texture"
+params = { rho_d = [0.9, 0.8, 0.7] }
+
+[lights.sun]
+type = "directional"
+params = { direction = [0.0, 1.0, 0.0], color = [1.0, 1.0, 1.0] }
+
+[light_sets]
+day = ["sun"]
+
+[[objects]]
+name = "ring"
+material = "sharp_gold"
+lights = "day"
+
+[[objects]]
+name = "wall"
+material = "chalk"
+lights = "day"
+'''
+
+
+def test_command_scene_measures_its_materials_at_their_parameters(tmp_path, capsys):
+    scene = tmp_path / "acc.toml"
+    scene.write_text(SCENE)
+    rc = main(["accuracy", str(scene), "--targets", "numpy", "--dtypes", "float32", "--samples", "3",
+               "--format", "json"])
+    cap = capsys.readouterr()
+    assert rc == 0, cap.err
+    rep = json.loads(cap.out)
+    labels = ["sharp_gold: microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick)", "chalk: lambert"]
+    assert [v["spec"] for v in rep["verdicts"]] == labels and rep["specs"] == labels
+    by = {(r["spec"], r["set"]): r for r in rep["results"]}
+    gold = by[(labels[0], "stress")]
+    # one parameter set, the material's own (not the alpha/f0 sweeps), in both sample sets
+    assert gold["brdf"] == labels[0].split(": ")[1] and gold["params"] == {"alpha": 0.001, "f0": [1.0, 0.71, 0.29]}
+    assert [k for k in gold["by_param"] if k.startswith("alpha=")] == ["alpha=0.001"]
+    assert by[(labels[1], "hemisphere")]["params"] == {"rho_d": [0.9, 0.8, 0.7]}
+    assert "2 of 2 specs pass" in cap.err
+
+
+def test_command_scene_errors(tmp_path, capsys):
+    scene = tmp_path / "acc.toml"
+    scene.write_text(SCENE.replace('brdf = "lambert"', 'brdf = "lambrt"'))
+    assert main(["accuracy", str(scene), "--targets", "numpy"]) == 1
+    err = capsys.readouterr().err
+    assert f"{scene}:" in err and "lambrt" in err and "lambert" in err  # located, with the closest name
+    assert main(["accuracy", str(scene), "lambert", "--targets", "numpy"]) == 2
+    assert "either BRDF specs or one scene file" in capsys.readouterr().err

@@ -193,11 +193,14 @@ def stress_params(declared: dict) -> list[dict]:
     return combos
 
 
-def stress_sets(declared: dict) -> list[SampleSet]:
-    """One SampleSet per parameter set, each holding every stress geometry in both frames."""
+def stress_sets(declared: dict, params: dict | None = None) -> list[SampleSet]:
+    """One SampleSet per parameter set, each holding every stress geometry in both frames.
+
+    params: a material's own values (`accuracy SCENE`): one set at those values instead of the sweeps.
+    """
     L, V, labels = stress_geometry()
     out = []
-    for p in stress_params(declared):
+    for p in (stress_params(declared) if params is None else [dict(params)]):
         a = _framed("stress", p, L, V, labels, rotate=False)
         b = _framed("stress", p, L, V, [f"{s} [rotated]" for s in labels], rotate=True)
         out.append(SampleSet("stress", p, *(np.concatenate([getattr(a, f), getattr(b, f)])
@@ -350,13 +353,17 @@ def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:
     return [x.astype(dtype).astype(np.float64) for x in (s.L, s.V, s.N, s.T)]
 
 
-def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
-    """Errors of every (target, dtype) against the reference for one spec: {set: {"target/dtype": Errors}}."""
+def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12, params: dict | None = None) -> dict:
+    """Errors of every (target, dtype) against the reference for one spec: {set: {"target/dtype": Errors}}.
+
+    params: a material's parameter values (`accuracy SCENE`): the hemisphere and the stress geometries
+    are evaluated at them, instead of at the defaults and the parameter sweeps.
+    """
     from .evaluate import evaluate, gpu_kernel
     from ..reference import reference_brdf
 
     declared = declared_params(spec, lib)
-    sets = {"hemisphere": [hemisphere(hemisphere_k)], "stress": stress_sets(declared)}
+    sets = {"hemisphere": [hemisphere(hemisphere_k, params=params)], "stress": stress_sets(declared, params)}
     out: dict = {}
     for set_name, batches in sets.items():
         stats = {f"{t}/{d}": Errors() for t, d in runs(targets, dtypes)}
@@ -382,17 +389,26 @@ def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12) -> dict:
 DEFAULT_TOL = 1e-3  # float32 hemisphere max relative error a spec may have and pass (README's worst: ~5e-5)
 
 
-def run(specs, targets, dtypes, lib, hemisphere_k: int = 12, tol: float = DEFAULT_TOL) -> dict:
-    """The accuracy report of several specs as a JSON-ready dict, with a verdict per spec (see verdicts())."""
+def run(specs, targets, dtypes, lib, hemisphere_k: int = 12, tol: float = DEFAULT_TOL,
+        materials: dict | None = None) -> dict:
+    """The accuracy report of several specs as a JSON-ready dict, with a verdict per spec (see verdicts()).
+
+    materials: {label: (spec, params)} — an entry of `specs` that is a label there is measured as
+    that BRDF at those parameter values (a scene's material: `accuracy SCENE`); its results carry
+    the label as "spec" and the BRDF as "brdf".
+    """
     from tqdm import tqdm
 
     from ..io import show_progress
+    materials = materials or {}
     results = []
-    for spec in tqdm(specs, disable=not show_progress(), unit="spec", leave=False):
-        for set_name, stats in measure(spec, targets, dtypes, lib, hemisphere_k).items():
+    for label in tqdm(specs, disable=not show_progress(), unit="spec", leave=False):
+        spec, params = materials.get(label, (label, None))
+        extra = {"brdf": spec, "params": _plain(params)} if label in materials else {}
+        for set_name, stats in measure(spec, targets, dtypes, lib, hemisphere_k, params).items():
             for key, e in stats.items():
                 t, d = key.split("/")
-                results.append({"spec": spec, "set": set_name, "target": t, "dtype": d, **asdict(e)})
+                results.append({"spec": label, **extra, "set": set_name, "target": t, "dtype": d, **asdict(e)})
     bad = [r for r in results if r["dtype"] == "float32" and (r["nan"] or r["inf"])]
     return {"rel_floor": REL_FLOOR, "specs": list(specs), "runs": [f"{t}/{d}" for t, d in runs(targets, dtypes)],
             "results": results, "float32_finite": not bad, "tolerance": tol,

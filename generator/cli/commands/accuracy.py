@@ -1,10 +1,13 @@
 """`shadermatrix accuracy`: error of every target and dtype against the float64 references.
 
-    shadermatrix accuracy [SPEC ...] [--targets numpy,glsl,hlsl,wgsl] [--dtypes float64,float32,float16]
+    shadermatrix accuracy [SPEC ... | SCENE.toml] [--targets numpy,glsl,hlsl,wgsl] [--dtypes float64,float32,float16]
                           [--format md|json] [--out FILE] [--samples K] [--fail-above TOL]
 
 Without SPECs: every BRDF brick (each diffuse term, each specular term with
-every combination of slot fillers). Without --targets: numpy, GLSL, HLSL and
+each slot filler at least once; --all-combinations: every combination). With
+a scene file: exactly the scene's materials, each its BRDF at its own parameter
+values (a parameter a packing reads from a texture is measured at the
+material's factor, the value the texture is multiplied by). Without --targets: numpy, GLSL, HLSL and
 WGSL; without a lavapipe device that is an error (exit 3), never a silent
 numpy-only report: pass --targets numpy to run without one. Two sample sets per spec: a
 stratified hemisphere (K⁴ samples) and the stress set (see generator/eval/accuracy.py).
@@ -26,8 +29,9 @@ MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 
 
 
 def add_arguments(p) -> None:
-    p.add_argument("specs", nargs="*", metavar="SPEC", help="BRDF specs (default: every BRDF brick, each slot "
-                   "filler at least once; see --all-combinations)")
+    p.add_argument("specs", nargs="*", metavar="SPEC|SCENE", help="BRDF specs (default: every BRDF brick, each slot "
+                   "filler at least once; see --all-combinations), or one scene file (.toml): its materials, "
+                   "each at its own parameters")
     p.add_argument("--all-combinations", action="store_true",
                    help="by default, every combination of slot fillers instead of each filler once")
     p.add_argument("--targets", metavar="LIST",
@@ -57,6 +61,23 @@ def _list(value: str, allowed: tuple, what: str) -> list[str]:
     return items
 
 
+def _is_scene(arg: str) -> bool:
+    return arg.endswith(".toml")
+
+
+def scene_materials(path: Path, lib) -> dict:
+    """{"material: brdf": (brdf, params)} of a scene's materials, in the scene's order: the BRDF parameters
+    the material sets (packing and output parameters left out); the others take the bricks' defaults."""
+    from ...eval.accuracy import declared_params
+    from ...matrix.scene import load_scene
+    scene = load_scene(path, lib)
+    out = {}
+    for m in scene.materials.values():
+        declared = declared_params(m.brdf, lib)
+        out[f"{m.name}: {m.brdf}"] = (m.brdf, {k: v for k, v in m.params.items() if k in declared})
+    return out
+
+
 def run(args) -> int:
     from ...eval import accuracy
     from ...library.bricks import load_library
@@ -79,12 +100,20 @@ def run(args) -> int:
                 raise VulkanUnavailable("no lavapipe Vulkan device for the GPU targets (`shadermatrix doctor` says "
                                         "why; `make setup` installs it) — or pass --targets numpy to run without")
         lib = load_library(args.bricks or ())
-        specs = args.specs or accuracy.default_specs(lib, full=args.all_combinations)
+        materials = None
+        if any(_is_scene(s) for s in args.specs):
+            if len(args.specs) != 1:
+                raise UsageError("give either BRDF specs or one scene file, not both — "
+                                 f"e.g. shadermatrix accuracy {next(s for s in args.specs if _is_scene(s))}")
+            materials = scene_materials(Path(args.specs[0]), lib)
+            specs = list(materials)
+        else:
+            specs = args.specs or accuracy.default_specs(lib, full=args.all_combinations)
         if not accuracy.runs(targets, dtypes):
             raise UsageError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
                              "GPU targets run float32 only; add float32 or the numpy target")
         tol = accuracy.DEFAULT_TOL if args.fail_above is None else args.fail_above
-        report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples, tol=tol)
+        report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples, tol=tol, materials=materials)
     except (EvalError, SpecError, ReferenceMissing) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
