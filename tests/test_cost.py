@@ -273,7 +273,9 @@ def test_scene_costs_markdown_and_csv(scene_json):
     md = cli(EXAMPLE)
     assert md.returncode == 0, md.stderr
     assert "| permutation | materials | objects | stage | tex | ALU |" in md.stdout
-    assert "## Where the languages differ" in md.stdout
+    assert "## Where the languages differ" not in md.stdout and "course tex" not in md.stdout
+    more = cli(EXAMPLE, "--course", "--explain-languages")
+    assert "## Where the languages differ" in more.stdout and "| course tex / ALU |" in more.stdout
     csv_out = cli(EXAMPLE, "--format", "csv")
     assert csv_out.returncode == 0
     lines = csv_out.stdout.splitlines()
@@ -304,7 +306,8 @@ def test_manifest_carries_the_same_costs(scene_json, tmp_path):
 def test_bricks_table_markdown_shows_course_figures():
     for t in COMPILERS:
         require_tool(t)
-    r = cli("--per-brick")
+    assert "## The course's models" not in cli("--per-brick").stdout  # behind --course
+    r = cli("--per-brick", "--course")
     assert r.returncode == 0, r.stderr
     assert re.search(r"\| Blinn-Phong \| direct \| shift-invariant \| `lambert\+blinn_phong_normalized` \| 0 \| 7 \|",
                      r.stdout)

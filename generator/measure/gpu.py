@@ -19,6 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..runtime.gpu_stats import SHOWN, GpuStatsUnavailable, Job, statistics
+from .plans import REPORT_LANGUAGES
+from .report import LANGS_AND, LANGS_SLASH
 
 __all__ = ["GpuRequest", "attach", "estimate_check", "SHOWN"]
 
@@ -117,7 +119,7 @@ def estimate_check(rows, families) -> dict[str, dict]:
 MD = [("VGPRs", "VGPRs"), ("SGPRs", "SGPRs"), ("spills V/S", "spills"), ("instr.", "Instructions"),
       ("code B", "Code size"), ("waves/SIMD", "Subgroups per SIMD"), ("latency", "Latency"),
       ("inv. throughput", "Inverse Throughput")]
-LANGS = ("hlsl", "glsl", "wgsl")
+LANGS = REPORT_LANGUAGES
 
 
 def _stat(row, family, name):
@@ -156,7 +158,7 @@ def markdown(rows, groups, request: GpuRequest | None) -> list[str]:
            "per wave, spilled VGPRs/SGPRs, instructions, code bytes, waves (subgroups) per SIMD — the occupancy —, "
            "ACO's latency and inverse-throughput estimates in cycles. Graphics pipelines have the permutation's "
            "vertex layout and the renderer's R8G8B8A8_UNORM + D32_SFLOAT targets. A cell holds one number when "
-           "HLSL, GLSL and WGSL agree, otherwise HLSL / GLSL / WGSL. Per-brick rows: with the brick minus with "
+           f"{LANGS_AND} agree, otherwise {LANGS_SLASH}. Per-brick rows: with the brick minus with "
            "the stand-in.", "",
            "Devices: " + "; ".join(f"{f}: {devices.get(f, '?')}" for f in families) + ".", ""]
     head = [h for h, _ in MD]

@@ -36,6 +36,7 @@ from pathlib import Path
 
 from ..library.bricks import Brick, Library, load_brick, load_library
 from ..library.kinds import BRDF_KINDS, KINDS
+from .. import GPU_TARGETS
 from ..io import show_progress
 from ..toolchain.scenes import compile_scene, job_key, source_jobs
 from ..compose import Composed, compose_eval, compose_permutation
@@ -50,7 +51,7 @@ __all__ = ["Row", "CourseFigure", "CourseModel", "course_models", "course_figure
 
 COST_BRICKS = Path(__file__).resolve().parent / "standins"
 COURSE_FILE = Path(__file__).resolve().parent / "course_costs.toml"
-REPORT_LANGUAGES = ("hlsl", "glsl", "wgsl")  # column order of the reports
+REPORT_LANGUAGES = GPU_TARGETS  # column order of the reports: the order of build, accuracy and eval
 STANDIN_CITE = "shadermatrix cost baseline (no model)"  # what marks a stand-in brick
 
 

@@ -1,7 +1,7 @@
 """Cost tables as Markdown, CSV or JSON, and why the three languages differ.
 
 Markdown is for people: one row per subject, a cell holds one number when
-HLSL, GLSL and WGSL agree and ``HLSL / GLSL / WGSL`` when they do not, laid
+GLSL, HLSL and WGSL agree and ``GLSL / HLSL / WGSL`` when they do not, laid
 out like Hoffman & Baker 2006's "BRDF Costs" tables (texture, ALU) with
 transcendental, branch and register columns, and the course's figure beside
 ours where the model is in its table. CSV and JSON are for machines: one row
@@ -17,6 +17,9 @@ from collections import Counter
 from .. import __version__
 from ..analysis import COUNT_FIELDS
 from .plans import REPORT_LANGUAGES, CourseModel, Row
+
+LANGS_SLASH = " / ".join(x.upper() for x in REPORT_LANGUAGES)  # the order of every report's cells
+LANGS_AND = ", ".join(x.upper() for x in REPORT_LANGUAGES[:-1]) + " and " + REPORT_LANGUAGES[-1].upper()
 from ..toolchain import tool_versions
 
 # Markdown columns: (header, Cost field or derived name).
@@ -145,7 +148,7 @@ def _metric_cells(by_lang: dict[str, Row]) -> list[str]:
 
 LEGEND = [
     "Static counts from the optimized SPIR-V (`spirv-opt -O`) of each entry point. A cell holds one number "
-    "when HLSL, GLSL and WGSL agree, otherwise HLSL / GLSL / WGSL. tex, ALU, transc. (transcendental) and "
+    f"when {LANGS_AND} agree, otherwise {LANGS_SLASH}. tex, ALU, transc. (transcendental) and "
     "instr. count instructions (a vec3 operation is one); ALU ops is the scalarized ALU count (a vec3 add is "
     "3, a dot of vec3 5); regs is an estimate of the peak number of live 32-bit scalars. Rules: "
     "`generator/analysis/classify.py`, `generator/analysis/liveness.py`.",
@@ -156,9 +159,13 @@ LEGEND = [
 ]
 
 
-def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = None, gpu=None) -> str:
-    """The report as Markdown (per-permutation rows, or per-brick and model rows); gpu: the
-    measure.gpu.GpuRequest that added RADV's figures, or None."""
+def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = None, gpu=None,
+             course: bool = False, languages: bool = False) -> str:
+    """The report as Markdown (per-permutation rows, or per-brick rows); gpu: the
+    measure.gpu.GpuRequest that added RADV's figures, or None.
+
+    course: the comparison with Hoffman & Baker 2006's tables (a column per permutation, the models'
+    section per brick); languages: the section that explains where the languages differ."""
     from . import gpu as radv
 
     out = [f"# {title}", "", *LEGEND, ""]
@@ -170,9 +177,10 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
         lines = []
         for (_, subject, stage, _), by_lang in perm:
             r = next(iter(by_lang.values()))
-            lines.append([f"`{subject}`", ", ".join(r.materials), ", ".join(r.objects), stage, *_metric_cells(by_lang),
-                          _course_cell(r, per_light=True) if stage == "frag" else ""])
-        out += _md_table(["permutation", "materials", "objects", "stage", *head, "course tex / ALU"], lines)
+            lines.append([f"`{subject}`", ", ".join(r.materials), ", ".join(r.objects), stage, *_metric_cells(by_lang)]
+                         + ([_course_cell(r, per_light=True) if stage == "frag" else ""] if course else []))
+        out += _md_table(["permutation", "materials", "objects", "stage", *head]
+                         + (["course tex / ALU"] if course else []), lines)
         out += ["", *_totals(perm)]
         uber = [(k, v) for k, v in groups.items() if k[0] == "ubershader"]
         if uber:
@@ -195,7 +203,7 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
         lines = [[next(iter(v.values())).kind, f"`{k[1]}`", *_metric_cells(v)] for k, v in bricks]
         out += _md_table(["kind", "brick", *head], lines) + [""]
     model_rows = [(k, v) for k, v in groups.items() if k[0] == "model"]
-    if models is not None:
+    if models is not None and course:
         out += ["## The course's models", "",
                 "Whole BRDFs (`course_costs.toml`): shift-invariant = eval kernel of the spec minus the stand-in "
                 "BRDF; shift-variant = one-light fragment shader with the textured packing minus stand-ins.", ""]
@@ -209,7 +217,7 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
                               str(fig.texture), fig.alu, *ours])
         out += _md_table(["model", "form", "table", "measured", "course tex", "course ALU", *head], lines) + [""]
     out += radv.markdown(rows, groups, gpu)
-    diffs = differences(rows)
+    diffs = differences(rows) if languages else []
     if diffs:
         out += ["## Where the languages differ", ""]
         texts = _explanation_texts()
@@ -220,7 +228,7 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
             ops = "; ".join(f"{lang} vs {d['reference']}: " + ", ".join(f"{k} {v:+d}" for k, v in o.items())
                             for lang, o in d["opcodes"].items())
             ops = f" {ops}." if ops else ""
-            out.append(f"- `{d['subject']}` {d['stage']} — {metrics} (HLSL / GLSL / WGSL).{ops} "
+            out.append(f"- `{d['subject']}` {d['stage']} — {metrics} ({LANGS_SLASH}).{ops} "
                        f"Why: {', '.join(d['why'])}.")
             used += [w for w in d["why"] if w not in used]
         out += [""] + [f"- **{key}**: {texts[key]}" for key in used] + [""]

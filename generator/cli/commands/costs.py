@@ -16,7 +16,7 @@ BUDGET_NAMES = ("texture", "alu", "transcendental", "alu_t", "branches", "regist
 def add_arguments(p) -> None:
     p.add_argument("scene", nargs="?", help="scene file (TOML): one row per permutation and stage")
     p.add_argument("--per-brick", action="store_true",
-                   help="per-brick table instead: each brick's cost against a trivial stand-in, and the course's models")
+                   help="per-brick table instead: each brick's cost against a trivial stand-in")
     p.add_argument("--bricks", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
     p.add_argument("--format", choices=("md", "csv", "json"), default="md", help="output format (default md)")
@@ -34,6 +34,12 @@ def add_arguments(p) -> None:
     p.add_argument("--budget", metavar="NAME=MAX,...",
                    help=f"per-shader limits, e.g. alu=60,texture=4,registers=32 (names: {', '.join(BUDGET_NAMES)}): "
                         "every shader over one is listed and the exit code is 1 (a CI holds the budget)")
+    p.add_argument("--course", action="store_true",
+                   help="Markdown: beside our counts, Hoffman & Baker 2006's figures (a column per permutation; "
+                        "per brick, a section of the course's models). CSV and JSON always carry them")
+    p.add_argument("--explain-languages", action="store_true",
+                   help="Markdown: a section on where GLSL, HLSL and WGSL differ, opcode by opcode, and why. "
+                        "JSON always carries it")
     p.add_argument("--gpu-ir", metavar="DIR",
                    help="with --gpu: save each shader's NIR, ACO IR and disassembly as DIR/<family>/<key>.<stage>.txt")
 
@@ -126,7 +132,7 @@ def run(args) -> int:
     if args.diff:
         sys.stdout.write(diff(rows, old_rows, BUDGET_NAMES, args.diff))
     elif args.format == "md":
-        sys.stdout.write(markdown(rows, title, models, gpu))
+        sys.stdout.write(markdown(rows, title, models, gpu, course=args.course, languages=args.explain_languages))
     elif args.format == "csv":
         sys.stdout.write(to_csv(rows))
     else:
