@@ -28,3 +28,13 @@ def folder(text: str) -> str:
     if p.is_file() or p.suffix.lower() in (".png", ".md", ".json", ".txt", ".svg", ".pdf"):
         raise argparse.ArgumentTypeError(f"{text!r} is a file name; give the folder the results go into")
     return text
+
+
+def languages(text: str) -> list[str]:
+    """A comma-separated list of GPU languages (glsl, hlsl, wgsl), each once."""
+    allowed = ("glsl", "hlsl", "wgsl")
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    if not items or any(x not in allowed for x in items) or len(set(items)) != len(items):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a comma-separated list from {', '.join(allowed)} "
+                                         "(each once)")
+    return items

@@ -43,6 +43,7 @@ def test_readme_names_every_script_and_only_options_they_take():
     ("hybrid.py", "--frames", "-3"),
     ("runtime_vs_error.py", "--samples", "0"),
     ("contact_sheet.py", "--out", "sheet.png"),  # a file name where a folder goes: refused, not made a folder
+    ("contact_sheet.py", "--targets", "glsl,metal"),
     ("radv_estimate.py", "--families", "navi21"),
 ], ids=lambda a: " ".join(a))
 def test_a_bad_value_is_a_usage_error(args, tmp_path):
