@@ -158,3 +158,24 @@ def test_a_cost_diff_shows_what_a_change_cost_shader_by_shader(tmp_path):
     (tmp_path / "junk.json").write_text("{}")
     bad = run("costs", EXAMPLE, "--diff", tmp_path / "junk.json", *cache)
     assert bad.returncode == 1 and "not a `costs --format json` report" in bad.stderr
+
+
+def _complete(script: str, *words: str) -> list[str]:
+    """What bash offers for the last word of `shadermatrix WORDS...`, through the generated completion function."""
+    line = " ".join(("shadermatrix",) + words)
+    program = (f'source "$1"; COMP_WORDS=(shadermatrix {" ".join(words)}); COMP_CWORD={len(words)}; '
+               f'COMP_LINE="{line}"; COMP_POINT=${{#COMP_LINE}}; _shtab_shadermatrix; printf "%s\\n" "${{COMPREPLY[@]}}"')
+    r = subprocess.run(["bash", "-c", program, "bash", script], capture_output=True, text=True, timeout=30)
+    assert r.returncode == 0, r.stderr
+    return r.stdout.split()
+
+
+def test_bash_completion_offers_every_command_and_option(tmp_path):
+    r = run("completion", "bash")
+    assert r.returncode == 0, r.stderr
+    script = tmp_path / "shadermatrix.bash"
+    script.write_text(r.stdout)
+    assert _complete(str(script), "acc") == ["accuracy"]
+    assert _complete(str(script), "costs", "--bu") == ["--budget"]
+    assert set(_complete(str(script), "")) == set(_subparsers())  # every command, from the parser itself
+    assert run("completion", "fish").returncode == 2
