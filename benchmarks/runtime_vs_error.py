@@ -1,38 +1,50 @@
-"""Run time against error: every BRDF brick and slot filler, timed on lavapipe, against the exact model.
+"""Run time against error: every approximation a brick makes, timed on lavapipe against the exact model it approximates.
 
-    .venv/bin/python benchmarks/runtime_vs_error.py [--samples 1048576] [--repeats 21]
-        [--languages glsl,hlsl,wgsl] [--param NAME=VALUE ...] [--out benchmarks/results]
+    .venv/bin/python benchmarks/runtime_vs_error.py [--samples 1048576] [--repeats 31]
+        [--languages glsl,hlsl,wgsl] [--grid 12] [--out benchmarks/results]
 
-Kernels: each diffuse and specular brick alone, the microfacet brick with every
-combination of its slot fillers (ndf × fresnel × vis), at the bricks' default
-parameters (or --param). Each is the eval kernel of `shadermatrix eval`.
+Two parts.
 
-Time: device time of one dispatch over `--samples` samples (timestamp queries
-around the dispatch), median over `--repeats` dispatches (default 31). Every dispatch of a
-kernel is paired with one of the Lambert kernel of the same language (order
-alternating), and the ratio to Lambert is the median of the pairs' ratios, so
-drift of the machine cancels. Samples: L and V uniform over the hemisphere
-around random normals (every sample lit, so the whole BRDF runs).
+**Approximations against their exact model** (the plot). A study holds the
+kernels that approximate one exact model, with everything else held fixed, so
+the error on the y-axis is the approximation's and never a choice between
+models (an implicit or Kelemen geometry term is another model, not an
+approximation of Smith's; it appears in the second part only):
 
-Error: against the *exact* model the kernel approximates, in float64, from
-generator/reference/ (exact.py): the same NDF, the exact dielectric Fresnel
-for the same f0 (Cook & Torrance 1982; Walter et al. 2007 eq. 22) in place of
-Schlick or none, and the exact separable Smith G of that NDF (Walter et al.
-2007 eqs. 23, 27, 34; Beckmann's Λ for the Blinn-Phong NDF, as Walter et al.
-§5.2 do) in place of Smith-Schlick, Torrance-Sparrow or the implicit G. Bricks
-that approximate nothing (Lambert, the normalized Phong lobes) are compared
-with their own reference: their error is float32 arithmetic. Errors are over
-a jittered, stratified k⁴ grid of (L, V) over the hemisphere (k = 12: 20736
-pairs) of the GLSL kernel's output on lavapipe, with the exact model evaluated
-at the float32-rounded vectors the kernel gets (as in generator/eval/accuracy.py):
-- `rel_rms`: cosine-weighted relative RMS error over all samples and RGB
-  channels, sqrt(Σ cosθ_l (f - f*)²) / sqrt(Σ cosθ_l f*²) — the error of the
-  reflected radiance under uniform light;
-- `max_rel`: max |f - f*| / max(|f*|, 1e-6 sr⁻¹).
-The model error alone (NumPy float64 emission of the same IR) is reported too.
+- Fresnel: Schlick (Schlick 1994 eq. 15) and the spherical Gaussian
+  (Gotanda 2014 eq. 3) against the exact dielectric Fresnel written with f0
+  (Gotanda eq. 2), inside microfacet(ndf=ggx, vis=smith_ggx_height_correlated);
+- Smith for GGX: Smith-Schlick with k = α/2 (Karis) and with k = α·sqrt(2/π)
+  (Schlick's Beckmann match) against the exact separable Smith G of GGX
+  (Walter et al. 2007 eq. 34), inside microfacet(ndf=ggx, fresnel=schlick);
+- Smith for Beckmann: Smith-Schlick (k = α·sqrt(2/π)) and the `smith_beckmann`
+  brick against the exact Beckmann Λ with erfc (Walter et al. 2007 eq. 27),
+  inside microfacet(ndf=beckmann, fresnel=schlick);
+- diffuse: Lambert, the Oren-Nayar family and Gotanda's fit (eq. 8) against the
+  microfacet diffuse model Gotanda integrates (his eq. 4 and footnote 3: GGX D,
+  Schlick-type F_diff, height-correlated Smith G on Lambertian facets),
+  computed by quadrature (generator/reference/diffuse.py), at σ = α = 0.5,
+  f0 = 0.04, ρ_d = 1.
 
-Writes runtime_vs_error.json, .md and .png (time ratio against error, Pareto
-front marked) under --out. A progress bar is shown on a terminal only.
+Time: device time of one dispatch over `--samples` samples (timestamp queries),
+each dispatch of a kernel paired with one of the study's exact kernel (order
+alternating; for the diffuse study, with Lambert: its exact model has no
+kernel), and the ratio is the median of the pairs' ratios, so drift of the
+machine cancels; the error bar is the pairs' interquartile range. Error: the
+cosine-weighted relative RMS sqrt(Σ cosθ_l (f − f*)²) / sqrt(Σ cosθ_l f*²) of the
+first language's kernel on lavapipe against the exact model in float64, over a
+jittered stratified k⁴ grid of (L, V) (at the kernel's float32 inputs); `model`
+is the same for the float64 emission of the kernel (the approximation alone,
+without float32 arithmetic). Pareto front: a kernel is dominated when another
+is more accurate and not slower beyond the noise (their interquartile ranges
+overlap or it is faster); the front is drawn only when two or more kernels are
+on it, that is, when speed really buys error.
+
+**Every brick** (the table): each spec of `shadermatrix accuracy`'s default set,
+timed paired with Lambert, with its float32 error against its own float64
+reference (the arithmetic alone).
+
+Writes runtime_vs_error.json, .md and .png under --out. A progress bar is shown on a terminal only.
 """
 from __future__ import annotations
 
@@ -42,6 +54,7 @@ import math
 import os
 import platform
 import sys
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -50,63 +63,95 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
-from cliargs import folder, positive  # noqa: E402
+from cliargs import folder, languages, positive  # noqa: E402
 
-from generator import GPU_TARGETS as LANGS  # noqa: E402 (after the path)
+from generator import GPU_TARGETS  # noqa: E402 (after the path)
 from generator.eval.accuracy import REL_FLOOR, default_specs, hemisphere, rounded_inputs  # noqa: E402
 
-BASELINE = "lambert"
+LAMBERT = "lambert"
+DIFFUSE_SIGMA = 0.5
 
 
-# ------------------------------------------------------------------ what is measured
+@dataclass
+class Study:
+    """Kernels that approximate one exact model; `exact` is a spec whose float64 reference is that model, or
+    None where the model is the quadrature of `exact_fn`."""
 
-def exact_model(node) -> str:
-    """What a term is compared with (for the table)."""
-    if node.brick.id != "microfacet":
-        return f"reference {node.canonical()}"
-    ndf = dict(node.fillers)["ndf"].brick.id
-    lam = "GGX" if ndf == "ggx" else "Beckmann"
-    return f"D {ndf}, exact dielectric F, exact Smith G ({lam} Λ)"
+    name: str
+    title: str
+    kernels: dict[str, str]  # label -> spec
+    exact: str | None = None
+    exact_label: str = ""
+    params: dict = field(default_factory=dict)
+    exact_fn: object = None  # (L, V, N) -> (n, 3) float64, for models without a brick
 
-
-def _microfacet_factors(node, g, params: dict) -> dict:
-    """D, and F and G both as the kernel's bricks define them and exact, float64 per sample."""
-    from generator.reference import (fresnel_dielectric_f0, lambda_beckmann, lambda_ggx, lookup,
-                                     smith_g_separable)
-
-    fill = {slot: n.brick.id for slot, n in node.fillers}
-    alpha, f0 = float(params["alpha"]), np.broadcast_to(np.asarray(params["f0"], np.float64), (g.count, 3))
-    lam = lambda_ggx if fill["ndf"] == "ggx" else lambda_beckmann
-    return {"D": lookup("ndf", fill["ndf"])(g.NdotH, g.NxH2, alpha),
-            "F": lookup("fresnel", fill["fresnel"])(f0, g.VdotH), "F_exact": fresnel_dielectric_f0(f0, g.VdotH),
-            "G": lookup("visibility", fill["vis"])(g, alpha),
-            "G_exact": smith_g_separable(g.NdotL, g.NdotV, alpha, lam)}
+    @property
+    def baseline(self) -> str:
+        return self.exact or LAMBERT
 
 
-def exact_brdf(spec: str, L, V, N, T, params: dict, lib, keep: str = "") -> np.ndarray:
-    """f_r of the exact model a spec approximates, float64 (N, 3); see the module docstring.
+def _microfacet(ndf: str, fresnel: str, vis: str) -> str:
+    return f"microfacet(ndf={ndf},fresnel={fresnel},vis={vis})"
 
-    keep="F" or "G": the kernel's own Fresnel or geometry factor (float64) stays, the rest is
-    exact, so the difference to the exact model is the error of the other approximation.
-    """
-    from generator.matrix.permutation import parse_brdf
-    from generator.reference import reference_brdf, shading_geometry
 
-    g = shading_geometry(L, V, N, T)
-    total = np.zeros((g.count, 3))
-    for node in parse_brdf(spec, lib):
-        if node.brick.id != "microfacet":
-            sub = {k: v for k, v in params.items() if k in node.brick.params}
-            total += reference_brdf(node.canonical(), L, V, N, T, sub, lib=lib)
-            continue
-        f = _microfacet_factors(node, g, params)
-        F = f["F"] if keep == "F" else f["F_exact"]
-        G = f["G"] if keep == "G" else f["G_exact"]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            term = F * (f["D"] * G / (4.0 * g.NdotL * g.NdotV))[:, None]
-        total += np.where(g.lit[:, None], term, 0.0)
-    return total
+def _diffuse_exact(L, V, N) -> np.ndarray:
+    from generator.reference.diffuse import microfacet_diffuse
+    nl, nv = np.sum(L * N, 1), np.clip(np.sum(V * N, 1), 1e-4, 1.0)
+    lp, vp = L - nl[:, None] * N, V - np.sum(V * N, 1)[:, None] * N
+    d = np.sqrt(np.sum(lp * lp, 1) * np.sum(vp * vp, 1))
+    cp = np.where(d > 0, np.sum(lp * vp, 1) / np.where(d > 0, d, 1.0), 0.0)
+    f = np.where(nl > 0, microfacet_diffuse(np.clip(nl, 1e-6, 1.0), nv, cp, DIFFUSE_SIGMA, 0.04), 0.0)
+    return np.repeat(f[:, None], 3, axis=1)
 
+
+def studies(lib) -> tuple[list[Study], list[str]]:
+    """The studies whose bricks the library holds, and a note per study left out (a brick missing)."""
+    s = [
+        Study("fresnel", "Fresnel, in microfacet(ndf=ggx, vis=smith_ggx_height_correlated)",
+              {"schlick": _microfacet("ggx", "schlick", "smith_ggx_height_correlated"),
+               "spherical_gaussian": _microfacet("ggx", "spherical_gaussian", "smith_ggx_height_correlated")},
+              exact=_microfacet("ggx", "dielectric_exact", "smith_ggx_height_correlated"),
+              exact_label="exact dielectric Fresnel (dielectric_exact)"),
+        Study("smith_ggx", "Smith G for GGX, in microfacet(ndf=ggx, fresnel=schlick)",
+              {"smith_schlick_ggx (k = α/2)": _microfacet("ggx", "schlick", "smith_schlick_ggx"),
+               "smith_schlick (k = α√(2/π))": _microfacet("ggx", "schlick", "smith_schlick")},
+              exact=_microfacet("ggx", "schlick", "smith_ggx_separable"),
+              exact_label="exact separable Smith G (smith_ggx_separable)"),
+        Study("smith_beckmann", "Smith G for Beckmann, in microfacet(ndf=beckmann, fresnel=schlick)",
+              {"smith_schlick (k = α√(2/π))": _microfacet("beckmann", "schlick", "smith_schlick")},
+              exact=_microfacet("beckmann", "schlick", "smith_beckmann"),
+              exact_label="exact Beckmann Λ with erfc (the reference of smith_beckmann)"),
+        Study("diffuse", f"Diffuse at σ = α = {DIFFUSE_SIGMA}, f0 = 0.04, ρ_d = 1",
+              {"lambert": "lambert", "oren_nayar": "oren_nayar", "oren_nayar_simplified": "oren_nayar_simplified",
+               "oren_nayar_improved": "oren_nayar_improved", "oren_nayar_fresnel": "oren_nayar_fresnel",
+               "gotanda_fitted": "gotanda_fitted"},
+              exact_label="Gotanda's microfacet diffuse model (eq. 4, quadrature)",
+              params={"sigma": DIFFUSE_SIGMA, "f0": [0.04] * 3, "rho_d": [1.0] * 3}, exact_fn=_diffuse_exact),
+    ]
+    from generator.matrix.permutation import SpecError, parse_brdf
+    have, notes = [], []
+    for st in s:
+        specs = list(st.kernels.values()) + ([st.exact] if st.exact else [])
+        missing = []
+        for spec in specs:
+            try:
+                parse_brdf(spec, lib)
+            except SpecError:  # a brick this checkout lacks
+                missing.append(spec)
+        if missing:
+            notes.append(f"{st.name}: left out, no brick for {', '.join(missing)}")
+        else:
+            have.append(st)
+    return have, notes
+
+
+def own_params(spec: str, params: dict, lib) -> dict:
+    from generator.eval.accuracy import declared_params
+    declared = declared_params(spec, lib)
+    return {k: v for k, v in params.items() if k in declared}
+
+
+# ------------------------------------------------------------------ timing
 
 def timing_samples(n: int, seed: int) -> list[np.ndarray]:
     """float32 [L, V, N, T] (n, 3): L and V uniform over the hemisphere around random normals."""
@@ -126,38 +171,6 @@ def timing_samples(n: int, seed: int) -> list[np.ndarray]:
     return [x.astype(np.float32) for x in (around(), around(), N, T)]
 
 
-# ------------------------------------------------------------------ measuring
-
-def errors(spec: str, params: dict, lib, k: int) -> dict:
-    """rel_rms and max_rel of the GLSL kernel and of the float64 model against the exact model."""
-    from generator.eval.evaluate import evaluate
-
-    # A jittered k⁴ grid (N = z, T = x) as rounded to float32: the very vectors the kernel gets, and
-    # the ones the exact model is evaluated at, so the error is not that of the input rounding.
-    L, V, N, T = rounded_inputs(hemisphere(k, seed=1, rotate=False), "float32")
-    exact = exact_brdf(spec, L, V, N, T, params, lib)
-    w = np.clip(np.sum(L * N, 1), 0.0, None)[:, None]
-
-    def rel_rms(f, ref):
-        if not np.isfinite(f).all():
-            return math.inf
-        return float(np.sqrt(np.sum(w * (f - ref) ** 2) / np.sum(w * ref * ref)))
-
-    out = {}
-    for name, target, dtype in (("gpu", "glsl", "float32"), ("model", "numpy", "float64")):
-        f = evaluate(spec, L, V, N, T, params=params, target=target, dtype=dtype, lib=lib)
-        finite = np.isfinite(f).all()
-        out[name] = {
-            "rel_rms": rel_rms(f, exact),
-            "max_rel": float(np.max(np.abs(f - exact) / np.maximum(np.abs(exact), REL_FLOOR))) if finite else math.inf,
-            "nonfinite": int(np.size(f) - np.count_nonzero(np.isfinite(f))),
-        }
-    if "microfacet" in spec:  # attribution: only the Fresnel, or only the geometry factor, approximated
-        out["fresnel_only"] = rel_rms(exact_brdf(spec, L, V, N, T, params, lib, keep="F"), exact)
-        out["geometry_only"] = rel_rms(exact_brdf(spec, L, V, N, T, params, lib, keep="G"), exact)
-    return out
-
-
 def time_pairs(kernel, baseline, repeats: int) -> tuple[list[float], list[float]]:
     """Device seconds of `repeats` dispatches of kernel and baseline, interleaved in alternating order."""
     kernel.time(2), baseline.time(2)  # warm-up: first dispatches pay for lazy set-up in the driver
@@ -172,154 +185,222 @@ def time_pairs(kernel, baseline, repeats: int) -> tuple[list[float], list[float]
     return ts, tb
 
 
-def measure(specs, langs, params, samples, repeats, k, lib, progress) -> dict:
+class Timer:
+    """Paired timing of kernels against baselines, kernels compiled once per language."""
+
+    def __init__(self, lib, samples: int, repeats: int):
+        from generator.runtime.eval_kernel import shared_device
+        self.lib, self.repeats = lib, repeats
+        self.device = shared_device()
+        self.vecs = timing_samples(samples, seed=2)
+
+    def kernel(self, spec: str, lang: str, params: dict):
+        from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
+        ep = program(spec, self.lib)
+        k = gpu_kernel(spec, lang, self.lib, self.device)
+        k.load(self.vecs, _param_block(ep, resolve_params(ep, own_params(spec, params, self.lib))))
+        return k
+
+    def ratio(self, spec: str, baseline: str, lang: str, params: dict) -> dict:
+        base = self.kernel(baseline, lang, params)
+        kern = base if spec == baseline else self.kernel(spec, lang, params)
+        ts, tb = time_pairs(kern, base, self.repeats)
+        ratios = np.asarray(ts) / np.asarray(tb)
+        out = {"ratio": float(np.median(ratios)), "q25": float(np.percentile(ratios, 25)),
+               "q75": float(np.percentile(ratios, 75)), "ms": 1e3 * float(np.median(ts))}
+        if kern is not base:
+            kern.release()
+        base.release()
+        return out
+
+
+# ------------------------------------------------------------------ errors
+
+def _rel_rms(f, ref, w) -> float:
+    if not np.isfinite(f).all():
+        return math.inf
+    return float(np.sqrt(np.sum(w * (f - ref) ** 2) / np.sum(w * ref * ref)))
+
+
+def _max_rel(f, ref) -> float:
+    if not np.isfinite(f).all():
+        return math.inf
+    return float(np.max(np.abs(f - ref) / np.maximum(np.abs(ref), REL_FLOOR)))
+
+
+def errors(spec: str, exact, params: dict, lib, k: int, lang: str) -> dict:
+    """The kernel (lavapipe, float32) and its float64 emission against `exact`: a spec whose reference is the
+    exact model, or a function (L, V, N) -> f."""
+    from generator.eval.evaluate import evaluate
+    from generator.reference import reference_brdf
+
+    # A jittered k⁴ grid (N = z, T = x) as rounded to float32: the very vectors the kernel gets, and
+    # the ones the exact model is evaluated at, so the error is not that of the input rounding.
+    L, V, N, T = rounded_inputs(hemisphere(k, seed=1, rotate=False), "float32")
+    if callable(exact):
+        ref = exact(L, V, N)
+    else:
+        ref = reference_brdf(exact, L, V, N, T, own_params(exact, params, lib), lib=lib)
+    w = np.clip(np.sum(L * N, 1), 0.0, None)[:, None]
+    mine = own_params(spec, params, lib)
+    out = {}
+    for name, target, dtype in (("gpu", lang, "float32"), ("model", "numpy", "float64")):
+        f = evaluate(spec, L, V, N, T, params=mine, target=target, dtype=dtype, lib=lib)
+        out[name] = {"rel_rms": _rel_rms(f, ref, w), "max_rel": _max_rel(f, ref)}
+    return out
+
+
+# ------------------------------------------------------------------ the front
+
+def dominated(p: dict, q: dict) -> bool:
+    """q dominates p: more accurate, and not slower beyond the noise (interquartile ranges overlap, or faster)."""
+    return q["error"] < p["error"] and q["q25"] <= p["q75"]
+
+
+def front(points: list[dict]) -> list[bool]:
+    return [not any(dominated(p, q) for q in points if q is not p) for p in points]
+
+
+# ------------------------------------------------------------------ measuring
+
+def measure(lib, langs, samples, repeats, k, progress) -> dict:
     from tqdm import tqdm
 
-    from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
-    from generator.runtime.eval_kernel import shared_device
-
-    device = shared_device()
-    vecs = timing_samples(samples, seed=2)
-    rows = {s: {"spec": program(s, lib).spec, "time_ms": {}, "ratio": {}} for s in specs}
-    bar = tqdm(total=len(specs) * len(langs) + len(specs), disable=not progress, unit="kernel")
-    for lang in langs:
-        base = gpu_kernel(BASELINE, lang, lib, device)
-        bep = program(BASELINE, lib)
-        base.load(vecs, _param_block(bep, resolve_params(bep, {})))
-        for s in specs:
-            ep = program(s, lib)
-            bar.set_description(f"{lang} {s}")
-            kern = gpu_kernel(s, lang, lib, device)
-            own = {k_: v for k_, v in params.items() if k_ in ep.params}
-            kern.load(vecs, _param_block(ep, resolve_params(ep, own)))
-            ts, tb = time_pairs(kern, base, repeats)
-            rows[s]["time_ms"][lang] = 1e3 * float(np.median(ts))
-            ratios = np.asarray(ts) / np.asarray(tb)
-            rows[s]["ratio"][lang] = float(np.median(ratios))
-            rows[s].setdefault("ratio_quartiles", {})[lang] = [float(q) for q in np.percentile(ratios, [25, 75])]
-            rows[s].setdefault("time_ms_min", {})[lang] = 1e3 * float(np.min(ts))
-            if kern is not base:
-                kern.release()
+    found, notes = studies(lib)
+    every = default_specs(lib)
+    timer = Timer(lib, samples, repeats)
+    total = sum((len(s.kernels) + (1 if s.exact else 0)) * len(langs) for s in found) + len(every) * len(langs)
+    bar = tqdm(total=total, disable=not progress, unit="kernel")
+    out_studies = []
+    for st in found:
+        rows = []
+        members = list(st.kernels.items()) + ([("exact model's kernel", st.exact)] if st.exact else [])
+        for label, spec in members:
+            row = {"label": label, "spec": spec, "exact_kernel": spec == st.exact, "time": {}}
+            for lang in langs:
+                bar.set_description(f"{st.name} {lang} {label}")
+                row["time"][lang] = timer.ratio(spec, st.baseline, lang, st.params)
+                bar.update()
+            row["errors"] = errors(spec, st.exact_fn or st.exact, st.params, lib, k, langs[0])
+            rows.append(row)
+        pts = [{"error": r["errors"]["gpu"]["rel_rms"], **r["time"][langs[0]]} for r in rows]
+        for r, on in zip(rows, front(pts)):
+            r["front"] = on
+        out_studies.append({"name": st.name, "title": st.title, "exact": st.exact_label, "baseline": st.baseline,
+                            "params": st.params, "rows": rows})
+    bricks = []
+    for spec in every:
+        row = {"spec": spec, "time": {}}
+        for lang in langs:
+            bar.set_description(f"{lang} {spec}")
+            row["time"][lang] = timer.ratio(spec, LAMBERT, lang, {})
             bar.update()
-        base.release()
-    from generator.matrix.permutation import parse_brdf
-    for s in specs:
-        bar.set_description(f"error {s}")
-        ep = program(s, lib)
-        own = {k_: v for k_, v in params.items() if k_ in ep.params}
-        rows[s]["params"] = {n: (v[0] if len(v) == 1 else v) for n, v in resolve_params(ep, own).items()}
-        rows[s]["exact"] = "; ".join(exact_model(n) for n in parse_brdf(s, lib))
-        rows[s]["error"] = errors(s, rows[s]["params"], lib, k)
-        bar.update()
+        row["errors"] = errors(spec, spec, {}, lib, k, langs[0])
+        bricks.append(row)
     bar.close()
-    return {"device": device.name, "rows": list(rows.values())}
+    return {"device": timer.device.name, "studies": out_studies, "bricks": bricks, "notes": notes}
 
 
 # ------------------------------------------------------------------ reporting
-
-def pareto(points: list[tuple[float, float]]) -> list[bool]:
-    """True for points no other point beats in both coordinates (lower is better in both)."""
-    return [not any((q[0] <= p[0] and q[1] <= p[1]) and q != p for q in points) for p in points]
-
-
-def term_label(spec: str) -> str:
-    """'schlick / smith_schlick' for a microfacet spec: its Fresnel and geometry fillers."""
-    fill = dict(part.split("=") for part in spec[spec.index("(") + 1: -1].split(",")) if "(" in spec else {}
-    return f"{fill.get('fresnel', '?')} / {fill.get('vis', '?')}" if fill else spec
-
-
-def mark_pareto(report: dict) -> None:
-    """Pareto fronts within each group of kernels that approximate the same exact model.
-
-    Only groups with more than one kernel have a front; a brick that approximates
-    nothing (its error is float32 arithmetic) is compared with nothing.
-    """
-    lang = report["langs"][0]
-    groups: dict[str, list[dict]] = {}
-    for r in report["rows"]:
-        groups.setdefault(r["exact"], []).append(r)
-    for rows in groups.values():
-        front = pareto([(r["ratio"][lang], r["error"]["gpu"]["rel_rms"]) for r in rows])
-        for r, f in zip(rows, front):
-            r["pareto"] = f and len(rows) > 1
-
 
 def markdown(report: dict) -> str:
     langs = report["langs"]
     env = report["environment"]
     lines = [
-        "# Run time against error (lavapipe)",
-        "",
+        "# Run time against error (lavapipe)", "",
         f"Generated by `benchmarks/runtime_vs_error.py` on {env['device']} ({env['cpus']} CPUs, "
-        f"LP_NUM_THREADS={env['lp_num_threads']}); {report['samples']:,} samples per dispatch, median of "
-        f"{report['repeats']} dispatches (timestamp queries). `× Lambert`: median ratio of paired dispatches "
-        f"with the Lambert kernel of the same language. Error: the GLSL kernel on lavapipe against the exact "
-        f"model in float64 at the kernel's float32 inputs over {report['error_samples']:,} stratified "
-        f"hemisphere pairs (cosine-weighted relative RMS; max relative with a floor of {REL_FLOOR:g} sr⁻¹); `model`: the float64 emission of "
-        f"the same IR, i.e. the approximation alone; `F alone` / `G alone`: float64 error when only the "
-        f"kernel's Fresnel / only its geometry factor is approximated and the rest is exact. Pareto: among the kernels approximating the same "
-        f"exact model, no other is both faster ({langs[0].upper()} ratio) and more accurate. Load average "
-        f"(1 min) at start / end: {env['load_average'][0]:.2f} / {env['load_average'][1]:.2f}. Parameters: the bricks' defaults"
-        + (f" with {report['params']}" if report["params"] else "") + ".",
-        "",
-        "| kernel | exact model | " + " | ".join(f"{l.upper()} ms" for l in langs) + " | "
-        + " | ".join(f"× Lambert {l.upper()}" for l in langs)
-        + " | rel RMS (GPU) | max rel (GPU) | rel RMS (model) | F alone | G alone | Pareto |",
-        "|---|---|" + "---:|" * (2 * len(langs) + 5) + ":---:|",
-    ]
-    for r in report["rows"]:
-        e = r["error"]
-        errs = ([f"{e['gpu']['rel_rms']:.2e}", f"{e['gpu']['max_rel']:.2e}", f"{e['model']['rel_rms']:.2e}"]
-                + [f"{e[k]:.2e}" if k in e else "" for k in ("fresnel_only", "geometry_only")])
-        lines.append(f"| `{r['spec']}` | {r['exact']} | "
-                     + " | ".join(f"{r['time_ms'][l]:.2f}" for l in langs) + " | "
-                     + " | ".join(f"{r['ratio'][l]:.2f}" for l in langs) + " | "
-                     + " | ".join(errs) + f" | {'●' if r.get('pareto') else ''} |")
-    iqr = [q[1] - q[0] for r in report["rows"] for q in r["ratio_quartiles"].values()]
-    lines += ["", f"Spread of the paired ratios: median interquartile range {np.median(iqr):.2f} "
-              f"(max {np.max(iqr):.2f}); differences in the `× Lambert` columns smaller than that are noise. "
-              "Absolute times follow the machine's load; the ratios are paired to cancel it."]
+        f"LP_NUM_THREADS={env['lp_num_threads']}); {report['samples']:,} samples per dispatch, "
+        f"{report['repeats']} paired dispatches per kernel and language (timestamp queries). Time: the median ratio "
+        "of paired dispatches with the study's exact kernel (× exact; diffuse: × Lambert), in brackets the "
+        "pairs' interquartile range — two kernels whose ranges overlap are equally fast as far as this machine "
+        f"can tell. Error: cosine-weighted relative RMS against the exact model in float64 over "
+        f"{report['error_samples']:,} stratified hemisphere pairs, of the {langs[0].upper()} kernel on lavapipe "
+        "(float32) and of the float64 emission (`model`: the approximation alone); max rel with a floor of "
+        f"{REL_FLOOR:g} sr⁻¹. Front ●: no other kernel is more accurate without being slower beyond the noise. "
+        f"Load average (1 min) at start / end: {env['load_average'][0]:.2f} / {env['load_average'][1]:.2f}.", ""]
+    for st in report["studies"]:
+        unit = "× exact" if st["baseline"] != LAMBERT else "× Lambert"
+        lines += [f"## {st['title']}", "", f"Exact model: {st['exact']}."
+                  + (f" Parameters: {', '.join(f'{k} = {v}' for k, v in st['params'].items())}." if st["params"]
+                     else " Parameters: the bricks' defaults."), "",
+                  "| kernel | " + " | ".join(f"{l.upper()} {unit}" for l in langs)
+                  + " | rel RMS (GPU) | max rel (GPU) | rel RMS (model) | front |",
+                  "|---|" + "---:|" * (len(langs) + 3) + ":---:|"]
+        for r in st["rows"]:
+            e = r["errors"]
+            lines.append(f"| {r['label']} | " + " | ".join(
+                f"{r['time'][l]['ratio']:.2f} [{r['time'][l]['q25']:.2f}–{r['time'][l]['q75']:.2f}]" for l in langs)
+                + f" | {e['gpu']['rel_rms']:.2e} | {e['gpu']['max_rel']:.2e} | {e['model']['rel_rms']:.2e} | "
+                + ("●" if r["front"] else "") + " |")
+        lines.append("")
+    for note in report["notes"]:
+        lines += [f"Left out: {note}.", ""]
+    lines += ["## Every brick: time × Lambert and float32 error against its own reference", "",
+              "Each spec of `shadermatrix accuracy`'s default set at its bricks' defaults; the error is float32 "
+              "arithmetic alone (the model is its own reference), so it measures the brick's implementation, not "
+              "its choice of model.", "",
+              "| spec | " + " | ".join(f"{l.upper()} × Lambert" for l in langs) + " | rel RMS (GPU) | max rel (GPU) |",
+              "|---|" + "---:|" * (len(langs) + 2)]
+    for r in report["bricks"]:
+        e = r["errors"]["gpu"]
+        lines.append(f"| `{r['spec']}` | " + " | ".join(
+            f"{r['time'][l]['ratio']:.2f} [{r['time'][l]['q25']:.2f}–{r['time'][l]['q75']:.2f}]" for l in langs)
+            + f" | {e['rel_rms']:.2e} | {e['max_rel']:.2e} |")
+    iqr = [t["q75"] - t["q25"] for r in report["bricks"] for t in r["time"].values()]
+    lines += ["", f"Paired-ratio interquartile range over every brick and language: median {np.median(iqr):.3f}, "
+              f"max {np.max(iqr):.3f}. Absolute times follow the machine's load; the ratios are paired to cancel it."]
     return "\n".join(lines) + "\n"
 
 
 def plot(report: dict, path: Path) -> None:
-    """One panel per exact model with approximations (the microfacet NDFs): time ratio against error."""
+    """One panel per study: time ratio (error bar: the pairs' interquartile range) against error, log scale."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     lang = report["langs"][0]
-    groups: dict[str, list[dict]] = {}
-    for r in report["rows"]:
-        groups.setdefault(r["exact"], []).append(r)
-    multi = {k: v for k, v in groups.items() if len(v) > 1}
-    if not multi:
-        return
-    fig, axes = plt.subplots(1, len(multi), figsize=(5.2 * len(multi), 5.4), dpi=120, sharey=True, squeeze=False)
-    for ax, (exact, members) in zip(axes[0], sorted(multi.items())):
-        x = np.array([r["ratio"][lang] for r in members])
-        y = np.array([max(r["error"]["gpu"]["rel_rms"], 1e-9) for r in members])
-        front = np.array([bool(r.get("pareto")) for r in members])
-        ax.scatter(x[~front], y[~front], s=30, color="tab:gray", zorder=3, label="kernel")
-        ax.scatter(x[front], y[front], s=45, color="tab:red", zorder=4, label="Pareto front")
-        order = np.argsort(x[front])
-        ax.step(x[front][order], y[front][order], where="post", color="tab:red", lw=1.2, zorder=2)
-        for xi, yi, r in zip(x, y, members):
-            ax.annotate(term_label(r["spec"]), (xi, yi), textcoords="offset points", xytext=(4, 3), fontsize=7)
-        ndf, rest = exact.split(", ", 1)
-        ax.set_title(f"microfacet, {ndf.replace('D ', 'D = ')}\nagainst {rest}", fontsize=9)
+    sts = report["studies"]
+    cols = min(2, len(sts))
+    rows_n = math.ceil(len(sts) / cols)
+    fig, axes = plt.subplots(rows_n, cols, figsize=(7.0 * cols, 5.0 * rows_n), dpi=110, squeeze=False)
+    for ax, st in zip(axes.flat, sts):
+        rs = st["rows"]
+        x = np.array([r["time"][lang]["ratio"] for r in rs])
+        lo = x - np.array([r["time"][lang]["q25"] for r in rs])
+        hi = np.array([r["time"][lang]["q75"] for r in rs]) - x
+        y = np.array([max(r["errors"]["gpu"]["rel_rms"], 1e-9) for r in rs])
+        on = np.array([r["front"] for r in rs])
+        ex = np.array([r["exact_kernel"] for r in rs])
+        for sel, color, label in ((~on & ~ex, "tab:gray", "approximation"), (on & ~ex, "tab:red", "on the front"),
+                                  (ex, "tab:blue", "exact model's kernel (float32 error only)")):
+            if sel.any():
+                ax.errorbar(x[sel], y[sel], xerr=[lo[sel], hi[sel]], fmt="o", ms=6, color=color, capsize=3,
+                            label=label, zorder=3)
+        if on.sum() >= 2:  # a front is drawn only where speed buys error beyond the noise
+            order = np.argsort(x[on])
+            ax.step(x[on][order], y[on][order], where="post", color="tab:red", lw=1.0, zorder=2)
+        else:
+            ax.text(0.02, 0.02, "no front: the more accurate kernels are not slower beyond the noise",
+                    transform=ax.transAxes, fontsize=7, color="0.3")
+        order = np.argsort(y)
+        for rank, i in enumerate(order):  # labels alternate sides down the error axis, so close points stay legible
+            ax.annotate(rs[i]["label"], (x[i], y[i]), textcoords="offset points",
+                        xytext=(8, 4) if rank % 2 == 0 else (-8, -10), ha="left" if rank % 2 == 0 else "right",
+                        fontsize=7)
+        unit = "exact kernel" if st["baseline"] != LAMBERT else "Lambert"
+        ax.set_title(f"{st['title']}\nagainst: {st['exact']}", fontsize=9)
         ax.set_yscale("log")
+        span = max(np.max(x + hi) - np.min(x - lo), 0.1)
+        ax.set_xlim(np.min(x - lo) - 0.35 * span, np.max(x + hi) + 0.35 * span)
         ax.grid(True, which="both", alpha=0.3)
-        ax.set_xlabel(f"time × Lambert ({lang.upper()}, lavapipe)")
-    axes[0][0].set_ylabel("error vs exact model (cosine-weighted relative RMS)")
-    axes[0][0].legend(loc="lower left", fontsize=8)
-    exact_only = [r for r in report["rows"] if len(groups[r["exact"]]) == 1]
-    note = "Bricks without approximation (float32 error only): " + ", ".join(
-        f"{r['spec']} ×{r['ratio'][lang]:.2f} ({r['error']['gpu']['rel_rms']:.0e})" for r in exact_only)
-    fig.text(0.01, 0.01, note + f". Labels: Fresnel / geometry factor. {report['samples']:,} samples per dispatch.",
-             fontsize=7)
-    fig.suptitle("Run time against error: microfacet approximations on lavapipe", fontsize=11)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
+        ax.set_xlabel(f"time × {unit} ({lang.upper()} on lavapipe; bar: interquartile range of the pairs)", fontsize=8)
+        ax.set_ylabel("error vs exact model (cos-weighted rel. RMS)", fontsize=8)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3, fontsize=7, frameon=False)
+    for ax in list(axes.flat)[len(sts):]:
+        ax.set_axis_off()
+    fig.suptitle(f"Run time against error: approximations against the model they approximate "
+                 f"({report['samples']:,} samples per dispatch)", fontsize=11)
+    fig.tight_layout()
     tmp = path.with_suffix(".tmp.png")
     fig.savefig(tmp)
     plt.close(fig)
@@ -329,25 +410,21 @@ def plot(report: dict, path: Path) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--samples", type=positive, default=1 << 20, help="samples per dispatch (default 2^20)")
-    ap.add_argument("--repeats", type=positive, default=31, help="timed dispatches per kernel (default 31)")
-    ap.add_argument("--languages", default=",".join(LANGS), help="comma-separated, first one is plotted")
-    ap.add_argument("--param", action="append", default=[], metavar="NAME=VALUE", help="as in shadermatrix eval")
+    ap.add_argument("--repeats", type=positive, default=31, help="timed dispatch pairs per kernel (default 31)")
+    ap.add_argument("--languages", type=languages, default=",".join(GPU_TARGETS),
+                    help="comma-separated, from glsl, hlsl, wgsl; the first one is plotted and its errors measured")
     ap.add_argument("--grid", type=positive, default=12, help="k of the k⁴ error grid (default 12)")
     ap.add_argument("--out", type=folder, default=str(REPO / "benchmarks" / "results"),
                     help="the folder the table, JSON and plot go into (default benchmarks/results)")
     args = ap.parse_args(argv)
 
     from generator import __version__
+    from generator.io import atomic_write, show_progress
     from generator.library.bricks import load_library
-    from generator.io import atomic_write
-    from generator.cli.commands.eval import parse_params
 
     lib = load_library()
-    langs = tuple(args.languages.split(","))
-    params = parse_params(args.param)
-    specs = default_specs(lib)
     load_start = os.getloadavg()[0]
-    measured = measure(specs, langs, params, args.samples, args.repeats, args.grid, lib, sys.stderr.isatty())
+    measured = measure(lib, args.languages, args.samples, args.repeats, args.grid, show_progress())
     report = {
         "generator": __version__,
         "environment": {"device": measured["device"], "cpus": os.cpu_count(),
@@ -355,10 +432,11 @@ def main(argv=None) -> int:
                         "python": platform.python_version(), "numpy": np.__version__,
                         "load_average": [load_start, os.getloadavg()[0]]},
         "samples": args.samples, "repeats": args.repeats, "error_samples": args.grid ** 4,
-        "langs": list(langs), "params": params, "rows": measured["rows"],
+        "langs": list(args.languages), "studies": measured["studies"], "bricks": measured["bricks"],
+        "notes": measured["notes"],
     }
-    mark_pareto(report)
     out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
     atomic_write(out / "runtime_vs_error.json", (json.dumps(report, indent=2) + "\n").encode())
     atomic_write(out / "runtime_vs_error.md", markdown(report).encode())
     plot(report, out / "runtime_vs_error.png")
