@@ -23,7 +23,7 @@ approximation of Smith's; it appears in the second part only):
 - diffuse: Lambert, the Oren-Nayar family and Gotanda's fit (eq. 8) against the
   microfacet diffuse model Gotanda integrates (his eq. 4 and footnote 3: GGX D,
   Schlick-type F_diff, height-correlated Smith G on Lambertian facets),
-  computed by quadrature (generator/reference/diffuse.py), at σ = α = 0.5,
+  computed by quadrature (generator/reference/diffuse.py), at σ = α = 0.5 (Gotanda's fit reads α),
   f0 = 0.04, ρ_d = 1.
 
 Time: device time of one dispatch over `--samples` samples (timestamp queries),
@@ -126,7 +126,8 @@ def studies(lib) -> tuple[list[Study], list[str]]:
                "oren_nayar_improved": "oren_nayar_improved", "oren_nayar_fresnel": "oren_nayar_fresnel",
                "gotanda_fitted": "gotanda_fitted"},
               exact_label="Gotanda's microfacet diffuse model (eq. 4, quadrature)",
-              params={"sigma": DIFFUSE_SIGMA, "f0": [0.04] * 3, "rho_d": [1.0] * 3}, exact_fn=_diffuse_exact),
+              params={"sigma": DIFFUSE_SIGMA, "alpha": DIFFUSE_SIGMA, "f0": [0.04] * 3, "rho_d": [1.0] * 3},
+              exact_fn=_diffuse_exact),
     ]
     from generator.matrix.permutation import SpecError, parse_brdf
     have, notes = [], []

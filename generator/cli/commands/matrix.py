@@ -1,0 +1,56 @@
+"""`shadermatrix matrix SCENE [--explain]`: how the scene's matrix is pruned, stage by stage, and why.
+
+Counts: the full product of the axes the scene declares (BRDFs, packings, light
+configurations, output, precision), those the bricks' constraints allow, those
+the objects draw, and — after a build through the compile cache — those left
+when permutations with identical optimized SPIR-V merge. With --explain: every
+axis value kept or dropped and why, the combinations the constraints forbid and
+why, and the objects of every permutation.
+"""
+from __future__ import annotations
+
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+HELP = "how a scene's matrix is pruned: full product, valid, used, merged; --explain says why, value by value"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("--explain", action="store_true",
+                   help="every axis value kept or dropped and why, the forbidden combinations, each permutation's "
+                        "objects")
+    p.add_argument("--format", choices=("md", "json"), default="md", help="report format (default md)")
+    p.add_argument("--no-compile", action="store_true",
+                   help="leave out the merged count (it builds the scene, through the compile cache)")
+    p.add_argument("--cache-dir", metavar="DIR", help="the compile cache (default: as `build`'s)")
+    p.add_argument("--bricks", action="append", metavar="DIR", default=[],
+                   help="an extra brick directory (repeatable)")
+
+
+def spirv_identities(scene, lib, cache_dir) -> dict[str, tuple]:
+    """{permutation hash: its SPIR-V files, every language and stage} from a build into a temporary directory."""
+    from ...build import build_scene
+    from ...io import Store, default_cache_dir
+    root = cache_dir or default_cache_dir()
+    store = Store(root) if root else None
+    with tempfile.TemporaryDirectory(prefix="shadermatrix-matrix-") as tmp:
+        res = build_scene(scene, lib, Path(tmp), store=store)
+        return {p["hash"]: tuple(sorted((lang, stage, item["spirv"]) for lang, stages in p["languages"].items()
+                                        for stage, item in stages.items()))
+                for p in res.manifest["permutations"] if p.get("status") == "ok"}
+
+
+def run(args) -> int:
+    from ...library.bricks import load_library
+    from ...matrix.explain import markdown, report
+    from ...matrix.scene import load_scene
+
+    lib = load_library(args.bricks)
+    scene = load_scene(args.scene, lib)
+    spirv = None if args.no_compile else spirv_identities(scene, lib, args.cache_dir)
+    rep = report(scene, lib, spirv)
+    sys.stdout.write(markdown(rep, args.explain) if args.format == "md" else json.dumps(rep, indent=1) + "\n")
+    return 0

@@ -1,0 +1,159 @@
+"""How a scene's matrix is pruned, stage by stage, and why each axis value is kept or dropped.
+
+The axes of a scene's matrix are the values its declarations name: the BRDFs and
+packings of its materials, the light configurations of its light sets (light
+brick and shadow filter per light, in order), its output transform and its
+precision. Four counts:
+
+1. full product — every combination of the axes' values;
+2. valid — the combinations the bricks' constraints allow (CONSTRAINTS: a packing
+   that provides a parameter the BRDF does not read, a BRDF that reads the
+   tangent frame from a packing that supplies none, a packing that provides a
+   parameter with another type);
+3. used — the permutations the scene's objects draw (material × light set);
+4. merged — used permutations whose optimized SPIR-V is identical in every
+   language and stage are one shader (needs a build; its cache makes it cheap).
+
+The constraints are data (matrix/constraints.py): one Constraint per rule, each a
+predicate over a permutation's resolved bricks with the message and the fix it
+gives (Filament's variant filters, Unity's stripping log made readable);
+tests/test_explain.py holds their truth table.
+"""
+from __future__ import annotations
+
+from itertools import product
+
+from ..library.bricks import Library
+from .constraints import CONSTRAINTS
+from .permutation import Permutation, resolve
+from .scene import Scene
+
+
+def violations(perm: Permutation, lib: Library) -> list[tuple[str, str]]:
+    """(constraint name, why) for every constraint the permutation breaks; [] when it may exist."""
+    r = resolve(perm, lib)
+    return [(c.name, why) for c in CONSTRAINTS if (why := c.problem(r)[0])]
+
+
+def _first_seen(values) -> list:
+    out = []
+    for v in values:
+        if v not in out:
+            out.append(v)
+    return out
+
+
+def axes(scene: Scene) -> dict[str, list]:
+    """The values each axis takes in the scene's declarations, in declaration order."""
+    configs = _first_seen(tuple((scene.lights[n].type, scene.lights[n].shadow) for n in members)
+                          for members in scene.light_sets.values())
+    return {"brdf": _first_seen(m.brdf for m in scene.materials.values()),
+            "packing": _first_seen(m.packing for m in scene.materials.values()),
+            "lights": configs, "output": [scene.output], "precision": [scene.precision]}
+
+
+def _lights_text(config) -> str:
+    return ",".join(f"{t}/{s}" for t, s in config) or "-"
+
+
+def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) -> dict:
+    """The pruning report as data. spirv: {permutation hash: identity of its optimized SPIR-V (every language
+    and stage)} from a build, or None to leave the merged stage out."""
+    from .permutation import LightKey
+
+    ax = axes(scene)
+    full = 1
+    for values in ax.values():
+        full *= len(values)
+    pairs = {}
+    for brdf, packing in product(ax["brdf"], ax["packing"]):
+        pairs[(brdf, packing)] = violations(Permutation(brdf, (), packing, scene.output, scene.precision), lib)
+    valid_pairs = [k for k, v in pairs.items() if not v]
+    valid = len(valid_pairs) * len(ax["lights"]) * len(ax["output"]) * len(ax["precision"])
+
+    objects_of: dict[str, list[str]] = {h: list(users) for h, users in scene.users.items()}
+    materials_of: dict[str, list[str]] = {}
+    for o in scene.objects:
+        ms = materials_of.setdefault(o["permutation"], [])
+        if o["material"] not in ms:
+            ms.append(o["material"])
+    used = len(scene.permutations)
+
+    stages = [{"stage": "full product", "count": full,
+               "of": " × ".join(f"{len(v)} {k}" for k, v in ax.items())},
+              {"stage": "valid", "count": valid,
+               "of": f"{len(valid_pairs)} of {len(pairs)} BRDF × packing pairs pass the constraints, "
+                     f"× {len(ax['lights'])} light configurations"},
+              {"stage": "used", "count": used, "of": f"{len(scene.objects)} objects draw {used} distinct permutations; "
+                                                     f"{valid - used} valid combinations are drawn by no object"}]
+    merged_into: dict[str, str] = {}
+    if spirv is not None:
+        first: dict[tuple, str] = {}
+        for h in scene.permutations:
+            ident = spirv.get(h)
+            if ident is None:
+                continue
+            merged_into[h] = first.setdefault(ident, h)
+        stages.append({"stage": "merged", "count": len(set(merged_into.values())),
+                       "of": "used permutations with identical optimized SPIR-V in every language and stage "
+                             "are one shader"})
+
+    drawn = {h: p for h, p in scene.permutations.items()}
+    values = []
+    for axis, vals in ax.items():
+        for v in vals:
+            if axis == "brdf":
+                mats = [m.name for m in scene.materials.values() if m.brdf == v]
+                hs = [h for h, p in drawn.items() if p.brdf == v]
+            elif axis == "packing":
+                mats = [m.name for m in scene.materials.values() if m.packing == v]
+                hs = [h for h, p in drawn.items() if p.packing == v]
+            elif axis == "lights":
+                sets = [n for n, members in scene.light_sets.items()
+                        if tuple((scene.lights[x].type, scene.lights[x].shadow) for x in members) == v]
+                mats = sets
+                key = tuple(LightKey(t, s) for t, s in v)
+                hs = [h for h, p in drawn.items() if p.lights == key]
+            else:
+                mats, hs = [], list(drawn)
+            objs = [o for h in hs for o in objects_of.get(h, [])]
+            if objs:
+                why = f"kept: drawn by {len(objs)} object(s) ({_names(objs)}) in {len(hs)} permutation(s)"
+            elif axis == "lights":
+                why = f"dropped: light set(s) {_names(mats)} are lit on no object"
+            else:
+                why = f"dropped: material(s) {_names(mats)} are drawn by no object"
+            values.append({"axis": axis, "value": _lights_text(v) if axis == "lights" else v,
+                           "kept": bool(objs), "why": why, "declared_by": mats, "permutations": hs})
+    invalid = [{"brdf": b, "packing": p, "why": [f"{n}: {w}" for n, w in pairs[(b, p)]]}
+               for (b, p) in pairs if pairs[(b, p)]]
+    perms = [{"hash": h, "key": p.canonical(), "materials": materials_of.get(h, []), "objects": objects_of.get(h, []),
+              **({"merged_into": merged_into[h]} if h in merged_into and merged_into[h] != h else {})}
+             for h, p in scene.permutations.items()]
+    return {"scene": scene.name, "stages": stages, "axes": values, "invalid": invalid, "permutations": perms,
+            "constraints": [{"name": c.name, "doc": c.doc} for c in CONSTRAINTS]}
+
+
+def _names(xs, limit: int = 6) -> str:
+    xs = list(xs)
+    return ", ".join(xs[:limit]) + (f" and {len(xs) - limit} more" if len(xs) > limit else "")
+
+
+def markdown(rep: dict, explain: bool) -> str:
+    out = [f"# The matrix of scene {rep['scene']}", "", "| stage | permutations | how |", "|---|---:|---|"]
+    out += [f"| {s['stage']} | {s['count']:,} | {s['of']} |" for s in rep["stages"]]
+    if not explain:
+        return "\n".join(out) + "\n"
+    out += ["", "## Axis values", "", "| axis | value | kept | why |", "|---|---|---|---|"]
+    out += [f"| {v['axis']} | `{v['value']}` | {'yes' if v['kept'] else 'no'} | {v['why']} |" for v in rep["axes"]]
+    out += ["", "## Combinations the constraints forbid", ""]
+    out += ([f"- `{x['brdf']}` with `{x['packing']}`: {'; '.join(x['why'])}" for x in rep["invalid"]]
+            or ["None: every BRDF × packing pair of the scene is valid."])
+    out += ["", "Constraints (generator/matrix/constraints.py): "
+            + "; ".join(f"`{c['name']}` — {c['doc']}" for c in rep["constraints"]) + ".",
+            "", "## Permutations and their objects", "", "| permutation | materials | objects | merged into | key |",
+            "|---|---|---|---|---|"]
+    out += [f"| `{p['hash']}` | {', '.join(p['materials'])} | {', '.join(p['objects'])} | "
+            f"{('`' + p['merged_into'] + '`') if 'merged_into' in p else ''} | `{p['key']}` |"
+            for p in rep["permutations"]]
+    return "\n".join(out) + "\n"
