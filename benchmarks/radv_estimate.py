@@ -103,7 +103,7 @@ def main() -> int:
     all_scene = scene_rows(example, lib, gpu=request)
     assert not request.note and not request.errors, (request.note, request.errors)
     (RESULTS / "costs_example_gpu.md").write_text(markdown(all_scene, f"Costs of scene {example.name}", None,
-                                                           request))
+                                                           request, course=True, languages=True))
     scene = [r for r in all_scene if r.gpu and not r.error]
     kernels = kernel_rows(lib, families)
     rows = scene + kernels
