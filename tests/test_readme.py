@@ -49,8 +49,8 @@ def test_concrete_readme_command_runs(cmd, tmp_path):
         assert argv[1] in targets, f"README shows `{cmd}` but the Makefile has no such target"
         if argv[1] in ("test", "goldens"):  # test runs this file; goldens would rewrite the goldens
             return
-    elif argv[0] == "shadermatrix":
-        argv[0] = str(REPO / ".venv" / "bin" / "shadermatrix")
+    elif argv[0] in ("shadermatrix", "pytest"):  # as after `. .venv/bin/activate`
+        argv[0] = str(REPO / ".venv" / "bin" / argv[0])
     env = dict(os.environ)
     env.pop("SHADERMATRIX_FORBID_TOOLS", None)
     env.pop("SHADERMATRIX_FORBID_DEVICE", None)

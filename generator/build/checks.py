@@ -1,0 +1,71 @@
+"""Per-permutation compile checks an engine's CI runs: `shadermatrix check` and the pytest plugin share them.
+
+A check is one permutation of a scene in one language: composed, compiled to
+SPIR-V, validated (spirv-val) and optimized, through the compile cache. A
+failure reads as the brick line that caused it (the compilers' diagnostics are
+mapped back through #line). Golden sources: `<golden>/<language>/<hash>.<stage>.<language>`,
+the emitted source of each permutation (named by permutation, not by content,
+so a drift is a diff of one file).
+"""
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..library.bricks import Library
+from ..matrix.scene import Scene
+from ..targets import LANGUAGES
+
+
+@dataclass(frozen=True)
+class Check:
+    """One permutation × language of a scene."""
+
+    hash: str
+    language: str
+    objects: tuple[str, ...]
+
+    @property
+    def id(self) -> str:
+        return f"{self.hash}-{self.language}"
+
+
+def checks(scene: Scene, languages=LANGUAGES) -> list[Check]:
+    return [Check(h, lang, tuple(scene.users.get(h, ()))) for h in sorted(scene.permutations) for lang in languages]
+
+
+def run_check(scene: Scene, lib: Library, check: Check, store=None) -> tuple[list[str], dict[str, str]]:
+    """(errors, {golden-relative path: emitted source}) of one check; no errors when it compiles and validates."""
+    from ..compose import compose_permutation
+    from ..lang import SourceError
+    from ..toolchain import compile_many
+    from ..toolchain.scenes import source_jobs
+
+    perm = scene.permutations[check.hash]
+    try:
+        composed = compose_permutation(perm, lib, (check.language,))
+    except SourceError as e:
+        return [str(e)], {}
+    sources = {f"{s.language}/{check.hash}.{s.stage}.{s.language}": s.text for s in composed.sources}
+    results = compile_many(source_jobs(check.hash, composed.sources), optimize=True, validate=True, store=store)
+    errors = [line for r in results.values() if not r.ok for line in r.errors()]
+    return errors, sources
+
+
+def golden_diff(golden: Path, sources: dict[str, str]) -> list[str]:
+    """Unified diffs of emitted sources against `golden` (a missing golden file is a diff from nothing)."""
+    out = []
+    for rel, text in sorted(sources.items()):
+        path = golden / rel
+        old = path.read_text(encoding="utf-8") if path.is_file() else ""
+        if old != text:
+            out += difflib.unified_diff(old.splitlines(keepends=True), text.splitlines(keepends=True),
+                                        f"golden/{rel}", f"emitted/{rel}")
+    return out
+
+
+def default_store(cache_dir=None):
+    from ..io import Store, default_cache_dir
+    root = cache_dir or default_cache_dir()
+    return Store(root) if root else None

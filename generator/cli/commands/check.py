@@ -1,0 +1,68 @@
+"""`shadermatrix check SCENE [--golden DIR]`: compile and validate every permutation × language, as a CI does.
+
+One line per check (`ok` or the failure as the brick line that caused it), then a
+summary; with --golden DIR, the emitted sources are compared with
+DIR/<language>/<hash>.<stage>.<language> and every drift is printed as a unified
+diff (--update-golden writes them instead). Exit 1 on a failure or a drift.
+The same checks run as pytest tests through the plugin: `pytest --shadermatrix-scene SCENE`.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ...lang.errors import UsageError
+
+HELP = "compile and validate every permutation × language of a scene (a CI's check); --golden DIR diffs the sources"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("--golden", metavar="DIR", help="compare the emitted sources with DIR/<language>/<hash>.<stage>.<ext>")
+    p.add_argument("--update-golden", action="store_true", help="with --golden: write the emitted sources there")
+    p.add_argument("--languages", default="glsl,hlsl,wgsl", metavar="LIST",
+                   help="comma-separated, from glsl, hlsl, wgsl (default all)")
+    p.add_argument("--cache-dir", metavar="DIR", help="the compile cache (default: as `build`'s)")
+    p.add_argument("--bricks", action="append", metavar="DIR", default=[],
+                   help="an extra brick directory (repeatable)")
+
+
+def run(args) -> int:
+    from ...build.checks import checks, default_store, golden_diff, run_check
+    from ...io import atomic_write
+    from ...library.bricks import load_library
+    from ...matrix.scene import load_scene
+    from ...targets import LANGUAGES
+
+    langs = [x.strip() for x in args.languages.split(",") if x.strip()]
+    if not langs or any(x not in LANGUAGES for x in langs):
+        raise UsageError(f"--languages {args.languages!r}: use a comma-separated list from {', '.join(LANGUAGES)}")
+    if args.update_golden and not args.golden:
+        raise UsageError("--update-golden needs --golden DIR — e.g. --golden tests/golden/scene --update-golden")
+    lib = load_library(args.bricks)
+    scene = load_scene(args.scene, lib)
+    store = default_store(args.cache_dir)
+    failed = drifted = 0
+    todo = checks(scene, langs)
+    for c in todo:
+        errors, sources = run_check(scene, lib, c, store)
+        if errors:
+            failed += 1
+            print(f"FAIL {c.id} ({', '.join(c.objects)}):", file=sys.stderr)
+            for e in errors:
+                print(f"  {e}", file=sys.stderr)
+            continue
+        if args.golden and args.update_golden:
+            for rel, text in sources.items():
+                atomic_write(Path(args.golden) / rel, text.encode())
+        elif args.golden:
+            diff = golden_diff(Path(args.golden), sources)
+            if diff:
+                drifted += 1
+                print(f"DRIFT {c.id} ({', '.join(c.objects)}):", file=sys.stderr)
+                sys.stderr.writelines(diff)
+                continue
+        print(f"ok {c.id}")
+    print(f"{len(todo) - failed - drifted} of {len(todo)} checks pass ({len(scene.permutations)} permutations × "
+          f"{len(langs)} languages); {failed} failed, {drifted} drifted from the golden sources", file=sys.stderr)
+    return 1 if failed or drifted else 0
