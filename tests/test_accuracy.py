@@ -122,9 +122,14 @@ def test_float32_microfacet_peaks_keep_their_digits_down_to_alpha_1e_4(numpy_flo
     # textbook (n·h)²(α²-1)+1. Bound: 64 ulp x the sharpness 2/α² ... capped at 5e-4
     # (measured 2.1e-4 at α = 1e-4, where 2/α² ulps would be meaningless).
     for spec in SPECS:
-        if "vis=torrance_sparrow" in spec or not spec.startswith("microfacet"):
-            continue  # Torrance-Sparrow's n·l cap is measured below
-        for key, err in numpy_float32[(spec, "stress")]["by_param"].items():
+        if "vis=smith_schlick)" not in spec or not spec.startswith("microfacet"):
+            continue  # the NDFs, under the default geometry term (Torrance-Sparrow's n·l cap is measured below;
+            # the other geometry terms' own grazing errors are in their accuracy verdicts)
+        by_param = numpy_float32[(spec, "stress")]["by_param"]
+        if "_anisotropic" in spec:  # alpha_u and alpha_v sweep down to 1e-4 in every batch: the cap holds
+            assert max(by_param.values()) <= 5e-4, (spec, by_param)
+            continue
+        for key, err in by_param.items():
             if key.startswith("alpha=") and float(key[6:]) > 0.0:
                 a = float(key[6:])
                 assert err <= min(5e-4, 64 * EPS32 * (1 + 2 / a ** 2 / 16)), (spec, key, err)
@@ -231,7 +236,7 @@ def test_command_errors(tmp_path, capsys):
          "diffuse brick 'no_reference' has no float64 reference"),
         (["accuracy", "lambrt", "--targets", "numpy"], "unknown diffuse/specular brick 'lambrt'"),
         (["accuracy", "lambert", "--targets", "numpy,metal"], "unknown target 'metal'"),
-        (["accuracy", "lambert", "--targets", "glsl", "--dtypes", "float16"], "GPU targets run float32 only"),
+        (["accuracy", "lambert", "--targets", "glsl", "--dtypes", "float64"], "GPU targets run float32"),
         (["accuracy", "lambert", "--targets", "numpy", "--samples", "0"], "--samples 0"),
         (["accuracy", "lambert", "--targets", "numpy", "--samples", "100"], "--samples 100 is outside 1 … 40"),
     ]

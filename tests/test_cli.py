@@ -113,7 +113,7 @@ lights = "s"
      "'microfacet' has no slot 'dnf'"),
     ("params = { n = 32.0 }", "params = { n = 0.5 }", "3:12", "0.5 is outside the range [1.0, 100000.0]"),
     ("params = { n = 32.0 }", "params = { m = 32.0 }", "3:12", "unknown parameter 'm'"),
-    ('type = "directional"', 'type = "spot"', "5:1", "unknown type 'spot'"),
+    ('type = "directional"', 'type = "spotlight"', "5:1", "unknown type 'spotlight'"),
     ('material = "m"', 'material = "x"', "10:1", "unknown material 'x'"),
     ("[light_sets]", "[light_sets", "6:12", "TOML syntax error"),
 ])
@@ -148,7 +148,7 @@ def test_bricks_lists_kinds_slots_params_and_citations():
     assert r.returncode == 0, r.stderr
     rows = {(b["kind"], b["id"]): b for b in json.loads(r.stdout)}
     mf = rows[("specular", "microfacet")]
-    assert mf["slots"]["ndf"]["fillers"] == ["beckmann", "blinn_phong", "ggx"]
+    assert mf["slots"]["ndf"]["fillers"] == ["beckmann", "beckmann_anisotropic", "blinn_phong", "ggx", "ggx_anisotropic", "ward"]
     assert mf["params"]["alpha"] == {"type": "float", "range": [0.0, 1.0], "default": 0.3, "doc": mf["params"]["alpha"]["doc"]}
     assert all(b["cite"] for b in rows.values())
     assert ("diffuse", "lambert") in rows and ("light", "point") in rows

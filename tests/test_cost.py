@@ -210,8 +210,8 @@ def test_every_brick_and_slot_filler_has_a_row_and_no_stand_in_does(fixture_bric
             assert any(s.endswith(f"={bid}") for s in subjects), bid
         elif b.slots and kind in ("diffuse", "specular"):
             assert any(s.startswith(f"{bid}(") for s in subjects), bid  # named with its default fillers
-        else:
-            assert bid in subjects, bid
+        else:  # a brick with an array parameter is named with its count: lafortune(lobes=4,K=4)
+            assert bid in subjects or any(s.startswith(f"{bid}(") for s in subjects), bid
     shadow = _rows(fixture_brick_rows, "shadow_map")
     assert all(r.cost.texture == 1 and r.stage == "frag" for r in shadow.values())
 
@@ -227,7 +227,11 @@ def test_course_models_are_data_and_a_new_brick_adds_its_row(fixture_brick_rows)
         assert all(r.cost.texture == 1 for r in variant)  # the albedo texture
     from generator.measure.plans import brick_rows, course_models, load_cost_library
     assert "Ashikhmin-Shirley" in {m.name for m in course_models()[0]}
-    assert not any(r.subject == "Ashikhmin-Shirley" for r in fixture_brick_rows)
+    # every direct-form model has its brick now (issue 11); the factored forms have none: no row
+    for model in ("Ashikhmin-Shirley", "Lafortune"):
+        rows = [r for r in fixture_brick_rows if r.table == "model" and r.subject == model]
+        assert {r.course.table for r in rows} == {"shift-invariant", "shift-variant"} and not any(r.error for r in rows)
+    assert not any(r.course.form == "factored" for r in fixture_brick_rows if r.course)
 
 
 # ------------------------------------------------------------------ CLI, scene, manifest
@@ -311,7 +315,8 @@ def test_bricks_table_markdown_shows_course_figures():
     assert r.returncode == 0, r.stderr
     assert re.search(r"\| Blinn-Phong \| direct \| shift-invariant \| `lambert\+blinn_phong_normalized` \| 0 \| 7 \|",
                      r.stdout)
-    assert "| Lafortune | direct | shift-invariant |  | 0 | 10 + 5n | no brick yet |" in r.stdout
+    assert "| Banks | factored | shift-invariant |  | 1 | 5 | no brick yet |" in r.stdout
+    assert "| Lafortune | direct | shift-invariant | `lambert+lafortune` | 0 | 10 + 5n |" in r.stdout
     assert "standin" not in r.stdout.split("## The course's models")[0].split("## Per brick")[1]
 
 

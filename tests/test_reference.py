@@ -78,9 +78,15 @@ def test_reference_equals_the_float64_emission_of_the_brick(spec, hemi):
         rtol = max(1e-12, 8 * EPS64 * _kappa(spec, p))
         if "ndf=blinn_phong" in spec:  # its series for ln(1 - x) is exact to float32, not float64
             rtol += _kappa(spec, p) * 2e-11
+        if "vis=smith_beckmann" in spec:  # its erfc is Abramowitz & Stegun 7.1.26: G1 to 7.5e-8 per factor
+            rtol += 2e-7
         bound = rtol * np.abs(ref) + 1e-15 * np.abs(ref).max()
         worst = (np.abs(got - ref) / bound)[keep].max()
         assert worst <= 1.0, (spec, p, float(worst))
+
+
+# Bricks whose f_r carries 1/n·l alone (no n·v beside it to keep the lobe's peak the batch's maximum).
+OVER_COS_L = {"phong"}
 
 
 @pytest.mark.parametrize("spec", ALL_SPECS)
@@ -94,22 +100,34 @@ def test_float32_emission_is_within_a_stated_tolerance_of_the_reference(spec, he
         ref = reference_brdf(spec, *given, p)
         got = evaluate(spec, *given, p, target="numpy", dtype="float32")
         rtol = 64 * EPS32 * (1.0 + _kappa(spec, p) / 16.0)
+        if spec in OVER_COS_L:  # f ∝ 1/n·l: the float32 n·l's rounding (~1 ulp of 1, relative 8 ε32/n·l at most)
+            rtol = rtol + 8 * EPS32 / shading_geometry(*given).NdotL[:, None]
         bound = rtol * np.abs(ref) + 2.0 ** -20 * np.abs(ref).max()
         worst = (np.abs(got - ref) / bound)[keep].max()
         assert worst <= 1.0, (spec, p, float(worst))
 
 
-@pytest.mark.parametrize("spec", ALL_SPECS)
+# Bricks that are not reciprocal by design, and why (ACCURACY-FACTS §4.6); their tests say so.
+NOT_RECIPROCAL = {
+    "phong": "the course's original Phong, k_s (cos α_r)^n / (π cos θ_i): the 1/cos θ_i is the light's alone "
+             "(tests/test_library_specular.py asserts the asymmetry)",
+    "gotanda_fitted": "Gotanda 2014 eq. 8 is a fit: F_r reads n·e only, L_m n·l only "
+                      "(tests/test_library_diffuse.py asserts the asymmetry)",
+}
+
+
+@pytest.mark.parametrize("spec", [s for s in ALL_SPECS if getattr(s, "values", (s,))[0] not in NOT_RECIPROCAL])
 def test_reciprocity(spec):
-    # Every brick present is reciprocal (ACCURACY-FACTS §4.6); the n·v clamp of the
-    # shading policy is not, so both cosines stay above 1e-3.
+    # Every brick present is reciprocal (ACCURACY-FACTS §4.6) but NOT_RECIPROCAL; the n·v clamp
+    # of the shading policy is not, so both cosines stay above 1e-3. T = x (tangent-frame bricks).
     rng = np.random.default_rng(7)
     L = accuracy.direction(rng.uniform(1e-3, 1, 2000), rng.uniform(0, 2 * np.pi, 2000))
     V = accuracy.direction(rng.uniform(1e-3, 1, 2000), rng.uniform(0, 2 * np.pi, 2000))
     N = np.broadcast_to([0.0, 0.0, 1.0], L.shape)
+    T = np.broadcast_to([1.0, 0.0, 0.0], L.shape)
     for target in ("reference", "numpy"):
-        a = evaluate(spec, L, V, N, target=target, dtype="float64")
-        b = evaluate(spec, V, L, N, target=target, dtype="float64")
+        a = evaluate(spec, L, V, N, T, target=target, dtype="float64")
+        b = evaluate(spec, V, L, N, T, target=target, dtype="float64")
         rel = np.abs(a - b) / np.maximum(np.abs(a), 1e-300)
         assert rel.max() <= 1e-12, (spec, target, float(rel.max()))
 
@@ -121,9 +139,10 @@ def test_policy_no_light_from_below_and_view_below_the_horizon_shades_as_grazing
     L = accuracy.direction(np.array([0.6]), np.array([0.0]))
     below = accuracy.direction(np.array([-0.2]), np.array([np.pi]))
     graze = accuracy.direction(np.array([1e-4]), np.array([np.pi]))
+    T = np.array([[1.0, 0.0, 0.0]])  # for the tangent-frame bricks
     for spec in SPECS:
-        assert np.all(reference_brdf(spec, -L, graze, N) == 0.0), spec
-        f = reference_brdf(spec, L, below, N)
+        assert np.all(reference_brdf(spec, -L, graze, N, T) == 0.0), spec
+        f = reference_brdf(spec, L, below, N, T)
         assert np.all(np.isfinite(f)) and np.all(f >= 0.0), spec
     # n·v is clamped, h comes from the true v: Lambert ignores v, Smith-Schlick sees n·v = 1e-4
     g = shading_geometry(L, below, N)
@@ -135,7 +154,7 @@ def test_undefined_half_vector_is_zero_and_gives_finite_values():
     g = shading_geometry(L, -L, [0.0, 0.0, 1.0])
     assert g.NdotH[0] == 0.0 and g.VdotH[0] == 0.0 and g.NxH2[0] == 1.0
     for spec in SPECS:
-        f = reference_brdf(spec, L, -L, [0.0, 0.0, 1.0])
+        f = reference_brdf(spec, L, -L, [0.0, 0.0, 1.0], [0.0, 1.0, 0.0])  # T for the tangent-frame bricks
         assert np.all(np.isfinite(f)), spec
 
 

@@ -99,6 +99,11 @@ def _templates_used(lang: str, main: str) -> dict[str, str]:
 LINE_RESET = "//@line-reset"
 
 
+def _function(prog, name: str):
+    """The linked function `name` of a program (an entry point)."""
+    return next(f for f in prog.functions if f.name == name)
+
+
 def _render(template: str, target, ctx: dict, emitted, name: str) -> Source:
     """Render one template; `name` is the generated file's name for #line resets."""
     text = env().get_template(template).render(target=target, functions=emitted.text, **ctx)
@@ -122,22 +127,25 @@ def _provenance(kind: str, key: str, h: str, bricks: dict, templates: dict) -> l
 
 # ------------------------------------------------------------------ eval kernel
 
-def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram | None = None) -> Composed:
-    """The compute eval kernel of one BRDF spec (or a linked `ep`): f_r for each (L, V, N[, T]) sample."""
+def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram | None = None,
+                 precision: str = "fp32") -> Composed:
+    """The compute eval kernel of one BRDF spec (or a linked `ep`): f_r for each (L, V, N[, T]) sample
+    (precision "fp16": the BRDF computes in half; samples, parameters and result stay 32-bit)."""
     ep = ep or eval_program(spec, lib)
     prog, canon, h = ep.program, ep.spec, ep.hash
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
     sources = []
     for lang in languages:
-        target = get_target(lang)
+        target = get_target(lang, precision)
         emitted = target.emit(prog.structs, prog.functions)
+        emitted, entry = target.entry32(emitted, _function(prog, ep.entry))  # fp16: a 32-bit wrapper
         tname = f"{lang}/eval.{lang}.j2"
         used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance("eval", canon, h, bricks, used),
                "params": ep.slots, "param_vec4s": max(ep.param_vec4s, 1), "tangent": ep.tangent,
-               "brdf": target.ident(ep.entry), "switch": ep.entry == "brdf_switch",
+               "brdf": entry, "switch": ep.entry == "brdf_switch",
                "textures": ep.interface.textures}
         sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
     return Composed(canon, h, sources, bricks, templates, ep.interface)
@@ -173,13 +181,14 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
     layout_ = ["P", "Ng", "V"] + (["T"] if "T" in surface else []) + (["uv"] if "uv" in surface else [])
     templates, sources = {}, []
     for lang in languages:
-        target = get_target(lang)
+        target = get_target(lang, perm.precision)
         emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
         tname = f"{lang}/shade.{lang}.j2"
         used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance("shade kernel", perm.canonical(), h, bricks, used),
-               "inputs": surface, "samples": layout_, "call_args": _call_args(lp), "shade": target.ident("shade"),
+               "inputs": surface, "samples": layout_, "call_args": _call_args(lp), "shade": shade,
                "material_vec4s": iface.block("Material").members[-1]["size"] // 16,
                "light_vec4s": iface.block("Lights").members[-1]["size"] // 16, "uber": False}
         sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
@@ -197,8 +206,9 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
     call_args = _call_args(lp)
     mat, lights = iface.block("Material"), iface.block("Lights")
     for lang in languages:
-        target = get_target(lang)
+        target = get_target(lang, perm.precision)
         emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
         for stage in ("vertex", "fragment"):
             tname = f"{lang}/{stage}.{lang}.j2"
             used = _templates_used(lang, tname)
@@ -206,8 +216,8 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
             ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, used),
                    "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
                    "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
-                   "textures": iface.textures, "call_args": call_args, "shade": target.ident("shade"),
-                   "iface": iface, "spell": lambda name, _t=target: _t.type_name(BUILTIN_TYPES[name])}
+                   "textures": iface.textures, "call_args": call_args, "shade": shade,
+                   "iface": iface, "spell": lambda name, _t=get_target(lang): _t.type_name(BUILTIN_TYPES[name])}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
     return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)

@@ -9,7 +9,7 @@ from ..link.uber import Uber, link_ubershader
 from ..matrix.permutation import Permutation
 from ..targets import LANGUAGES, get_target
 from ..targets.base import Emitted
-from . import Composed, _provenance, _render, _templates_used
+from . import Composed, _function, _provenance, _render, _templates_used
 
 MATERIAL_INDEX = {"glsl": "draw.material.x", "hlsl": "draw_material.x", "wgsl": "draw.material.x"}
 
@@ -31,6 +31,12 @@ def _call_args(u: Uber, material: dict | None) -> list[dict]:
     return out
 
 
+def _precision(perms) -> str:
+    """The permutations' precision when they all share one (a scene's), else fp32."""
+    found = {p.precision for p in perms}
+    return found.pop() if len(found) == 1 else "fp32"
+
+
 def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAGES,
                        specialized: bool = False) -> tuple[Composed, Uber]:
     """The fragment ubershader (and its vertex shader) standing in for every permutation of `perms`.
@@ -44,16 +50,18 @@ def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAG
     prog = u.program
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates, sources = {}, []
+    precision = _precision(perms)
     for lang in languages:
-        target = get_target(lang)
+        target = get_target(lang, precision)
         emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
         for stage, tname in (("vertex", f"{lang}/vertex.{lang}.j2"), ("fragment", f"{lang}/ubershader.{lang}.j2")):
             used = _templates_used(lang, tname)
             templates.update(used)
             ctx = {"provenance": _provenance("ubershader", f"{len(perms)} permutations", h, bricks, used),
-                   "inputs": iface.surface, "textures": iface.textures, "shade": target.ident("shade"),
+                   "inputs": iface.surface, "textures": iface.textures, "shade": shade,
                    "call_args": _call_args(u, MATERIAL_INDEX[lang]), "iface": iface,
-                   "spell": lambda name, _t=target: _t.type_name(BUILTIN_TYPES[name])}
+                   "spell": lambda name, _t=get_target(lang): _t.type_name(BUILTIN_TYPES[name])}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"ubershader.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
     return Composed(key, h, sources, bricks, templates, iface), u
@@ -73,14 +81,16 @@ def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUA
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     layout_ = ["P", "Ng", "V"] + (["T"] if "T" in u.surface else []) + (["uv"] if "uv" in u.surface else [])
     templates, sources = {}, []
+    precision = _precision(perms)
     for lang in languages:
-        target = get_target(lang)
+        target = get_target(lang, precision)
         emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
         tname = f"{lang}/shade.{lang}.j2"
         used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance("ubershader kernel", f"{len(perms)} permutations", h, bricks, used),
-               "inputs": u.surface, "samples": layout_, "call_args": _call_args(u, None), "shade": target.ident("shade"),
+               "inputs": u.surface, "samples": layout_, "call_args": _call_args(u, None), "shade": shade,
                "material_vec4s": 1, "light_vec4s": 1, "uber": True}
         sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
     return Composed(key, h, sources, bricks, templates, iface), u

@@ -34,13 +34,31 @@ REL_FLOOR = 1e-6
 # A sample is ill-conditioned in a dtype when rounding its inputs alone changes the reference
 # by more than this (relative, with REL_FLOOR).
 ILL_CONDITIONED = 0.1
+# A batch is broken (Errors.broken_by_param, fp16_limits) when its relative error exceeds this: the value is
+# off by more than itself.
+BREAK_REL = 1.0
+# The fp16 verdict (reported beside the float32 one, never the exit status): the hemisphere at the default
+# parameters within FP16_TOL and free of NaN/Inf on every fp16 run. fp16 rounds at 2^-11 ≈ 4.9e-4 per
+# operation; a BRDF's chain of a few dozen operations and a pow() stays within a few percent.
+FP16_TOL = 5e-2
 GRAZING = (0.0, 1e-7, 1e-4, 1e-2)
 SWEEPS = {
     "alpha": (0.0, 1e-4, 1e-3, 1e-2, 0.3, 1.0),
     "n": (1.0, 10.0, 100.0, 1e3, 1e4, 1e5),
     "f0": (0.0, 0.04, 1.0),
+    "alpha_u": (1e-4, 1e-2, 0.5),  # anisotropic GGX/Beckmann NDF and Smith (issue 11 fillers)
+    "alpha_v": (1e-3, 1.0),
+    "eta": (0.2, 1.0, 1.5),  # conductor_exact: metal-like, the degenerate index 1 (with k = 0), glass
+    "k": (0.0, 3.5),
     "sigma": (0.0, 0.3, 0.6, 1.2),
     "rho_d": (0.0, 1.0),
+    "k_s": (0.0, 1.0),
+    "m": (1e-4, 1e-3, 1e-2, 0.3, 1.0),
+    "m_u": (1e-4, 1e-2, 1.0),
+    "m_v": (1e-4, 0.3, 1.0),
+    "n_u": (1.0, 100.0, 1e5),
+    "n_v": (1.0, 1e3, 1e5),
+    "s": (0.0, 1.0),
 }
 
 
@@ -237,14 +255,19 @@ class Errors:
     worst: dict = field(default_factory=dict)  # the sample of max_rel: case, params, value, reference
     by_param: dict = field(default_factory=dict)  # "alpha=0.001" -> max rel over the batches with that value
     by_case: dict = field(default_factory=dict)  # stress geometry label -> max rel (both frames)
+    # "alpha=0.001" -> {stress geometry label: [batches where it broke, batches]}: a geometry breaks in a batch
+    # when a sample of it (either frame) gives a NaN or Inf or a relative error above BREAK_REL (fp16_limits)
+    broken_by_param: dict = field(default_factory=dict)
 
     def add(self, got: np.ndarray, ref: np.ndarray, labels: list[str], params: dict,
             comparable: np.ndarray | None = None) -> None:
         """Fold one batch ((n, 3) arrays) into the statistics; `comparable`: (n,) well-conditioned samples."""
         self.nan += int(np.count_nonzero(np.isnan(got)))
         self.inf += int(np.count_nonzero(np.isinf(got)))
+        nonfinite = ~np.isfinite(got).all(axis=1)
         if params.get("alpha") == 0:
             self.dirac += got.size
+            self._tally(params, labels, nonfinite)
             return
         nan_ref = np.isnan(ref)
         if nan_ref.any():
@@ -258,6 +281,7 @@ class Errors:
         self.ref_inf += int(np.count_nonzero(inf_ref))
         m = keep[:, None] & np.isfinite(got) & ~inf_ref
         if not m.any():
+            self._tally(params, labels, nonfinite)
             return
         with np.errstate(invalid="ignore", over="ignore"):
             a = np.abs(got - ref)
@@ -270,6 +294,7 @@ class Errors:
         self.max_abs = max(self.max_abs, float(a[m].max()))
         r = np.where(m, rel, -1.0)
         i, j = np.unravel_index(int(np.argmax(r)), r.shape)
+        self._tally(params, labels, nonfinite | (r.max(axis=1) > BREAK_REL))
         for k, v in _plain(params).items():
             key = f"{k}={v:g}" if not isinstance(v, list) else f"{k}={v}"
             self.by_param[key] = max(self.by_param.get(key, 0.0), float(r[i, j]))
@@ -283,6 +308,23 @@ class Errors:
             self.max_rel = float(r[i, j])
             self.worst = {"case": labels[i], "params": _plain(params),
                           "value": float(got[i, j]), "reference": float(ref[i, j])}
+
+    def _tally(self, params: dict, labels: list[str], broken: np.ndarray) -> None:
+        """Count, per parameter value and stress geometry, the batches where the geometry broke."""
+        cases: dict[str, bool] = {}
+        for lab, b in zip(labels, broken.tolist()):
+            case = lab.removesuffix(" [rotated]")
+            cases[case] = cases.get(case, False) or b
+        for key in _param_keys(params):
+            per = self.broken_by_param.setdefault(key, {})
+            for case, b in cases.items():
+                c = per.setdefault(case, [0, 0])
+                c[0] += int(b)
+                c[1] += 1
+
+
+def _param_keys(params: dict) -> list[str]:
+    return [f"{k}={v:g}" if not isinstance(v, list) else f"{k}={v}" for k, v in _plain(params).items()]
 
 
 def _plain(params: dict) -> dict:
@@ -328,13 +370,38 @@ def default_targets() -> list[str]:
 
 
 def runs(targets, dtypes) -> list[tuple[str, str]]:
-    """(target, dtype) pairs to measure: numpy in each dtype asked, GPU languages in float32."""
+    """(target, dtype) pairs to measure: numpy in each dtype asked; GPU languages in float32, and in float16
+    (their fp16 kernels) where the device reports shaderFloat16 (gpu_fp16(); skipped_runs() says why not)."""
     out = []
     for t in targets:
         for d in dtypes:
             if t == "numpy" or (t in GPU_TARGETS and d == "float32"):
                 out.append((t, d))
+            elif t in GPU_TARGETS and d == "float16" and gpu_fp16()[0]:
+                out.append((t, d))
     return out
+
+
+def skipped_runs(targets, dtypes) -> list[dict]:
+    """The (target, dtype) pairs asked for that runs() leaves out, each with the reason."""
+    out = []
+    for t in targets:
+        for d in dtypes:
+            if t in GPU_TARGETS and d == "float64":
+                out.append({"run": f"{t}/{d}", "why": "GPU targets compute in float32 or float16"})
+            elif t in GPU_TARGETS and d == "float16" and not gpu_fp16()[0]:
+                out.append({"run": f"{t}/{d}", "why": gpu_fp16()[1]})
+    return out
+
+
+def gpu_fp16() -> tuple[bool, str]:
+    """(whether the GPU targets run float16 here, why not): the shared device must report shaderFloat16
+    (asked of the process-wide device each time: opening it is cached there, not the answer)."""
+    from .evaluate import gpu_fp16_status
+    try:
+        return gpu_fp16_status()
+    except Exception as exc:  # no Vulkan device at all (or none may be opened here)
+        return False, f"no Vulkan device ({exc})"
 
 
 def declared_params(spec: str, lib) -> dict:
@@ -381,8 +448,9 @@ def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12, params: dic
                     got = evaluate(spec, *given, s.params, target=t, dtype=d, lib=lib)
                 stats[f"{t}/{d}"].add(got, refs[d][0], s.labels, s.params, refs[d][1])
         out[set_name] = stats
-    for t in sorted({t for t, _ in runs(targets, dtypes) if t in GPU_TARGETS}):
-        gpu_kernel(spec, t, lib).release()  # its buffers have the largest batch's size; the pipeline stays
+    for t, d in sorted({(t, d) for t, d in runs(targets, dtypes) if t in GPU_TARGETS}):  # float32 and float16
+        gpu_kernel(spec, t, lib, precision="fp16" if d == "float16" else "fp32").release()  # buffers of the
+        # largest batch's size; the pipeline stays
     return out
 
 
@@ -412,10 +480,10 @@ def run(specs, targets, dtypes, lib, hemisphere_k: int = 12, tol: float = DEFAUL
     bad = [r for r in results if r["dtype"] == "float32" and (r["nan"] or r["inf"])]
     return {"rel_floor": REL_FLOOR, "specs": list(specs), "runs": [f"{t}/{d}" for t, d in runs(targets, dtypes)],
             "results": results, "float32_finite": not bad, "tolerance": tol,
-            "verdicts": verdicts(results, specs, tol)}
+            "verdicts": verdicts(results, specs, tol, lib), "skipped": skipped_runs(targets, dtypes)}
 
 
-def verdicts(results: list[dict], specs, tol: float) -> list[dict]:
+def verdicts(results: list[dict], specs, tol: float, lib=None) -> list[dict]:
     """Per spec: pass when float32 gives no NaN or Inf anywhere and its hemisphere max relative error is at most
     tol on every target; with the worst hemisphere error (and where) and the worst stress case (and which).
     Where no float32 ran (--dtypes float64), the dtypes that ran are judged instead."""
@@ -434,7 +502,105 @@ def verdicts(results: list[dict], specs, tol: float) -> list[dict]:
                     "hemisphere_target": hemi["target"] if hemi else None,
                     "stress_max_rel": stress["max_rel"] if stress else None,
                     "stress_target": stress["target"] if stress else None,
-                    "stress_case": f"{case['case']} {case['params'] or ''}".strip() if case else None})
+                    "stress_case": f"{case['case']} {case['params'] or ''}".strip() if case else None,
+                    **fp16_verdict(mine, _defaults(mine[0].get("brdf", spec) if mine else spec, lib))})
+    return out
+
+
+def _defaults(spec: str, lib) -> dict:
+    """{parameter: default} of a BRDF spec ({} without a library, or for a spec that does not parse)."""
+    if lib is None:
+        return {}
+    try:
+        return {k: d for k, (_ty, d, _rng) in declared_params(spec, lib).items()}
+    except Exception:
+        return {}
+
+
+def fp16_verdict(mine: list[dict], defaults: dict | None = None) -> dict:
+    """The fp16 columns of one spec's verdict, from its float16 results (numpy and the GPU fp16 kernels):
+    fp16_pass (None when no float16 ran): the hemisphere, at the default parameters, has no NaN or Inf
+    and a max relative error of at most FP16_TOL on every float16 run; the worst hemisphere error and its
+    target; NaN/Inf counts of both sets; and fp16_limits(), where the stress set's parameters break it.
+    Reported beside the float32 verdict, which alone decides pass/fail."""
+    f16 = [r for r in mine if r["dtype"] == "float16"]
+    if not f16:
+        return {"fp16_pass": None}
+    hemi = [r for r in f16 if r["set"] == "hemisphere"]
+    worst = max(hemi, key=lambda r: r["max_rel"], default=None)
+    hemi_bad = sum(r["nan"] + r["inf"] for r in hemi)
+    stress_bad = sum(r["nan"] + r["inf"] for r in f16 if r["set"] == "stress")
+    return {"fp16_pass": not hemi_bad and (worst is None or worst["max_rel"] <= FP16_TOL),
+            "fp16_targets": sorted({r["target"] for r in f16}),
+            "fp16_hemisphere_max_rel": worst["max_rel"] if worst else None,
+            "fp16_hemisphere_target": worst["target"] if worst else None,
+            "fp16_hemisphere_nan_inf": hemi_bad, "fp16_stress_nan_inf": stress_bad,
+            "fp16_limits": fp16_limits([r for r in f16 if r["set"] == "stress"], defaults),
+            "fp16_broken_cases": fp16_broken_cases([r for r in f16 if r["set"] == "stress"], defaults)}
+
+
+def fp16_limits(stress: list[dict], defaults: dict | None = None) -> dict[str, str]:
+    """Per parameter: which of its swept values break the BRDF in fp16, from the stress set's
+    broken_by_param merged over the runs given (a geometry is broken at a value when it broke in every
+    batch holding that value, whatever the other parameters were, on some run). A value is a limit when
+    it breaks a geometry that the parameter's baseline value does not: the swept value nearest its
+    default (`defaults`: {name: default}; without one, the value breaking the fewest geometries).
+    Geometries broken at the baselines already are fp16_broken_cases().
+
+    {"alpha": ">= 0.01 (breaks at 0.0001, 0.001)", "n": "<= 1000 (breaks at 1e+04, 1e+05)"}; parameters
+    with no limit are left out."""
+    out = {}
+    for name, values in _broken_sets(stress).items():
+        base = values[_baseline(name, values, defaults)]
+        limit = {v: bool(c - base) for v, c in values.items()}
+        try:
+            order = sorted(limit, key=float)
+        except ValueError:  # vector values ("[0.1, 0.2]"): listed, not ordered
+            order = sorted(limit)
+        bad = [v for v in order if limit[v]]
+        if not bad:
+            continue
+        good = [v for v in order if not limit[v]]
+        where = ", ".join(bad)
+        if good and order.index(bad[-1]) < order.index(good[0]):
+            out[name] = f">= {good[0]} (breaks at {where})"
+        elif good and order.index(bad[0]) > order.index(good[-1]):
+            out[name] = f"<= {good[-1]} (breaks at {where})"
+        else:
+            out[name] = f"breaks at {where}"
+    return out
+
+
+def fp16_broken_cases(stress: list[dict], defaults: dict | None = None) -> list[str]:
+    """The stress geometries broken at the baseline value of every parameter (near the defaults)."""
+    sets = [values[_baseline(name, values, defaults)] for name, values in _broken_sets(stress).items()]
+    return sorted(set.intersection(*sets)) if sets else []
+
+
+def _baseline(name: str, values: dict[str, set], defaults: dict | None) -> str:
+    """The swept value of `name` nearest its default (on a log scale for positive numbers), else the value
+    breaking the fewest geometries."""
+    d = (defaults or {}).get(name)
+    d = d[0] if isinstance(d, (list, tuple)) and d else d
+    try:
+        nums = {v: float(v) for v in values}
+        d = float(d)
+    except (TypeError, ValueError):
+        return min(values, key=lambda v: (len(values[v]), v))
+
+    def dist(x: float) -> float:
+        return abs(math.log(x) - math.log(d)) if x > 0 and d > 0 else abs(x - d) + (1e9 if d > 0 else 0)
+    return min(nums, key=lambda v: dist(nums[v]))
+
+
+def _broken_sets(stress: list[dict]) -> dict[str, dict[str, set]]:
+    """{parameter: {value: geometries broken in every batch holding the value, on some run}}."""
+    out: dict[str, dict[str, set]] = {}
+    for r in stress:
+        for key, cases in r.get("broken_by_param", {}).items():
+            name, _, value = key.partition("=")
+            got = out.setdefault(name, {}).setdefault(value, set())
+            got |= {c for c, (b, n) in cases.items() if n and b == n}
     return out
 
 
@@ -467,6 +633,29 @@ def markdown(report: dict, detail: bool = False) -> str:
                       if v["stress_max_rel"] is not None else "–")
             lines.append(f"| `{v['spec']}` | {'pass' if v['pass'] else '**FAIL**'} | {hemi} | "
                          f"{v['float32_nan_inf']} | {stress} |")
+        lines.append("")
+    fp16 = [v for v in report.get("verdicts", []) if v.get("fp16_pass") is not None]
+    if fp16:
+        lines += ["## fp16 per spec (reported, not judged)", "",
+                  f"fp16 verdict: the hemisphere at the default parameters has no NaN or Inf and a max relative "
+                  f"error of at most {FP16_TOL:g} on every float16 run ({', '.join(fp16[0]['fp16_targets'])}). "
+                  "Limits: the swept parameter values that keep the BRDF working in fp16 (a value breaks when a "
+                  "stress geometry gives NaN, Inf or a relative error above "
+                  f"{BREAK_REL:g} in every batch holding the value, and does not at the swept value nearest the "
+                  "parameter's default); the geometries already broken there are listed apart.", "",
+                  "| spec | fp16 verdict | fp16 hemisphere max rel (target) | hemisphere NaN/Inf | stress NaN/Inf "
+                  "| fp16 limits | stress geometries broken near the defaults |", "|---|---|---|---|---|---|---|"]
+        for v in fp16:
+            hemi = (f"{_fmt(v['fp16_hemisphere_max_rel'])} ({v['fp16_hemisphere_target']})"
+                    if v["fp16_hemisphere_max_rel"] is not None else "–")
+            limits = "; ".join(f"{k} {x}" for k, x in v["fp16_limits"].items()) or "none in the sweeps"
+            lines.append(f"| `{v['spec']}` | {'pass' if v['fp16_pass'] else 'fail'} | {hemi} | "
+                         f"{v['fp16_hemisphere_nan_inf']} | {v['fp16_stress_nan_inf']} | {limits} | "
+                         f"{'; '.join(v['fp16_broken_cases']) or 'none'} |")
+        lines.append("")
+    for sk in report.get("skipped", []):
+        lines.append(f"Not run: {sk['run']} — {sk['why']}.")
+    if report.get("skipped"):
         lines.append("")
     lines += ["## NaN / Inf per run (every spec, both sample sets)", "", "| run | NaN | Inf |", "|---|---|---|"]
     for run_ in report["runs"]:

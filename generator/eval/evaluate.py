@@ -9,8 +9,12 @@ used as given (nothing is normalized unless a brick does it).
   float64, float32 or float16 (inputs and parameters are rounded to that dtype).
 - ``glsl`` / ``hlsl`` / ``wgsl``: that language's eval kernel (compose_eval),
   compiled with the project toolchain (validated, spirv-opt -O) and dispatched
-  on lavapipe, float32 only. The device, compiled pipelines and loaded NumPy
-  programs are cached per process, so sweeps pay for compilation once.
+  on lavapipe, float32 or float16. float16 is the fp16 kernel (compose_eval
+  precision "fp16": the BRDF and glue compute in half; samples, parameters and
+  the result stay 32-bit and are converted at the kernel's entry and exit) and
+  needs a device reporting shaderFloat16 (EvalError otherwise; lavapipe has it).
+  The device, compiled pipelines and loaded NumPy programs are cached per
+  process, so sweeps pay for compilation once.
 
 Parameters default to the bricks' defaults; a scalar for a vector parameter
 splats. Every bad input raises :class:`EvalError` ("what — what to do").
@@ -198,24 +202,40 @@ def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int, texels=()
     return np.broadcast_to(np.asarray(out, np.float64), (n, 3)).copy()
 
 
-def gpu_kernel(spec: str, language: str, lib=None, device=None):
-    """The cached EvalKernel of a spec in one language on `device` (default: the shared lavapipe device)."""
+def gpu_kernel(spec: str, language: str, lib=None, device=None, precision: str = "fp32"):
+    """The cached EvalKernel of a spec in one language on `device` (default: the shared lavapipe device);
+    precision "fp16" gives the half kernel (the device must report shaderFloat16)."""
     from ..runtime.eval_kernel import compile_kernel, shared_device
 
     lib = library_or_builtin(lib)
     ep = program(spec, lib)
     device = device or shared_device()
-    key = ("eval", lib.serial, ep.spec, language)  # kernels live on their device
-    if key not in device.cache:
-        src = compose_eval(ep.spec, lib, (language,), ep=ep).sources[0]
+    key = ("eval", lib.serial, ep.spec, language) + ((precision,) if precision != "fp32" else ())
+    if key not in device.cache:  # kernels live on their device
+        src = compose_eval(ep.spec, lib, (language,), ep=ep, precision=precision).sources[0]
         device.cache[key] = compile_kernel(src, device, ep.tangent, ep.param_vec4s, textures=len(ep.textures))
     return device.cache[key]
 
 
-def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, texels=()) -> np.ndarray:
+def gpu_fp16_status(device=None) -> tuple[bool, str]:
+    """(whether fp16 eval kernels run on the device, why not): the device must report shaderFloat16."""
+    from ..runtime.eval_kernel import shared_device
+
+    device = device or shared_device()
+    if device.fp16:
+        return True, ""
+    return False, f"{device.name} does not report shaderFloat16 (VkPhysicalDeviceShaderFloat16Int8Features)"
+
+
+def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, texels=(), dtype: str = "float32") -> np.ndarray:
     from ..runtime.eval_kernel import Texture
 
-    kernel = gpu_kernel(ep.spec, language, lib)
+    if dtype == "float16":
+        ok, why = gpu_fp16_status()
+        if not ok:
+            raise EvalError(f"target {language} cannot run float16 here: {why}",
+                            "evaluate float32 on the GPU, or float16 with --target numpy")
+    kernel = gpu_kernel(ep.spec, language, lib, precision="fp16" if dtype == "float16" else "fp32")
     f32 = [v.astype(np.float32) for v in vecs]
     textures = [Texture(np.asarray(x), bool(d.get("srgb"))) for x, (_, _, d) in zip(texels, ep.textures)]
     return kernel.run(f32, _param_block(ep, values), textures=textures or None).astype(np.float64)
@@ -230,17 +250,19 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
     filters the same texels the same way.
 
     dtype: float64 (default) for reference and numpy; float32/float16 for numpy;
-    GPU targets compute in float32 (the default for them; any other is an error).
+    GPU targets compute in float32 (their default) or float16 (the fp16 kernel, where the
+    device reports shaderFloat16); float64 is an error for them. Inputs and parameters reach
+    the fp16 kernel as float32 and are rounded to half inside it.
     """
     if target not in EVAL_TARGETS:
         raise EvalError(f"unknown target {target!r}", f"use one of {', '.join(EVAL_TARGETS)}")
     if dtype is not None:
         dtype = np.dtype(dtype).name if isinstance(dtype, type) or hasattr(dtype, "name") else str(dtype)
     if target in GPU_TARGETS:
-        if dtype not in (None, "float32"):
-            raise EvalError(f"target {target} runs in float32 on lavapipe, not {dtype}",
-                            "pass --dtype float32 (or none) for GPU targets; numpy runs float16/float64")
-        dtype = "float32"
+        if dtype not in (None, "float32", "float16"):
+            raise EvalError(f"target {target} runs in float32 or float16 on lavapipe, not {dtype}",
+                            "pass --dtype float32 (or none) or float16 for GPU targets; numpy runs float64")
+        dtype = dtype or "float32"
     elif target == "reference":
         if dtype not in (None, "float64"):
             raise EvalError(f"the reference is float64 only, not {dtype}",
@@ -262,5 +284,5 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
         return _run_reference(ep, vecs, values, n)
     if target == "numpy":
         return _run_numpy(ep, lib, vecs, values, dtype, n, texels)
-    return _run_gpu(ep, lib, target, vecs, values, texels)
+    return _run_gpu(ep, lib, target, vecs, values, texels, dtype)
 

@@ -27,7 +27,7 @@ BUILTIN_BRICKS = REPO / "bricks"
 
 
 PARAM_TYPES = ("float", "vec2", "vec3", "vec4", "mat4")
-META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc"}
+META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc", "fp16"}
 
 
 @dataclass
@@ -53,6 +53,17 @@ class Brick:
     textures: dict[str, dict]
     cite: str
     doc: str
+    # "fp16": "unsafe: why" where the brick cannot be made safe in half (build warns for an fp16
+    # permutation using it); "" or any other note ("guarded: ...") otherwise
+    fp16: str = ""
+
+    @property
+    def fp16_unsafe(self) -> str:
+        """Why the brick is unsafe in fp16 ("" when it is not marked unsafe)."""
+        note = self.fp16.strip()
+        if not note.lower().startswith("unsafe"):
+            return ""
+        return note.partition(":")[2].strip() or "marked unsafe"
 
     @property
     def entries(self) -> list[ir.Function]:
@@ -207,7 +218,8 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     if kind == "packing" and "normal" not in slots:
         raise _meta_error(shown, loc, "a packing brick needs a 'normal' slot (the shading normal it provides)",
                           '"slots": {"normal": {"kind": "normal", "default": "vertex"}}')
-    brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip())
+    brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip(),
+                  str(meta.get("fp16", "")).strip())
     _check_entries(brick, loc)
     return brick
 

@@ -28,6 +28,7 @@ BRICK_SCHEMA = {
         "kind": {"type": "string"},
         "cite": {"type": "string", "maxLength": 1000},
         "doc": {"type": "string"},
+        "fp16": {"type": "string", "maxLength": 1000},  # "unsafe: why" makes an fp16 build warn
         "needs": {"type": "array", "items": IDENT},
         "params": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type", "default"],

@@ -19,7 +19,7 @@ from ..lang import SourceError
 from ..lang.errors import UserError
 
 _TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[0-9]+|[()+=,])")
-PRECISIONS = ("fp32",)  # fp16 is on the roadmap (issue: accuracy); the key keeps the axis
+PRECISIONS = ("fp32", "fp16")  # fp16: the BRDF and glue arithmetic in half (targets/*Half*), the interface 32-bit
 
 
 class SpecError(UserError, ValueError):
@@ -243,26 +243,27 @@ def resolve(perm: Permutation, lib: Library) -> Resolved:
 
 
 def check_packing(r: Resolved) -> tuple[str, str]:
-    """('', '') when the packing fits the BRDF, else (what is wrong, what to do)."""
-    from ..library.inputs import BY_NAME, SHADING
-    from ..library.params import spec_params
+    """('', '') when the packing fits the BRDF, else (what is wrong, what to do): the first rule of
+    matrix/constraints.py the permutation breaks."""
+    from .constraints import first_problem
+    return first_problem(r)
 
-    params = spec_params(r.brdf)
-    brdf = "+".join(n.canonical() for n in r.brdf)
-    for f in r.packing.brick.entries:
-        name = f.name[len("get_"):]
-        if name not in params:
-            return (f"packing '{r.packing.brick.id}' provides {name}, which BRDF '{brdf}' does not read",
-                    "use the constants packing for this BRDF")
-        if f.ret != params[name].ty:
-            return (f"packing '{r.packing.brick.id}' provides {name} as {f.ret} ({r.packing.brick.display_path}:"
-                    f"{f.loc.line}), but BRDF '{brdf}' reads {name} as {params[name].ty}",
-                    f"make get_{name} return {params[name].ty}")
-    tangent = sorted({p.name for n in r.brdf for x in n.walk() for f in x.brick.entries for p in f.params
-                      if p.name in SHADING and BY_NAME[p.name].tangent})
-    frame = any(p.name in ("T", "B") for x in r.packing.walk() for f in x.brick.entries for p in f.params)
-    if tangent and not frame:
-        return (f"BRDF '{brdf}' reads {', '.join(tangent)} (the tangent frame), but packing "
-                f"'{r.packing.canonical()}' supplies no tangent",
-                f"fill its normal slot with vertex_tangent or normal_map, e.g. {r.packing.brick.id}(normal=vertex_tangent)")
-    return "", ""
+
+def fp16_warnings(perms, lib: Library) -> list[str]:
+    """One line per fp16 permutation and brick it uses whose metadata says "fp16": "unsafe: why"
+    (`build` prints them as warnings; the permutation still builds)."""
+    out = []
+    for perm in perms:
+        if perm.precision != "fp16":
+            continue
+        r = resolve(perm, lib)
+        nodes = [n for top in (*r.brdf, r.packing, *(s for _, s in r.lights)) for n in top.walk()]
+        bricks = [n.brick for n in nodes] + [b for b, _ in r.lights] + [r.output]
+        seen = set()
+        for b in bricks:
+            why = b.fp16_unsafe
+            if why and (b.kind, b.id) not in seen:
+                seen.add((b.kind, b.id))
+                out.append(f"fp16 permutation {perm.hash} ({perm.brdf}) uses {b.kind} brick '{b.id}', "
+                           f"unsafe in fp16: {why} ({b.display_path})")
+    return out

@@ -187,7 +187,7 @@ def load_scene(path, lib: Library) -> Scene:
         _check_params(loc, f"materials.{name}", params, specs, f"BRDF '{brdf}'")
         problem, todo = check_packing(resolve(Permutation(brdf, (), packing, output), lib))
         if problem:
-            raise loc.error(loc.find(f"materials.{name}", "packing"), problem, todo)
+            raise loc.error(loc.find(f"materials.{name}", "packing"), f"material '{name}': {problem}", todo)
         scene.materials[name] = Material(name, brdf, packing, params)
 
     for name, li in _table(loc, data, "lights").items():

@@ -216,15 +216,28 @@ def _consumer(lib: Library, packing: Brick, pair) -> str | None:
         for b in lib.of_kind(kind):
             if not is_standin(b) and wanted <= set(b.params):
                 return pair(kind, b.id)
+    # what no one term reads, a diffuse + specular pair may (the course's specular map: rho_d, f0, n)
+    for d in (x for x in lib.of_kind("diffuse") if not is_standin(x) and not x.slots):
+        for s in (x for x in lib.of_kind("specular") if not is_standin(x) and not x.slots):
+            if wanted <= set(d.params) | set(s.params) and not _reads_tangent(f"{d.id}+{s.id}", lib):
+                return f"{d.id}+{s.id}"
     return None
 
 
-def _with_standin_slots(b: Brick, lib: Library) -> str:
-    """A brick's spec with every slot filled by its kind's stand-in."""
+def _with_standin_slots(b: Brick, lib: Library, normal: str | None = None) -> str:
+    """A brick's spec with every slot filled by its kind's stand-in (a packing's normal slot by `normal` if given)."""
     if not b.slots:
         return b.id
-    fillers = [f"{slot}={standin(lib, v['kind']).id}" for slot, v in b.slots.items()]
+    fillers = [f"{slot}={normal if normal and v['kind'] == 'normal' else standin(lib, v['kind']).id}"
+               for slot, v in b.slots.items()]
     return f"{b.id}({','.join(fillers)})"
+
+
+def _reads_tangent(spec: str, lib: Library) -> bool:
+    """Whether a BRDF spec reads a tangent-frame row of the inputs table (an anisotropic model)."""
+    from ..library.inputs import BY_NAME
+    return any(p.name in BY_NAME and BY_NAME[p.name].tangent
+               for top in parse_brdf(spec, lib) for n in top.walk() for f in n.brick.entries for p in f.params)
 
 
 @dataclass
@@ -259,6 +272,8 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -
         plans.append(_Plan(table, subject, kind, batch.perm(perm), batch.perm(baseline), course))
 
     hosts = [b for k in BRDF_KINDS for b in lib.of_kind(k) if b.slots and not is_standin(b)]
+    # a slot filler is measured in one host (microfacet when there is one), so its row is named once
+    hosts.sort(key=lambda h: h.id != "microfacet")
     for kind in KINDS:
         sub = standin(lib, kind)
         for b in (x for x in lib.of_kind(kind) if not is_standin(x)):
@@ -270,10 +285,10 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -
                     continue
                 eval_plan("brick", subject, kind, pair(kind, b.id), pair(kind, sub.id))
             elif any(v["kind"] == kind for h in hosts for v in h.slots.values()):
-                for h in hosts:
-                    for slot in (s for s, v in h.slots.items() if v["kind"] == kind):
-                        eval_plan("brick", f"{slot}={b.id}", kind, pair(h.kind, f"{h.id}({slot}={b.id})"),
-                                  pair(h.kind, f"{h.id}({slot}={sub.id})"))
+                h = next(h for h in hosts if any(v["kind"] == kind for v in h.slots.values()))
+                for slot in (s for s, v in h.slots.items() if v["kind"] == kind):
+                    eval_plan("brick", f"{slot}={b.id}", kind, pair(h.kind, f"{h.id}({slot}={b.id})"),
+                              pair(h.kind, f"{h.id}({slot}={sub.id})"))
             elif kind == "light":
                 perm_plan("brick", b.id, kind, replace(base, lights=(LightKey(b.id, base.lights[0].shadow),)))
             elif kind == "shadow":
@@ -304,8 +319,10 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -
         eval_plan("model", m.name, "brdf", m.spec, stand, m.invariant)
         packing = lib.find(variant_packing, ("packing",))
         if packing:
+            # an anisotropic model needs the mesh's tangent: the packing's normal slot takes vertex_tangent
+            normal = "vertex_tangent" if _reads_tangent(m.spec, lib) else None
             perm_plan("model", m.name, "brdf",
-                      replace(base, brdf=m.spec, packing=_with_standin_slots(packing[0], lib)), m.variant,
+                      replace(base, brdf=m.spec, packing=_with_standin_slots(packing[0], lib, normal)), m.variant,
                       baseline=replace(base, brdf=stand))
 
     batch.run()

@@ -183,6 +183,8 @@ def slot_function(fn: Callable, g: Geometry, p: dict) -> Callable:
 def _term(node, g: Geometry, p: dict) -> np.ndarray:
     slots = {slot: slot_function(lookup(filler.brick.kind, filler.brick.id), g, p)
              for slot, filler in node.fillers}
+    if node.counts:  # an array parameter's element count, a key constant: `<array>_count` as the brick reads it
+        p = {**p, **{f"{a}_count": c for a, c in node.counts}}
     return lookup(node.brick.kind, node.brick.id)(g, p, slots)
 
 
@@ -208,3 +210,6 @@ def missing_references(lib=None) -> list[str]:
     from ..library.bricks import library_or_builtin
     lib = library_or_builtin(lib)
     return [f"{k}/{b.id}" for k in REFERENCES for b in lib.of_kind(k) if b.id not in REFERENCES[k]]
+from . import diffuse as _diffuse  # noqa: E402,F401  (the diffuse references of issue 11)
+from . import specular as _specular  # noqa: E402,F401
+from . import fillers as _fillers  # noqa: E402,F401

@@ -60,6 +60,7 @@ class ComputePipeline:
             if unknown:
                 raise ValueError(f"unknown binding kinds {unknown}: use {', '.join(kinds)}")
             self._types = [kinds[b] for b in self.bindings]
+            spirv = device.fit_spirv(spirv)  # fp16: drop naga's unused StorageInputOutput16 where unsupported
             self.module = vk.vkCreateShaderModule(dev, vk.VkShaderModuleCreateInfo(
                 codeSize=len(spirv), pCode=spirv), None)
             self.set_layout = vk.vkCreateDescriptorSetLayout(dev, vk.VkDescriptorSetLayoutCreateInfo(

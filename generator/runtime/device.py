@@ -38,6 +38,37 @@ STATISTICS_EXTENSION = "VK_KHR_pipeline_executable_properties"
 VALIDATION_LAYER = "VK_LAYER_KHRONOS_validation"
 
 
+STORAGE_INPUT_OUTPUT_16 = 4436  # SPIR-V capability StorageInputOutput16
+_FLOAT16 = 9  # SPIR-V capability Float16
+_OP_CAPABILITY = 17
+
+
+def _capabilities(spirv: bytes):
+    """(word offset, capability) of each OpCapability; capabilities open every module."""
+    words = np.frombuffer(spirv, np.uint32)
+    i = 5
+    while i + 1 < len(words) and int(words[i]) & 0xFFFF == _OP_CAPABILITY:
+        yield i, int(words[i + 1])
+        i += max(int(words[i]) >> 16, 1)
+
+
+def uses_float16(spirv: bytes) -> bool:
+    """Whether the module declares OpCapability Float16 (an fp16 shader)."""
+    return any(c == _FLOAT16 for _, c in _capabilities(spirv))
+
+
+def drop_capabilities(spirv: bytes, drop: set[int]) -> bytes:
+    """The module without its `OpCapability X` instructions for X in `drop` (nothing else changes)."""
+    words = np.frombuffer(spirv, np.uint32)
+    cut = {i for i, c in _capabilities(spirv) if c in drop}
+    if not cut:
+        return spirv
+    keep = np.ones(len(words), bool)
+    for i in cut:
+        keep[i: i + 2] = False
+    return words[keep].astype(np.uint32).tobytes()
+
+
 class VulkanUnavailable(EnvironmentMissing, RuntimeError):
     """No usable Vulkan loader, lavapipe device or validation layer; the message says why and what to do."""
 
@@ -135,6 +166,7 @@ class Device:
         # no command pool, no fence (RADV's null device, runtime/gpu_stats.py, has no hardware to run on)
         self.compile_only = compile_only
         self.messages: list[ValidationMessage] = []
+        self.features: dict[str, bool] = {}  # fp16 features the device reports (filled in by _open)
         self.handle = self.instance = self._messenger = self.command_pool = self.fence = None
         self._owned: list = []  # objects with destroy(), released in reverse order by close()
         self.cache: dict = {}  # objects callers keep per device (compiled eval kernels)
@@ -203,22 +235,65 @@ class Device:
         have = {e.extensionName for e in vk.vkEnumerateDeviceExtensionProperties(self.physical, None)}
         self.extensions = [e for e in ("VK_EXT_pipeline_creation_feedback",) if e in have]
         features = None
+        # fp16 (issue 11): half arithmetic (shaderFloat16) and 16-bit storage access, which naga's f16
+        # modules declare, are enabled wherever the device reports them; self.features says which.
+        self.features = self._fp16_features(have)
+        storage = {k: vk.VK_TRUE for k in ("storageBuffer16BitAccess", "uniformAndStorageBuffer16BitAccess")
+                   if self.features.get(k)}
+        f16 = s16 = vk.VkPhysicalDevice16BitStorageFeatures(**storage) if storage else None
+        if self.features.get("shaderFloat16"):  # the instance is Vulkan 1.1: the extension, not 1.2 core
+            self.extensions.append("VK_KHR_shader_float16_int8")
+            f16 = vk.VkPhysicalDeviceShaderFloat16Int8Features(pNext=s16, shaderFloat16=vk.VK_TRUE)
         if self.compile_only:
             if STATISTICS_EXTENSION not in have:
                 raise VulkanUnavailable(f"{self.name} has no {STATISTICS_EXTENSION}: it cannot report compiler "
                                         "statistics")
             self.extensions.append(STATISTICS_EXTENSION)
-            features = vk.VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR(pipelineExecutableInfo=vk.VK_TRUE)
+            features = vk.VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR(pNext=f16,
+                                                                                  pipelineExecutableInfo=vk.VK_TRUE)
+        features = features if features is not None else f16
         self.handle = vk.vkCreateDevice(self.physical, vk.VkDeviceCreateInfo(
             pNext=features, pQueueCreateInfos=[queue_info], pEnabledFeatures=vk.VkPhysicalDeviceFeatures(),
             ppEnabledExtensionNames=self.extensions), None)
-        del features  # alive across the call
+        del features, f16, s16  # alive across the call
         if self.compile_only:
             return
         self.queue = vk.vkGetDeviceQueue(self.handle, self.queue_family, 0)
         self.command_pool = vk.vkCreateCommandPool(self.handle, vk.VkCommandPoolCreateInfo(
             flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT, queueFamilyIndex=self.queue_family), None)
         self.fence = vk.vkCreateFence(self.handle, vk.VkFenceCreateInfo(), None)
+
+    def _fp16_features(self, extensions: set) -> dict[str, bool]:
+        """What the physical device reports for fp16: shaderFloat16 (VkPhysicalDeviceShaderFloat16Int8Features of
+        VK_KHR_shader_float16_int8, core in Vulkan 1.2) and the 16-bit storage features (core in Vulkan 1.1)."""
+        vk = self.vk
+        out = dict.fromkeys(("shaderFloat16", "storageBuffer16BitAccess", "uniformAndStorageBuffer16BitAccess",
+                             "storagePushConstant16", "storageInputOutput16"), False)
+        try:
+            f16 = vk.VkPhysicalDeviceShaderFloat16Int8Features()
+            s16 = vk.VkPhysicalDevice16BitStorageFeatures(pNext=f16)
+            vk.vkGetPhysicalDeviceFeatures2(self.physical, vk.VkPhysicalDeviceFeatures2(pNext=s16))
+        except Exception:  # a loader or driver without vkGetPhysicalDeviceFeatures2: no fp16
+            return out
+        # the instance asks for Vulkan 1.1, so shaderFloat16 is usable through VK_KHR_shader_float16_int8 only
+        out["shaderFloat16"] = bool(f16.shaderFloat16) and "VK_KHR_shader_float16_int8" in extensions
+        for k in list(out)[1:]:
+            out[k] = bool(getattr(s16, k))
+        return out
+
+    def fit_spirv(self, spirv: bytes) -> bytes:
+        """A module as this device takes it: naga declares StorageInputOutput16 in every module that enables
+        f16, whether or not a 16-bit stage input or output exists; the project's fp16 shaders keep their
+        interface 32-bit (targets/clike.py), so where the device lacks storageInputOutput16 (lavapipe) the
+        capability is dropped. Every other module passes unchanged."""
+        if self.features.get("storageInputOutput16") or not uses_float16(spirv):
+            return spirv
+        return drop_capabilities(spirv, {STORAGE_INPUT_OUTPUT_16})
+
+    @property
+    def fp16(self) -> bool:
+        """Whether fp16 eval kernels run here (shaderFloat16; naga's f16 modules also need 16-bit storage)."""
+        return bool(self.features.get("shaderFloat16"))
 
     def host_memory_type(self, type_bits: int) -> int:
         """A memory type the host can map coherently (device-local too when there is one: lavapipe)."""

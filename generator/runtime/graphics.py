@@ -152,6 +152,8 @@ class GraphicsPipeline:
                     pBindings=bindings), None)
             handles = [self.set_layout_handles[s] for s in range(top + 1)]
             self.layout = vk.vkCreatePipelineLayout(dev, vk.VkPipelineLayoutCreateInfo(pSetLayouts=handles), None)
+            vert_spirv = device.fit_spirv(vert_spirv)  # fp16: naga's unused StorageInputOutput16 (device.py)
+            frag_spirv = device.fit_spirv(frag_spirv) if frag_spirv is not None else None
             self.vert = vk.vkCreateShaderModule(dev, vk.VkShaderModuleCreateInfo(codeSize=len(vert_spirv),
                                                                                  pCode=vert_spirv), None)
             if frag_spirv is not None:

@@ -7,16 +7,23 @@ nothing beyond the standard library.
 from __future__ import annotations
 
 from .base import Emitted, Target
-from .glsl import GlslTarget
-from .hlsl import HlslTarget
-from .wgsl import WgslTarget
+from .glsl import GlslHalfTarget, GlslTarget
+from .hlsl import HlslHalfTarget, HlslTarget
+from .wgsl import WgslHalfTarget, WgslTarget
 
 TARGETS: dict[str, Target] = {"glsl": GlslTarget(), "hlsl": HlslTarget(), "wgsl": WgslTarget()}
+# fp16 variants: the brick language's float is the language's 16-bit float (issue 11, "fp16 for real")
+HALF_TARGETS: dict[str, Target] = {"glsl": GlslHalfTarget(), "hlsl": HlslHalfTarget(), "wgsl": WgslHalfTarget()}
 LANGUAGES: tuple[str, ...] = ("glsl", "hlsl", "wgsl")  # the shading languages, in output order
 
 
-def get_target(name: str) -> Target:
-    """The emitter for `name`: "glsl", "hlsl", "wgsl" or "numpy"."""
+def get_target(name: str, precision: str = "fp32") -> Target:
+    """The emitter for `name`: "glsl", "hlsl", "wgsl" or "numpy"; precision "fp16" gives a shading
+    language's half variant (the NumPy target takes its dtype at load() instead)."""
+    if precision == "fp16" and name in HALF_TARGETS:
+        return HALF_TARGETS[name]
+    if precision not in ("fp32", "fp16"):
+        raise ValueError(f"unknown precision '{precision}' (known: fp32, fp16)")
     if name not in TARGETS and name == "numpy":
         # Registered lazily: numpy.py imports NumPy, which the shader targets do not need.
         from .numpy import NumpyTarget
@@ -27,4 +34,5 @@ def get_target(name: str) -> Target:
         raise ValueError(f"unknown target '{name}' (known: glsl, hlsl, numpy, wgsl)") from None
 
 
-__all__ = ["Emitted", "Target", "TARGETS", "LANGUAGES", "get_target", "GlslTarget", "HlslTarget", "WgslTarget"]
+__all__ = ["Emitted", "Target", "TARGETS", "HALF_TARGETS", "LANGUAGES", "get_target", "GlslTarget", "HlslTarget",
+           "WgslTarget", "GlslHalfTarget", "HlslHalfTarget", "WgslHalfTarget"]

@@ -11,16 +11,22 @@ is needed and every target reads the same.
 from __future__ import annotations
 
 import math
+import struct
 
 from ..lang import ir
 from ..lang.intrinsics import CONSTANTS
-from ..lang.types import Type
+from ..lang.types import BUILTIN_TYPES, Type
 from . import reserved
 from .base import Emitted
 from .clike_control import ControlMixin, wrap  # noqa: F401  (wrap: re-exported)
 from .clike_resources import ResourceMixin
 
 INDENT = "    "
+HALF_MAX = 65504.0  # the largest finite fp16 value
+# fp16 names (generated names start with '_', which brick names never do):
+MIRROR_PREFIX = "_w32_"  # the 32-bit twin of a buffer's element struct
+LOAD_PREFIX = "_load_"  # the function converting a buffer's 32-bit element to its half struct
+ENTRY32_PREFIX = "_f32_"  # the 32-bit wrapper of an entry point (entry32), and its half copies of arrays
 
 
 class Writer:
@@ -71,6 +77,10 @@ class CLikeTarget(ControlMixin, ResourceMixin):
 
     reserved = reserved.ALL
     line_directives = True          # emit `#line N "brick"` before mapped lines
+    # "fp32" or "fp16": at fp16 the brick language's `float` is the language's 16-bit float (the
+    # *Half subclasses); what crosses the interface (uniforms, buffers, samples, textures, stage
+    # inputs and outputs) stays 32-bit and is converted where brick code meets it (from32/to32).
+    precision = "fp32"
 
     # ---- tables a subclass fills in
     SCALARS: dict[str, str] = {}    # brick scalar -> spelling
@@ -95,6 +105,87 @@ class CLikeTarget(ControlMixin, ResourceMixin):
         if name in self.reserved or name.startswith(reserved.RESERVED_PREFIXES):
             return reserved.PREFIX + name
         return name
+
+    @property
+    def half(self) -> bool:
+        """True for the fp16 variant of a language (generator.targets.get_target(name, "fp16"))."""
+        return self.precision == "fp16"
+
+    def convert(self, t: Type, x: str) -> str:
+        """x converted to this target's spelling of t (a value conversion, e.g. float -> half)."""
+        return f"{self.type_name(t)}({x})"
+
+    def from32(self, t, x: str) -> str:
+        """A 32-bit value x (a uniform, a sample, a stage input) as brick type t (a Type or a builtin
+        type name like "vec3"): x itself at fp32, a conversion to half at fp16."""
+        t = BUILTIN_TYPES[t] if isinstance(t, str) else t
+        if not self.half or not _has_float(t) or self.type_name(t) == self.full().type_name(t):
+            return x
+        return self.convert(t, x)
+
+    def to32(self, t, x: str) -> str:
+        """A value x of brick type t as its 32-bit spelling (results leaving brick code, texture coordinates)."""
+        t = BUILTIN_TYPES[t] if isinstance(t, str) else t
+        if not self.half or not _has_float(t) or self.type_name(t) == self.full().type_name(t):
+            return x
+        return self.full().convert(t, x)
+
+    def mirror_decl(self, w: Writer, elem: Type) -> None:
+        """fp16: struct MIRROR_PREFIX+S, S's fields at 32 bits (what a buffer of S holds), and the function
+        LOAD_PREFIX+S converting one to S (field by field; arrays element by element)."""
+        mirror = Type("struct", name=MIRROR_PREFIX + elem.name, fields=elem.fields)
+        self.full().struct_decl(w, mirror)
+        w.line("")
+        w.line(self.signature(ir.Function(LOAD_PREFIX + elem.name, [], elem, [], None),
+                              self.var_decl("w", mirror)))
+        w.depth += 1
+        w.line(self.declare_local("s", elem))
+        for f, t in elem.fields:
+            name = self.ident(f)
+            if t.kind == "array":
+                for i in range(t.size):
+                    w.line(f"s.{name}[{i}] = {self.from32(t.elem, f'w.{name}[{i}]')};")
+            else:
+                w.line(f"s.{name} = {self.from32(t, f'w.{name}')};")
+        w.line("return s;")
+        w.depth -= 1
+        w.line("}")
+        w.line("")
+
+    def entry32(self, emitted: Emitted, f: ir.Function) -> tuple[Emitted, str]:
+        """At fp16: `emitted` plus a wrapper of entry `f` that takes and returns 32-bit values (what the
+        templates pass: samples, uniform reads, stage inputs), converting them to half and the result back;
+        and the wrapper's name. At fp32: (emitted, f's name) unchanged. The templates are precision-blind:
+        they call the returned name."""
+        if not self.half:
+            return emitted, self.ident(f.name)
+        full, name = self.full(), ENTRY32_PREFIX + f.name
+        params, args, body = [], [], []
+        for p in f.params:
+            pname = self.ident(p.name)
+            params += full.params(p)
+            if p.ty.kind == "texture":
+                args += [pname] + ([self.sampler_name(p.name)] if self.SAMPLER else [])
+            elif p.ty.kind == "array" and _has_float(p.ty.elem):  # element by element into a half copy
+                local = ENTRY32_PREFIX + p.name
+                body.append(self.declare_local(local, p.ty))
+                body += [f"{local}[{i}] = {self.from32(p.ty.elem, f'{pname}[{i}]')};" for i in range(p.ty.size)]
+                args.append(local)
+            else:
+                args.append(self.from32(p.ty, pname))
+        sig = full.signature(ir.Function(name, [], f.ret, [], f.loc), ", ".join(params))
+        call = self.to32(f.ret, f"{self.ident(f.name)}({', '.join(args)})")
+        lines = [sig] + [INDENT + b for b in body] + [f"{INDENT}return {call};", "}", ""]
+        return Emitted(emitted.text + "\n".join(lines) + "\n", list(emitted.line_map)), name
+
+    def declare_local(self, name: str, t: Type) -> str:
+        """A local variable without an initializer (written element by element after)."""
+        return f"{self.var_decl(name, t)};"
+
+    def full(self) -> "CLikeTarget":
+        """The fp32 target of this language (spells the 32-bit side of every conversion)."""
+        from . import get_target
+        return get_target(self.name)
 
     def sampler_name(self, texture: str) -> str:
         """The sampler that travels with texture `texture` ('_smp_' + its brick name: never a brick's name)."""
@@ -135,6 +226,12 @@ class CLikeTarget(ControlMixin, ResourceMixin):
         for s in structs:
             self.struct_decl(w, s)
             w.line("")
+        if self.half:  # buffers keep 32-bit elements: declare their twins (read through buffer_element)
+            seen = set()
+            for g in globals:
+                if g.ty.kind == "buffer" and g.ty.elem.name not in seen:
+                    seen.add(g.ty.elem.name)
+                    self.mirror_decl(w, g.ty.elem)
         for g in globals:
             for text in self.declare_global(g).splitlines():
                 w.line(text)
@@ -282,6 +379,11 @@ class CLikeTarget(ControlMixin, ResourceMixin):
             assert type(v) is bool
             return "true" if v else "false"
         if t.scalar == "float":
+            if self.half:  # past the half range a literal saturates to ±65504 (FP16_MAX), never inf;
+                # and it is written as the half it rounds to (to nearest, even): glslang converts a
+                # literal to half by truncation (0.3183098861837907hf became 0.318115234375, not
+                # 0.318359375), naga rounds; an exact half is the same number to both
+                v = struct.unpack("<e", struct.pack("<e", max(-HALF_MAX, min(HALF_MAX, float(v)))))[0]
             s = float_literal(v) + self.FLOAT_SUFFIX
         elif t.scalar == "uint":
             assert 0 <= v < 2**32, f"uint literal {v} out of range"
@@ -336,6 +438,9 @@ class CLikeTarget(ControlMixin, ResourceMixin):
             return f"{e.name}({', '.join(self.expr(a) for a in e.args)})"
         args = [self.expr(a) for a in e.args]
         smp = self.sampler_name(e.args[0].name) if e.args[0].ty.kind == "texture" else ""
+        if self.half and e.name in ("sample", "sample_level"):  # textures are 32-bit: coordinates and texels convert
+            args = [args[0]] + [self.to32(a.ty, x) for a, x in zip(e.args[1:], args[1:])]
+            return self.from32(e.ty, fmt.format(*args, smp=smp))
         return fmt.format(*args, smp=smp)
 
     def expr_construct(self, e: ir.Construct) -> str:
@@ -368,6 +473,8 @@ class CLikeTarget(ControlMixin, ResourceMixin):
 
     def expr_index(self, e: ir.Index) -> str:
         if e.base.ty.kind == "buffer":
+            if self.half:  # a 32-bit element (its MIRROR_PREFIX twin), converted by its LOAD_PREFIX function
+                return f"{LOAD_PREFIX}{e.base.ty.elem.name}({self.buffer_element(e.base, self.expr(e.index))})"
             return self.buffer_element(e.base, self.expr(e.index))
         return f"{self.expr(e.base)}[{self.expr(e.index)}]"
 
@@ -376,3 +483,8 @@ class CLikeTarget(ControlMixin, ResourceMixin):
 
     def select(self, cond: str, if_true: str, if_false: str) -> str:
         return f"({cond} ? {if_true} : {if_false})"
+
+
+def _has_float(t: Type) -> bool:
+    """Whether t holds floats that change width with the precision (scalars, vectors, matrices of float)."""
+    return t.kind in ("scalar", "vector", "matrix") and t.scalar == "float"

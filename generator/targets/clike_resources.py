@@ -67,7 +67,11 @@ class ResourceMixin(Target):
             raise ValueError(f"buffer '{name}': kind is 'storage' or 'uniform', not {kind!r}")
         if kind == "uniform" and not (type(capacity) is int and capacity >= 1):
             raise ValueError(f"uniform buffer '{name}' needs a capacity of at least 1, got {capacity!r}")
-        return self.buffer_decl(self.ident(name), self.type_name(elem), int(set), int(binding), kind, capacity)
+        spelled = self.type_name(elem)
+        if getattr(self, "half", False):  # fp16: the buffer holds the 32-bit twin of its element struct
+            from .clike import MIRROR_PREFIX
+            spelled = MIRROR_PREFIX + elem.name
+        return self.buffer_decl(self.ident(name), spelled, int(set), int(binding), kind, capacity)
 
     def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
         raise NotImplementedError

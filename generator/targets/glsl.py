@@ -73,3 +73,21 @@ class GlslTarget(CLikeTarget):
         which is harmless: brick expressions are pure."""
         sel = cond if ty.kind == "scalar" else f"bvec{ty.size}({cond})"
         return f"mix({if_false}, {if_true}, {sel})"
+
+
+class GlslHalfTarget(GlslTarget):
+    """GLSL at fp16: `float16_t`, `f16vecN`, `f16matN` and `hf` literals
+    (GL_EXT_shader_explicit_arithmetic_types_float16: SPIR-V Float16, real half arithmetic on a
+    device with shaderFloat16). Interface values stay 32-bit and convert where brick code reads
+    them (clike.from32/to32); textures take vec2/vec3 coordinates and give vec4 texels."""
+
+    precision = "fp16"
+    SCALARS = {**GlslTarget.SCALARS, "float": "float16_t"}
+    VECTORS = {**GlslTarget.VECTORS, "float": "f16vec{n}"}
+    MATRIX = "f16mat{n}"
+    FLOAT_SUFFIX = "hf"
+    INTRINSICS = {**GlslTarget.INTRINSICS, "saturate": "clamp({0}, 0.0hf, 1.0hf)"}
+    EXTENSION = "#extension GL_EXT_shader_explicit_arithmetic_types_float16 : require"
+
+    def header(self) -> str:
+        return super().header() + "\n" + self.EXTENSION

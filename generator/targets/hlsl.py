@@ -148,3 +148,66 @@ def _column(e: ir.Expr) -> ir.Index | None:
     if isinstance(e, ir.Index) and e.base.ty.kind == "matrix":
         return e
     return None
+
+
+class HlslHalfTarget(HlslTarget):
+    """HLSL at fp16: `half`, `halfN` and `h` literals, compiled with 16-bit types on (glslc
+    -fhlsl-16bit-types, DXC's -enable-16bit-types): real SPIR-V Float16, not min16float's
+    RelaxedPrecision float. glslang's HLSL front end accepts neither `float16_t` nor 16-bit
+    matrices in mul()/transpose(), so matrices stay floatNxN: a product with one runs in 32 bits
+    (its vector operand converted), and a matrix element read converts back to half. glslang
+    refuses implicit float -> half, so every such crossing is an explicit cast."""
+
+    precision = "fp16"
+    SCALARS = {**HlslTarget.SCALARS, "float": "half"}
+    VECTORS = {**HlslTarget.VECTORS, "float": "half{n}"}
+    FLOAT_SUFFIX = "h"
+
+    def convert(self, t: Type, x: str) -> str:
+        return f"(({self.type_name(t)})({x}))"
+
+    def expr_binary(self, e: ir.Binary) -> str:
+        if e.op == "*" and _is_product(e.lhs.ty, e.rhs.ty):
+            lhs, rhs = (self.to32(a.ty, self.expr(a)) for a in (e.lhs, e.rhs))
+            return self.from32(e.ty, f"mul({lhs}, {rhs})")
+        return super().expr_binary(e)
+
+    def expr_index(self, e: ir.Index) -> str:
+        text = super().expr_index(e)
+        if _column(e.base) is not None or e.base.ty.kind == "matrix":
+            return self.convert(e.ty, text)
+        return text
+
+    def expr_swizzle(self, e: ir.Swizzle) -> str:
+        col = _column(e.base)
+        text = super().expr_swizzle(e)
+        return self.convert(e.ty, text) if col is not None and len(e.components) == 1 else text
+
+    def expr_intrinsic(self, e: ir.Intrinsic) -> str:
+        """glslang's HLSL front end (glslc 2023.2, glslang 11.13) has no 16-bit overloads of the intrinsics:
+        max, clamp, rsqrt, pow, ... promote their half arguments to float and return float (SPIR-V
+        `OpExtInst %float Pow`), which it will not narrow implicitly. Every float-valued intrinsic is cast
+        back to half: exact for min/max/clamp/abs; a transcendental runs in 32 bits and rounds once, so
+        HLSL's fp16 errors are somewhat below GLSL's and WGSL's (phong_normalized: 3.5e-2 against 9.3e-2;
+        DXC would keep them half). +, -, *, / and the brick's own functions are half as in GLSL."""
+        text = super().expr_intrinsic(e)
+        if _has_float_value(e.ty) and e.name not in ("sample", "sample_level"):
+            return self.convert(e.ty, text)
+        return text
+
+    def assign(self, w: Writer, s: ir.Assign) -> None:
+        if s.op == "*" and _is_product(s.target.ty, s.value.ty):
+            t = self.expr(s.target)
+            w.line(f"{t} = {self.from32(s.target.ty, f'mul({self.to32(s.target.ty, t)}, {self.to32(s.value.ty, self.expr(s.value))})')};",
+                   s.loc)
+            return
+        super().assign(w, s)
+
+    def type_name(self, t: Type) -> str:
+        if t.kind == "matrix":
+            return HlslTarget.MATRIX.format(n=t.size)
+        return super().type_name(t)
+
+
+def _has_float_value(t: Type) -> bool:
+    return t.kind in ("scalar", "vector") and t.scalar == "float"

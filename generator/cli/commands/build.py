@@ -78,6 +78,9 @@ def run(args) -> int:
         if args.json:  # a script reading stdout gets its answer too
             print(json.dumps({"ok": False, "failures": [str(e)]}, indent=2))
         raise
+    from ...matrix.permutation import fp16_warnings
+    for w in fp16_warnings(scene.permutations.values(), lib):  # bricks marked "fp16": "unsafe: ..."
+        print(f"warning: {w}", file=sys.stderr)
     root = args.cache_dir or default_cache_dir()
     if root is None and not args.no_cache:
         print("note: no home directory for the compile cache — building without it (--cache-dir DIR to keep one)",

@@ -36,7 +36,8 @@ def add_arguments(p) -> None:
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a parameter (canonical name); RGB as f0=0.9,0.6,0.3; a scalar splats (repeatable)")
     p.add_argument("--dtype", choices=DTYPES,
-                   help="numpy: float64 (default), float32 or float16; GPU targets: float32 only")
+                   help="numpy: float64 (default), float32 or float16; GPU targets: float32, or float16 where the device "
+                        "reports shaderFloat16")
     p.add_argument("--bricks", action="append", metavar="DIR", help="an extra brick directory (repeatable)")
     p.add_argument("--unchecked", action="store_true",
                    help="pass non-finite and non-unit sample vectors through as they are (default: an error)")

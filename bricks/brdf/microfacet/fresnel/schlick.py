@@ -2,6 +2,8 @@
 
 Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering", eq. 15;
 RTR3 eq. 7.40. The fifth power is written as multiplications (no pow(0, 0)).
+
+fp16: safe.
 """
 BRICK = {
     "kind": "fresnel",

@@ -6,9 +6,15 @@ tan^2 theta_h = sin^2 / cos^2 with sin^2 theta_h = |n x h|^2 from the glue (NxH2
 which keeps its digits as h -> n where 1 - cos^2 does not (ACCURACY-FACTS pitfall 4).
 Measured in float32 against the float64 reference (stress set, `shadermatrix
 accuracy`): max error 18 % at alpha = 1e-3 with (1 - cos^2)/cos^2, 4e-5 with NxH2.
+
+fp16 (measured on lavapipe, `accuracy --dtypes float16`): unsafe. COS2_MIN = 1e-8 is 0 in
+half and (n.h)^4 underflows below n.h = 0.016, so D is 0/0 = NaN there (black specks on grazing
+ground). A floor of 2.5e-4 on (n.h)^2 would guard it; the brick language has no precision-
+conditional constant yet, so fp16 permutations that use it get a build warning.
 """
 BRICK = {
     "kind": "ndf",
+    "fp16": "unsafe: COS2_MIN 1e-8 is 0 in half and (n.h)^4 underflows below n.h = 0.016: 0/0 = NaN",
     "cite": "Cook & Torrance 1982 eq. 5; normalized form Walter et al. 2007 eq. 25",
 }
 

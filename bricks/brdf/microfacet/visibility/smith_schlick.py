@@ -3,6 +3,8 @@
 G = (n.l / ((n.l)(1 - k) + k)) (n.v / ((n.v)(1 - k) + k)), k = m sqrt(2/pi)
 (Schlick 1994; RTR3 eq. 7.56, m the Beckmann RMS slope = alpha). Divided by
 4 (n.l)(n.v), the cosines cancel: V = 1 / (4 ((n.l)(1-k)+k) ((n.v)(1-k)+k)).
+
+fp16: the 1e-8 floor is 0 in half, which is harmless for alpha > 0.
 """
 BRICK = {
     "kind": "visibility",

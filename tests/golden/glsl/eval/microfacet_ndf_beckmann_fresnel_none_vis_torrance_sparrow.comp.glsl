@@ -4,7 +4,7 @@
 // eval: microfacet(ndf=beckmann,fresnel=none,vis=torrance_sparrow)
 // hash: 5e84b038a5f7
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:3a248d03882c
 // brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template glsl/eval.glsl.j2 sha256:9df531e080fc
@@ -17,7 +17,7 @@ layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } sa
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
 layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[2]; } params;
 
-#line 24 "bricks/brdf/microfacet/ndf/beckmann.py"
+#line 30 "bricks/brdf/microfacet/ndf/beckmann.py"
 float beckmann_ndf(float NdotH, float NxH2, float alpha) {
     float a2 = max((alpha * alpha), 1e-08);
     float c2 = max((NdotH * NdotH), 1e-08);

@@ -2,7 +2,7 @@
 // eval: microfacet(ndf=beckmann,fresnel=none,vis=torrance_sparrow)
 // hash: 5e84b038a5f7
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:3a248d03882c
 // brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
@@ -14,7 +14,7 @@ StructuredBuffer<float4> samples : register(t0, space0);
 RWStructuredBuffer<float4> result : register(u1, space0);
 cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[2]; };
 
-#line 24 "bricks/brdf/microfacet/ndf/beckmann.py"
+#line 30 "bricks/brdf/microfacet/ndf/beckmann.py"
 float beckmann_ndf(float NdotH, float NxH2, float alpha) {
     float a2 = max((alpha * alpha), 1e-08);
     float c2 = max((NdotH * NdotH), 1e-08);

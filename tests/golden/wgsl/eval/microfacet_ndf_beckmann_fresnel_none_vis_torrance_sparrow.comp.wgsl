@@ -2,7 +2,7 @@
 // eval: microfacet(ndf=beckmann,fresnel=none,vis=torrance_sparrow)
 // hash: 5e84b038a5f7
 // brick bricks/brdf/microfacet/fresnel/none.py sha256:820b018388dd
-// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:4156950c29d0
+// brick bricks/brdf/microfacet/ndf/beckmann.py sha256:3a248d03882c
 // brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template wgsl/eval.wgsl.j2 sha256:f197bbce6026
