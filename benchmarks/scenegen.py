@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import re
 import random
 import sys
 from pathlib import Path
@@ -44,8 +45,18 @@ def brdfs(lib) -> list[str]:
     return diffuse + specular + [f"{d}+{s}" for d in diffuse for s in specular]
 
 
+def _reads(b, names) -> bool:
+    return any(p.name in names for f in b.entries for p in f.params)
+
+
 def packings(lib, brdf: str) -> list[str]:
+    from generator.library.inputs import BY_NAME
+    tangent_rows = {n for n, row in BY_NAME.items() if row.tangent}
+    anisotropic = {b.id for k in ("diffuse", "specular", "ndf", "fresnel", "visibility") for b in lib.of_kind(k)
+                   if _reads(b, tangent_rows)}
     normals = [b.id for b in sorted(lib.of_kind("normal"), key=lambda b: b.id)]
+    if set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", brdf)) & anisotropic:  # only normals that carry the tangent
+        normals = [n for n in normals if _reads(lib.get("normal", n), ("T", "B"))]
     reads_albedo = brdf.split("+")[0] in {b.id for b in lib.of_kind("diffuse") if "rho_d" in b.params}
     out = [f"constants(normal={n})" for n in normals]
     if reads_albedo:

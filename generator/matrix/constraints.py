@@ -31,7 +31,9 @@ def _provides_unread(r) -> tuple[str, str]:
         name = f.name[len("get_"):]
         if name not in params:
             return (f"packing '{r.packing.brick.id}' provides {name}, which BRDF '{_brdf_text(r)}' does not read",
-                    "use the constants packing for this BRDF")
+                    "use a packing that provides only what this BRDF reads: constants, or f0_roughness_texture "
+                    "for a textured specular-only microfacet BRDF (`shadermatrix bricks` lists each packing's "
+                    "inputs)")
     return "", ""
 
 

@@ -85,7 +85,7 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
                "of": f"{len(valid_pairs)} of {len(pairs)} BRDF × packing pairs pass the constraints, "
                      f"× {len(ax['lights'])} light configurations"},
               {"stage": "used", "count": used, "of": f"{len(scene.objects)} objects draw {used} distinct permutations; "
-                                                     f"{valid - used} valid combinations are drawn by no object"}]
+                                                     f"{valid - used:,} valid combinations are drawn by no object"}]
     merged_into: dict[str, str] = {}
     if spirv is not None:
         first: dict[tuple, str] = {}
