@@ -254,7 +254,7 @@ def test_cli_start_loads_neither_vulkan_nor_numpy():
 
 
 @pytest.mark.parametrize("command", [["build", str(EXAMPLE), "--out", "{tmp}"],
-                                     ["eval", "lambert", "--input", "{tmp}/s.npy", "--output", "{tmp}/f.npy",
+                                     ["eval", "lambert", "--input", "{tmp}/s.npy", "--out", "{tmp}/f.npy",
                                       "--target", "glsl"]], ids=["build", "eval"])
 @pytest.mark.lavapipe  # the eval case opens the device before it looks for a compiler
 def test_missing_tool_is_one_line_error(tmp_path, monkeypatch, capsys, command):

@@ -58,7 +58,7 @@ def test_an_unknown_option_prints_the_subcommands_usage_and_exits_2():
 
 def test_a_bad_option_value_is_a_usage_error_in_every_command(tmp_path):
     assert run("render", EXAMPLE, "--out", tmp_path, "--size", "big").returncode == 2
-    assert run("eval", "lambert", "--input", tmp_path / "s.npy", "--output", tmp_path / "f.npy", "--target", "numpy",
+    assert run("eval", "lambert", "--input", tmp_path / "s.npy", "--out", tmp_path / "f.npy", "--target", "numpy",
                "--param", "rho_d").returncode == 2
     assert run("accuracy", "lambert", "--targets", "metal").returncode == 2
     assert run("costs").returncode == 2  # neither a scene nor --per-brick

@@ -242,7 +242,7 @@ def test_cli_round_trip_matches_the_python_function(tmp_path, samples):
     runs += [(lang, None, s12) for lang in LANGS]
     for target, dtype, inp in runs:
         out = tmp_path / f"f_{target}_{dtype}.npy"
-        r = cli(spec, "--input", inp, "--output", out, "--target", target, *params,
+        r = cli(spec, "--input", inp, "--out", out, "--target", target, *params,
                 *(["--dtype", dtype] if dtype else []))
         assert r.returncode == 0, r.stderr
         f = np.load(out)
@@ -275,7 +275,7 @@ def test_cli_kernel_that_does_not_compile_is_one_line_error(tmp_path):
     bricks.mkdir()
     (bricks / "div_zero.py").write_text(DIVIDE_BY_ZERO)
     good = save(tmp_path / "s.npy", np.tile([0.0, 0.0, 1.0], (4, 3)))
-    r = cli("div_zero", "--bricks", bricks, "--input", good, "--output", tmp_path / "f.npy", "--target", "wgsl")
+    r = cli("div_zero", "--bricks", bricks, "--input", good, "--out", tmp_path / "f.npy", "--target", "wgsl")
     assert r.returncode == 1, r.stderr
     assert r.stderr.startswith("error: the wgsl eval kernel does not compile: ")
     assert "bricks/div_zero.py:7:" in r.stderr and " — " in r.stderr, r.stderr
@@ -305,7 +305,7 @@ def test_cli_errors_exit_1_or_2_and_leave_the_output_alone(tmp_path):
     ]
     for args, msg in cases:
         target = [] if "--target" in args else ["--target", "numpy"]
-        r = cli(*args, "--output", out, *target)
+        r = cli(*args, "--out", out, *target)
         usage = any(w in msg for w in ("not a number", "NAME=VALUE", "given twice"))  # of --param's form: exit 2
         assert r.returncode == (2 if usage else 1), (args, r.stderr)
         assert msg in r.stderr and " — " in r.stderr, (args, r.stderr)
@@ -320,13 +320,13 @@ def test_non_finite_and_non_unit_samples_are_refused_naming_the_row(tmp_path):
     good = np.tile([0.0, 0.0, 1.0], (5, 3))
     nan = good.copy()
     nan[3, 4] = np.nan
-    r = cli("lambert", "--input", save(tmp_path / "nan.npy", nan), "--output", tmp_path / "f.npy", "--target", "numpy")
+    r = cli("lambert", "--input", save(tmp_path / "nan.npy", nan), "--out", tmp_path / "f.npy", "--target", "numpy")
     assert r.returncode == 1 and "row 3 holds a NaN or infinity" in r.stderr and "--unchecked" in r.stderr, r.stderr
     long = good.copy()
     long[2, 6:9] = [0.0, 0.0, 2.0]
-    r = cli("lambert", "--input", save(tmp_path / "long.npy", long), "--output", tmp_path / "f.npy", "--target", "numpy")
+    r = cli("lambert", "--input", save(tmp_path / "long.npy", long), "--out", tmp_path / "f.npy", "--target", "numpy")
     assert r.returncode == 1 and "row 2: N has length 2, not 1" in r.stderr, r.stderr
-    r = cli("lambert", "--input", tmp_path / "long.npy", "--output", tmp_path / "f.npy", "--target", "numpy",
+    r = cli("lambert", "--input", tmp_path / "long.npy", "--out", tmp_path / "f.npy", "--target", "numpy",
             "--unchecked")
     assert r.returncode == 0, r.stderr
 
@@ -340,5 +340,5 @@ def test_a_header_declaring_what_the_file_cannot_be_allocates_nothing(tmp_path, 
     buf = io.BytesIO()
     np.lib.format.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": shape})
     (tmp_path / "huge.npy").write_bytes(buf.getvalue())  # a header, no data
-    r = cli("lambert", "--input", tmp_path / "huge.npy", "--output", tmp_path / "f.npy", "--target", "numpy")
+    r = cli("lambert", "--input", tmp_path / "huge.npy", "--out", tmp_path / "f.npy", "--target", "numpy")
     assert r.returncode == 1 and words in r.stderr and "Traceback" not in r.stderr, r.stderr

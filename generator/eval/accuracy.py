@@ -327,6 +327,20 @@ def _param_keys(params: dict) -> list[str]:
     return [f"{k}={v:g}" if not isinstance(v, list) else f"{k}={v}" for k, v in _plain(params).items()]
 
 
+def _first(items: list[str], n: int = 3) -> str:
+    """A report cell naming at most n items: the rest counted (the JSON report lists them all)."""
+    if not items:
+        return "none"
+    return "; ".join(items[:n]) + (f"; and {len(items) - n} more" if len(items) > n else "")
+
+
+def _params_text(params: dict | None) -> str:
+    """{"alpha": 0.001, "f0": [1, 0.5, 0]} -> "alpha = 0.001, f0 = (1, 0.5, 0)": for a report's cell, not a Python dict."""
+    def one(v):
+        return f"({', '.join(f'{x:g}' for x in v)})" if isinstance(v, (list, tuple)) else f"{v:g}"
+    return ", ".join(f"{k} = {one(v)}" for k, v in (params or {}).items())
+
+
 def _plain(params: dict) -> dict:
     return {k: (v if not isinstance(v, (list, tuple)) else (v[0] if len(set(v)) == 1 else list(v)))
             for k, v in params.items()}
@@ -502,7 +516,7 @@ def verdicts(results: list[dict], specs, tol: float, lib=None) -> list[dict]:
                     "hemisphere_target": hemi["target"] if hemi else None,
                     "stress_max_rel": stress["max_rel"] if stress else None,
                     "stress_target": stress["target"] if stress else None,
-                    "stress_case": f"{case['case']} {case['params'] or ''}".strip() if case else None,
+                    "stress_case": f"{case['case']} {_params_text(case['params'])}".strip() if case else None,
                     **fp16_verdict(mine, _defaults(mine[0].get("brdf", spec) if mine else spec, lib))})
     return out
 
@@ -651,7 +665,7 @@ def markdown(report: dict, detail: bool = False) -> str:
             limits = "; ".join(f"{k} {x}" for k, x in v["fp16_limits"].items()) or "none in the sweeps"
             lines.append(f"| `{v['spec']}` | {'pass' if v['fp16_pass'] else 'fail'} | {hemi} | "
                          f"{v['fp16_hemisphere_nan_inf']} | {v['fp16_stress_nan_inf']} | {limits} | "
-                         f"{'; '.join(v['fp16_broken_cases']) or 'none'} |")
+                         f"{_first(v['fp16_broken_cases'])} |")
         lines.append("")
     for sk in report.get("skipped", []):
         lines.append(f"Not run: {sk['run']} — {sk['why']}.")

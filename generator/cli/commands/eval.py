@@ -1,6 +1,6 @@
 """`shadermatrix eval`: f_r of a BRDF spec for samples from a .npy file, on the CPU or on lavapipe.
 
-    shadermatrix eval SPEC --input S.npy --output F.npy --target {reference,numpy,glsl,hlsl,wgsl}
+    shadermatrix eval SPEC --input S.npy --out F.npy --target {reference,numpy,glsl,hlsl,wgsl}
                       [--param NAME=VALUE ...] [--dtype float64|float32|float16]
 
 S.npy: float (N, 9) = [L, V, N] or (N, 12) = [L, V, N, T], unit vectors in one
@@ -30,7 +30,7 @@ HELP = "evaluate a BRDF spec on samples (.npy in, float64 f_r .npy out): referen
 def add_arguments(p) -> None:
     p.add_argument("spec", help="BRDF spec, e.g. 'lambert+microfacet(ndf=ggx)'")
     p.add_argument("--input", required=True, metavar="S.npy", help="samples: (N, 9) [L, V, N] or (N, 12) [L, V, N, T]")
-    p.add_argument("--output", required=True, metavar="F.npy", help="f_r as float64 (N, 3)")
+    p.add_argument("--out", required=True, metavar="F.npy", help="f_r as float64 (N, 3), written atomically")
     p.add_argument("--target", required=True, choices=EVAL_TARGETS,
                    help="reference (float64), numpy (IR at --dtype), or a language's eval kernel on lavapipe")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
@@ -150,7 +150,7 @@ def run(args) -> int:
         return 1
     buf = io.BytesIO()
     np.save(buf, np.ascontiguousarray(f, dtype=np.float64))
-    atomic_write(Path(args.output), buf.getvalue())
+    atomic_write(Path(args.out), buf.getvalue())
     print(f"{args.target}{'' if args.dtype is None else ' ' + args.dtype}: {len(f)} samples of "
-          f"'{args.spec}' → {args.output}", file=sys.stderr)
+          f"'{args.spec}' → {args.out}", file=sys.stderr)
     return 0
