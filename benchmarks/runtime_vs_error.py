@@ -146,6 +146,17 @@ def studies(lib) -> tuple[list[Study], list[str]]:
     return have, notes
 
 
+def _once(fn):
+    """fn(L, V, N) computed on its first call only: every kernel of a study is measured on the same grid."""
+    memo: dict = {}
+
+    def exact(L, V, N):
+        if "f" not in memo:
+            memo["f"] = fn(L, V, N)
+        return memo["f"]
+    return exact
+
+
 def own_params(spec: str, params: dict, lib) -> dict:
     from generator.eval.accuracy import declared_params
     declared = declared_params(spec, lib)
@@ -275,6 +286,7 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
     out_studies = []
     for st in found:
         rows = []
+        exact = st.exact if st.exact_fn is None else _once(st.exact_fn)  # a quadrature: once per study
         members = list(st.kernels.items()) + ([("exact model's kernel", st.exact)] if st.exact else [])
         for label, spec in members:
             row = {"label": label, "spec": spec, "exact_kernel": spec == st.exact, "time": {}}
@@ -282,7 +294,7 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
                 bar.set_description(f"{st.name} {lang} {label}")
                 row["time"][lang] = timer.ratio(spec, st.baseline, lang, st.params)
                 bar.update()
-            row["errors"] = errors(spec, st.exact_fn or st.exact, st.params, lib, k, langs[0])
+            row["errors"] = errors(spec, exact, st.params, lib, k, langs[0])
             rows.append(row)
         pts = [{"error": r["errors"]["gpu"]["rel_rms"], **r["time"][langs[0]]} for r in rows]
         for r, on in zip(rows, front(pts)):
