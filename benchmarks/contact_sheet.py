@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -119,7 +120,9 @@ def sheet(target: str, specs: list[str], size: int, lib, out: Path, progress) ->
                  "(exposure under each)", fontsize=9)
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"contact_sheet_{target}.png"
-    fig.savefig(path, dpi=100)
+    tmp = path.with_suffix(".tmp.png")  # written whole, then renamed: an interrupted run leaves the old sheet
+    fig.savefig(tmp, dpi=100)
+    os.replace(tmp, path)
     plt.close(fig)
     return path, max(worst)
 

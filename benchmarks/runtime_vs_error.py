@@ -94,14 +94,15 @@ def _microfacet(ndf: str, fresnel: str, vis: str) -> str:
     return f"microfacet(ndf={ndf},fresnel={fresnel},vis={vis})"
 
 
-def _diffuse_exact(L, V, N) -> np.ndarray:
+def _diffuse_exact(L, V, N, params: dict) -> np.ndarray:
+    """Gotanda's microfacet diffuse model at the study's roughness (α = σ) and f0, times ρ_d."""
     from generator.reference.diffuse import microfacet_diffuse
     nl, nv = np.sum(L * N, 1), np.clip(np.sum(V * N, 1), 1e-4, 1.0)
     lp, vp = L - nl[:, None] * N, V - np.sum(V * N, 1)[:, None] * N
     d = np.sqrt(np.sum(lp * lp, 1) * np.sum(vp * vp, 1))
     cp = np.where(d > 0, np.sum(lp * vp, 1) / np.where(d > 0, d, 1.0), 0.0)
-    f = np.where(nl > 0, microfacet_diffuse(np.clip(nl, 1e-6, 1.0), nv, cp, DIFFUSE_SIGMA, 0.04), 0.0)
-    return np.repeat(f[:, None], 3, axis=1)
+    f = np.where(nl > 0, microfacet_diffuse(np.clip(nl, 1e-6, 1.0), nv, cp, params["alpha"], params["f0"][0]), 0.0)
+    return f[:, None] * np.asarray(params["rho_d"], np.float64)[None, :]
 
 
 def studies(lib) -> tuple[list[Study], list[str]]:
@@ -286,7 +287,7 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
     out_studies = []
     for st in found:
         rows = []
-        exact = st.exact if st.exact_fn is None else _once(st.exact_fn)  # a quadrature: once per study
+        exact = st.exact if st.exact_fn is None else _once(lambda L, V, N, st=st: st.exact_fn(L, V, N, st.params))
         members = list(st.kernels.items()) + ([("exact model's kernel", st.exact)] if st.exact else [])
         for label, spec in members:
             row = {"label": label, "spec": spec, "exact_kernel": spec == st.exact, "time": {}}
@@ -395,11 +396,27 @@ def plot(report: dict, path: Path) -> None:
         else:
             ax.text(0.02, 0.02, "no front: the more accurate kernels are not slower beyond the noise",
                     transform=ax.transAxes, fontsize=7, color="0.3")
-        order = np.argsort(y)
-        for rank, i in enumerate(order):  # labels alternate sides down the error axis, so close points stay legible
-            ax.annotate(rs[i]["label"], (x[i], y[i]), textcoords="offset points",
-                        xytext=(8, 4) if rank % 2 == 0 else (-8, -10), ha="left" if rank % 2 == 0 else "right",
-                        fontsize=7)
+        # points that coincide on the plot (equal to 2 % in time and error) share one label; labels alternate
+        # sides down the error axis, so close points stay legible
+        groups: list[list[int]] = []
+        for i in np.argsort(y):
+            near = next((g for g in groups if abs(x[g[0]] - x[i]) < 0.02 * max(x[g[0]], 1e-9)
+                         and abs(np.log10(y[g[0]] / y[i])) < 0.01), None)
+            (near.append(i) if near is not None else groups.append([i]))
+        placed = []  # the labels' boxes so far: a label takes the first offset whose box overlaps none
+        renderer = fig.canvas.get_renderer()
+        offsets = [(8, 4, "left"), (-8, -10, "right"), (8, -12, "left"), (-8, 6, "right"), (8, 14, "left"),
+                   (-8, -20, "right"), (8, -22, "left"), (-8, 16, "right")]
+        for rank, g in enumerate(groups):
+            for k in range(len(offsets)):
+                dx, dy, ha = offsets[(rank + k) % len(offsets)]
+                a = ax.annotate(" = ".join(rs[i]["label"] for i in g), (x[g[0]], y[g[0]]), textcoords="offset points",
+                                xytext=(dx, dy), ha=ha, fontsize=7)
+                box = a.get_window_extent(renderer)
+                if not any(box.overlaps(b) for b in placed) or k == len(offsets) - 1:
+                    placed.append(box)
+                    break
+                a.remove()
         unit = "exact kernel" if st["baseline"] != LAMBERT else "Lambert"
         ax.set_title(f"{st['title']}\nagainst: {st['exact']}", fontsize=9)
         ax.set_yscale("log")

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import re
 import random
 import sys
 from pathlib import Path
@@ -45,23 +44,28 @@ def brdfs(lib) -> list[str]:
     return diffuse + specular + [f"{d}+{s}" for d in diffuse for s in specular]
 
 
-def _reads(b, names) -> bool:
-    return any(p.name in names for f in b.entries for p in f.params)
-
-
 def packings(lib, brdf: str) -> list[str]:
-    from generator.library.inputs import BY_NAME
-    tangent_rows = {n for n, row in BY_NAME.items() if row.tangent}
-    anisotropic = {b.id for k in ("diffuse", "specular", "ndf", "fresnel", "visibility") for b in lib.of_kind(k)
-                   if _reads(b, tangent_rows)}
+    """The packings a material of this BRDF may have: constants and albedo_texture with every normal filler, kept
+    where scene loading accepts them (matrix/constraints.py): albedo_texture only for a BRDF that reads rho_d,
+    and only normals that carry the tangent for a BRDF that reads the tangent frame. Each term is parsed once."""
+    from generator.matrix.constraints import reads_tangent
+    from generator.matrix.permutation import parse_brdf
+    from generator.library.params import spec_params
     normals = [b.id for b in sorted(lib.of_kind("normal"), key=lambda b: b.id)]
-    if set(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", brdf)) & anisotropic:  # only normals that carry the tangent
-        normals = [n for n in normals if _reads(lib.get("normal", n), ("T", "B"))]
-    reads_albedo = brdf.split("+")[0] in {b.id for b in lib.of_kind("diffuse") if "rho_d" in b.params}
-    out = [f"constants(normal={n})" for n in normals]
-    if reads_albedo:
-        out += [f"albedo_texture(normal={n})" for n in normals]
-    return out
+    tangent, params = False, set()
+    for term in brdf.split("+"):  # a BRDF is diffuse + specular terms; fillers have no '+'
+        if term not in _TERMS:
+            nodes = parse_brdf(term, lib)
+            _TERMS[term] = (bool(reads_tangent(nodes)), set(spec_params(nodes)))
+        tangent, params = tangent or _TERMS[term][0], params | _TERMS[term][1]
+    if tangent:
+        normals = [n for n in normals if any(p.name in ("T", "B") for f in lib.get("normal", n).entries
+                                                 for p in f.params)]
+    return [f"{p}(normal={n})" for p in ("constants", "albedo_texture") for n in normals
+            if p == "constants" or "rho_d" in params]
+
+
+_TERMS: dict[str, tuple[bool, set]] = {}
 
 
 def light_sets(lib) -> list[list[tuple[str, str]]]:
@@ -90,9 +94,8 @@ def scene_text(n: int, per: int = 1) -> str:
     for k, s in enumerate(sets):
         out.append(f"set{k} = [{', '.join(repr(light_names[x]).replace(chr(39), chr(34)) for x in s)}]")
     out.append("")
-    pairs = [(m, s) for m in range(len(materials)) for s in range(len(sets))]
-    random.Random(0).shuffle(pairs)  # a fixed mix of materials and light sets
-    pairs = pairs[:n]
+    # a fixed mix of materials and light sets: n distinct (material, set) pairs drawn without building them all
+    pairs = [divmod(k, len(sets)) for k in random.Random(0).sample(range(len(materials) * len(sets)), n)]
     used = {m for m, _ in pairs}
     for m in sorted(used):
         b, p = materials[m]

@@ -312,3 +312,13 @@ def test_command_scene_errors(tmp_path, capsys):
     assert f"{scene}:" in err and "lambrt" in err and "lambert" in err  # located, with the closest name
     assert main(["accuracy", str(scene), "lambert", "--targets", "numpy"]) == 2
     assert "either BRDF specs or one scene file" in capsys.readouterr().err
+
+
+def test_float16_alone_is_reported_not_judged(capsys):
+    # n = 1e5 overflows half: NaN/Inf in float16, which must not fail the command (float32 decides; none ran)
+    rc = main(["accuracy", "blinn_phong_normalized", "--targets", "numpy", "--dtypes", "float16", "--samples", "2",
+               "--format", "json"])
+    cap = capsys.readouterr()
+    rep = json.loads(cap.out)
+    assert any(r["nan"] or r["inf"] for r in rep["results"]) and rc == 0, cap.err
+    assert rep["verdicts"][0]["pass"] and rep["verdicts"][0]["hemisphere_max_rel"] is None

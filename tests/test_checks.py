@@ -33,11 +33,26 @@ def test_check_passes_writes_and_diffs_golden_sources(tmp_path):
     r = _check(EXAMPLE, "--golden", golden, "--languages", "glsl,wgsl")
     assert r.returncode == 1 and "DRIFT " in r.stderr and "1 drifted" in r.stderr
     assert f"--- golden/{files[0]}" in r.stderr and "+++ emitted/" in r.stderr
+    # a golden source no permutation emits any more (a permutation that left the scene) is a drift too
+    _check(EXAMPLE, "--golden", golden, "--update-golden", "--languages", "glsl,wgsl")
+    (golden / "glsl" / "000000000000.frag.glsl").write_text("// gone\n")
+    r = _check(EXAMPLE, "--golden", golden, "--languages", "glsl,wgsl")
+    assert r.returncode == 1 and "DRIFT glsl/000000000000.frag.glsl" in r.stderr and "1 golden files left" in r.stderr
+    assert _check(EXAMPLE, "--golden", golden, "--update-golden", "--languages", "glsl,wgsl").returncode == 0
+    assert not (golden / "glsl" / "000000000000.frag.glsl").exists()
 
 
-def test_check_usage_errors():
+def test_check_usage_errors(tmp_path):
     assert _check(EXAMPLE, "--languages", "metal").returncode == 2
+    assert _check(EXAMPLE, "--languages", "glsl,glsl").returncode == 2
     assert _check(EXAMPLE, "--update-golden").returncode == 2
+    # the plugin: a bad option or scene is the run's usage error, one line, never an INTERNALERROR
+    for opts in (["--shadermatrix-scene", str(EXAMPLE), "--shadermatrix-languages", "metal"],
+                 ["--shadermatrix-scene", str(tmp_path / "missing.toml")]):
+        r = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", *opts], cwd=tmp_path,
+                           capture_output=True, text=True, timeout=300)
+        assert r.returncode == 4 and "INTERNALERROR" not in r.stdout + r.stderr, r.stdout + r.stderr
+        assert "--shadermatrix-scene" in r.stderr
 
 
 @pytest.mark.toolchain

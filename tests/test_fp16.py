@@ -145,7 +145,7 @@ def test_fp16_limits_from_broken_by_param():
 
 
 def test_drop_capabilities():
-    from generator.runtime.eval_kernel import STORAGE_INPUT_OUTPUT_16, drop_capabilities
+    from generator.runtime.device import STORAGE_INPUT_OUTPUT_16, drop_capabilities
 
     header = [0x07230203, 0x10300, 0, 10, 0]
     body = [(2 << 16) | 17, 1, (2 << 16) | 17, STORAGE_INPUT_OUTPUT_16, (2 << 16) | 17, 9, (3 << 16) | 14, 0, 1]
@@ -277,7 +277,7 @@ def test_build_warns_for_an_fp16_unsafe_brick(tmp_path):
     r = subprocess.run([sys.executable, "-m", "generator.cli", "build", str(tmp_path / "fp16.toml"), "--out",
                         str(tmp_path / "out"), "--bricks", str(tmp_path / "bricks"), "--no-cache", "-q"],
                        cwd=REPO, capture_output=True, text=True, timeout=300)
-    assert "warning: fp16 permutation" in r.stderr and "test overflow" in r.stderr
+    assert "fp16 permutation(s) (" in r.stderr and "test overflow" in r.stderr
     assert r.returncode == 0, r.stderr
 
 

@@ -65,6 +65,16 @@ def golden_diff(golden: Path, sources: dict[str, str]) -> list[str]:
     return out
 
 
+def stale_golden(golden: Path, languages, emitted: set[str]) -> list[str]:
+    """Golden files (relative paths) under the checked languages that no check emitted: permutations gone."""
+    out = []
+    for lang in languages:
+        d = golden / lang
+        if d.is_dir():
+            out += sorted(f"{lang}/{p.name}" for p in d.iterdir() if p.is_file() and f"{lang}/{p.name}" not in emitted)
+    return out
+
+
 def default_store(cache_dir=None):
     from ..io import Store, default_cache_dir
     root = cache_dir or default_cache_dir()

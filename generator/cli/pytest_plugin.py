@@ -22,8 +22,8 @@ def pytest_addoption(parser):
     group.addoption("--shadermatrix-bricks", action="append", default=[], metavar="DIR",
                     help="an extra brick directory (repeatable)")
     group.addoption("--shadermatrix-golden", metavar="DIR", help="golden sources to compare with")
-    group.addoption("--shadermatrix-languages", default="glsl,hlsl,wgsl", metavar="LIST",
-                    help="comma-separated languages (default glsl,hlsl,wgsl)")
+    group.addoption("--shadermatrix-languages", metavar="LIST",
+                    help="comma-separated languages, from glsl, hlsl, wgsl (default all)")
 
 
 class ShaderCheckFailed(Exception):
@@ -47,7 +47,8 @@ class PermutationItem(pytest.Item):
                 raise ShaderCheckFailed("emitted sources drift from the golden ones:\n" + "".join(diff))
 
     def repr_failure(self, excinfo):
-        if isinstance(excinfo.value, ShaderCheckFailed):
+        from ..lang.errors import UserError
+        if isinstance(excinfo.value, (ShaderCheckFailed, UserError)):  # a missing tool too: one message, no trace
             return f"{self.check.id} ({', '.join(self.check.objects)}):\n{excinfo.value}"
         return super().repr_failure(excinfo)
 
@@ -62,12 +63,18 @@ class SceneCollector(pytest.Collector):
 
     def collect(self):
         from ..build.checks import checks
+        from ..lang.errors import UserError
         from ..library.bricks import load_library
         from ..matrix.scene import load_scene
+        from ..targets import LANGUAGES, parse_languages
         opt = self.config.getoption
-        lib = load_library(opt("--shadermatrix-bricks"))
-        scene = load_scene(self.scene_path, lib)
-        langs = [x.strip() for x in opt("--shadermatrix-languages").split(",") if x.strip()]
+        try:  # a bad scene, brick or option is the run's usage error, one line, not an INTERNALERROR
+            langs = parse_languages(opt("--shadermatrix-languages")) if opt("--shadermatrix-languages") \
+                else list(LANGUAGES)
+            lib = load_library(opt("--shadermatrix-bricks"))
+            scene = load_scene(self.scene_path, lib)
+        except (UserError, ValueError) as e:
+            raise pytest.UsageError(f"--shadermatrix-scene {self.scene_path}: {e}") from None
         for c in checks(scene, langs):
             yield PermutationItem.from_parent(self, name=c.id, scene=scene, lib=lib, check=c,
                                               golden=opt("--shadermatrix-golden"))
@@ -78,6 +85,14 @@ def pytest_configure(config):
 
 
 def pytest_collection_modifyitems(session, config, items):
+    seen = set()
     for path in config.getoption("--shadermatrix-scene"):
         p = Path(path).resolve()
-        items.extend(SceneCollector.from_parent(session, name=p.name, path=p, scene_path=p).collect())
+        if p in seen:
+            continue
+        seen.add(p)
+        try:  # the node id names the scene by its path from the rootdir: two scene.toml files stay apart
+            name = p.relative_to(config.rootpath).as_posix()
+        except ValueError:
+            name = p.as_posix()
+        items.extend(SceneCollector.from_parent(session, name=name, path=p, scene_path=p).collect())

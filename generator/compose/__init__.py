@@ -133,6 +133,9 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram |
     (precision "fp16": the BRDF computes in half; samples, parameters and result stay 32-bit)."""
     ep = ep or eval_program(spec, lib)
     prog, canon, h = ep.program, ep.spec, ep.hash
+    if precision != "fp32":  # an fp16 kernel is another kernel: its key, hash and name say so (fp32 ones unchanged)
+        canon = f"{canon};precision={precision}"
+        h = hashlib.sha256(("eval:" + canon).encode()).hexdigest()[:12]
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
     sources = []

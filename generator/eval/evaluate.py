@@ -224,7 +224,7 @@ def gpu_fp16_status(device=None) -> tuple[bool, str]:
     device = device or shared_device()
     if device.fp16:
         return True, ""
-    return False, f"{device.name} does not report shaderFloat16 (VkPhysicalDeviceShaderFloat16Int8Features)"
+    return False, f"{device.name} does not report shaderFloat16 and 16-bit storage access"
 
 
 def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, texels=(), dtype: str = "float32") -> np.ndarray:
@@ -233,8 +233,9 @@ def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, texels=(), dtype
     if dtype == "float16":
         ok, why = gpu_fp16_status()
         if not ok:
-            raise EvalError(f"target {language} cannot run float16 here: {why}",
-                            "evaluate float32 on the GPU, or float16 with --target numpy")
+            from ..runtime.device import Fp16Unsupported
+            raise Fp16Unsupported(f"target {language} cannot run float16 here: {why} — evaluate float32 on the "
+                                  "GPU, or float16 with --target numpy")
     kernel = gpu_kernel(ep.spec, language, lib, precision="fp16" if dtype == "float16" else "fp32")
     f32 = [v.astype(np.float32) for v in vecs]
     textures = [Texture(np.asarray(x), bool(d.get("srgb"))) for x, (_, _, d) in zip(texels, ep.textures)]

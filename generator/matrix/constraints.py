@@ -49,10 +49,15 @@ def _provides_wrong_type(r) -> tuple[str, str]:
     return "", ""
 
 
-def _tangent_frame(r) -> tuple[str, str]:
+def reads_tangent(nodes) -> list[str]:
+    """The tangent-frame rows of the inputs table (T, B, HdotT, ...) that BRDF nodes and their fillers read."""
     from ..library.inputs import BY_NAME, SHADING
-    tangent = sorted({p.name for n in r.brdf for x in n.walk() for f in x.brick.entries for p in f.params
-                      if p.name in SHADING and BY_NAME[p.name].tangent})
+    return sorted({p.name for n in nodes for x in n.walk() for f in x.brick.entries for p in f.params
+                   if p.name in SHADING and BY_NAME[p.name].tangent})
+
+
+def _tangent_frame(r) -> tuple[str, str]:
+    tangent = reads_tangent(r.brdf)
     frame = any(p.name in ("T", "B") for x in r.packing.walk() for f in x.brick.entries for p in f.params)
     if tangent and not frame:
         return (f"BRDF '{_brdf_text(r)}' reads {', '.join(tangent)} (the tangent frame), but packing "

@@ -119,6 +119,8 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
             objs = [o for h in hs for o in objects_of.get(h, [])]
             if objs:
                 why = f"kept: drawn by {len(objs)} object(s) ({_names(objs)}) in {len(hs)} permutation(s)"
+            elif not mats:
+                why = "dropped: the scene has no object"
             elif axis == "lights":
                 why = f"dropped: light set(s) {_names(mats)} are lit on no object"
             else:

@@ -250,20 +250,21 @@ def check_packing(r: Resolved) -> tuple[str, str]:
 
 
 def fp16_warnings(perms, lib: Library) -> list[str]:
-    """One line per fp16 permutation and brick it uses whose metadata says "fp16": "unsafe: why"
-    (`build` prints them as warnings; the permutation still builds)."""
-    out = []
+    """One line per brick whose metadata says "fp16": "unsafe: why" and that fp16 permutations use, with how many
+    (`build` prints them as warnings; the permutations still build)."""
+    users: dict[tuple, list[str]] = {}
+    why: dict[tuple, tuple[str, str]] = {}
     for perm in perms:
         if perm.precision != "fp16":
             continue
         r = resolve(perm, lib)
         nodes = [n for top in (*r.brdf, r.packing, *(s for _, s in r.lights)) for n in top.walk()]
-        bricks = [n.brick for n in nodes] + [b for b, _ in r.lights] + [r.output]
-        seen = set()
-        for b in bricks:
-            why = b.fp16_unsafe
-            if why and (b.kind, b.id) not in seen:
-                seen.add((b.kind, b.id))
-                out.append(f"fp16 permutation {perm.hash} ({perm.brdf}) uses {b.kind} brick '{b.id}', "
-                           f"unsafe in fp16: {why} ({b.display_path})")
-    return out
+        for b in [n.brick for n in nodes] + [b for b, _ in r.lights] + [r.output]:
+            if b.fp16_unsafe:
+                key = (b.kind, b.id)
+                why[key] = (b.fp16_unsafe, b.display_path)
+                if perm.hash not in users.setdefault(key, []):
+                    users[key].append(perm.hash)
+    return [f"{len(hs)} fp16 permutation(s) ({', '.join(hs[:3])}{', …' if len(hs) > 3 else ''}) use {kind} brick "
+            f"'{bid}', unsafe in fp16: {why[(kind, bid)][0]} ({why[(kind, bid)][1]})"
+            for (kind, bid), hs in users.items()]

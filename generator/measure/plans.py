@@ -235,9 +235,8 @@ def _with_standin_slots(b: Brick, lib: Library, normal: str | None = None) -> st
 
 def _reads_tangent(spec: str, lib: Library) -> bool:
     """Whether a BRDF spec reads a tangent-frame row of the inputs table (an anisotropic model)."""
-    from ..library.inputs import BY_NAME
-    return any(p.name in BY_NAME and BY_NAME[p.name].tangent
-               for top in parse_brdf(spec, lib) for n in top.walk() for f in n.brick.entries for p in f.params)
+    from ..matrix.constraints import reads_tangent
+    return bool(reads_tangent(parse_brdf(spec, lib)))
 
 
 @dataclass

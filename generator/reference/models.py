@@ -181,10 +181,10 @@ def slot_function(fn: Callable, g: Geometry, p: dict) -> Callable:
 
 
 def _term(node, g: Geometry, p: dict) -> np.ndarray:
-    slots = {slot: slot_function(lookup(filler.brick.kind, filler.brick.id), g, p)
-             for slot, filler in node.fillers}
     if node.counts:  # an array parameter's element count, a key constant: `<array>_count` as the brick reads it
         p = {**p, **{f"{a}_count": c for a, c in node.counts}}
+    slots = {slot: slot_function(lookup(filler.brick.kind, filler.brick.id), g, p)
+             for slot, filler in node.fillers}
     return lookup(node.brick.kind, node.brick.id)(g, p, slots)
 
 

@@ -73,6 +73,10 @@ class VulkanUnavailable(EnvironmentMissing, RuntimeError):
     """No usable Vulkan loader, lavapipe device or validation layer; the message says why and what to do."""
 
 
+class Fp16Unsupported(EnvironmentMissing, RuntimeError):
+    """fp16 shaders asked of a device without shaderFloat16 and 16-bit storage (exit 3: the environment)."""
+
+
 @dataclass(frozen=True)
 class ValidationMessage:
     severity: str  # "warning" | "error"
@@ -285,15 +289,22 @@ class Device:
         """A module as this device takes it: naga declares StorageInputOutput16 in every module that enables
         f16, whether or not a 16-bit stage input or output exists; the project's fp16 shaders keep their
         interface 32-bit (targets/clike.py), so where the device lacks storageInputOutput16 (lavapipe) the
-        capability is dropped. Every other module passes unchanged."""
-        if self.features.get("storageInputOutput16") or not uses_float16(spirv):
+        capability is dropped. Every other module passes unchanged. A module using 16-bit floats on a device
+        without fp16 (Device.fp16) is Fp16Unsupported (exit 3): every pipeline is created through here."""
+        if not uses_float16(spirv):
+            return spirv
+        if not self.fp16:
+            raise Fp16Unsupported(f"{self.name} does not report shaderFloat16 and 16-bit storage: fp16 shaders "
+                                  "cannot run there — use precision fp32, or float16 with the numpy target")
+        if self.features.get("storageInputOutput16"):
             return spirv
         return drop_capabilities(spirv, {STORAGE_INPUT_OUTPUT_16})
 
     @property
     def fp16(self) -> bool:
-        """Whether fp16 eval kernels run here (shaderFloat16; naga's f16 modules also need 16-bit storage)."""
-        return bool(self.features.get("shaderFloat16"))
+        """Whether fp16 shaders run here: shaderFloat16, and the 16-bit storage access naga's f16 modules declare."""
+        return all(self.features.get(k) for k in ("shaderFloat16", "storageBuffer16BitAccess",
+                                                  "uniformAndStorageBuffer16BitAccess"))
 
     def host_memory_type(self, type_bits: int) -> int:
         """A memory type the host can map coherently (device-local too when there is one: lavapipe)."""

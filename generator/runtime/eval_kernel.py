@@ -26,7 +26,7 @@ import numpy as np
 
 from ..lang.errors import UserError
 from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM, ComputePipeline
-from .device import STORAGE_INPUT_OUTPUT_16, Device, drop_capabilities, uses_float16, validation_requested  # noqa: F401
+from .device import Device, validation_requested  # noqa: F401
 from .images import Image, texels
 
 WORKGROUP = 64  # local_size_x of templates/*/eval.*.j2
@@ -255,16 +255,12 @@ def _ids(ids, count: int) -> np.ndarray:
     return a.astype(np.float32)
 
 
-class Fp16Unsupported(UserError, RuntimeError):
-    """fp16 evaluation on a device that does not report shaderFloat16."""
-
-
 def compile_kernel(source, device: Device, tangent: bool, param_vec4s: int, textures: int = 0) -> EvalKernel:
     """Compile one composed eval Source (validated, spirv-opt -O) and create its pipeline.
 
     `textures`: how many textures the kernel samples (set 0 bindings 3 + 2k and 4 + 2k, see EvalKernel).
-    A kernel using 16-bit floats (an fp16 kernel: SPIR-V Float16) needs a device with shaderFloat16
-    (Device.fp16), else Fp16Unsupported.
+    A kernel using 16-bit floats (an fp16 kernel: SPIR-V Float16) needs a device with fp16 (Device.fp16):
+    its pipeline raises runtime.device.Fp16Unsupported otherwise (Device.fit_spirv).
     """
     from ..toolchain import CompileJob, compile_many
 
@@ -275,9 +271,6 @@ def compile_kernel(source, device: Device, tangent: bool, param_vec4s: int, text
         raise KernelError(f"the {source.language} eval kernel does not compile: "
                           + "; ".join(e.replace("\n", " ") for e in res.errors())
                           + " — fix the brick at that line (or evaluate with another --target)")
-    if uses_float16(res.spirv) and not device.fp16:
-        raise Fp16Unsupported(f"{device.name} does not report shaderFloat16: fp16 eval kernels cannot run "
-                              "there — evaluate float32, or float16 with the numpy target")
     return EvalKernel(device, res.spirv, tangent, param_vec4s, textures)  # ComputePipeline fits its capabilities
 
 

@@ -17,6 +17,15 @@ HALF_TARGETS: dict[str, Target] = {"glsl": GlslHalfTarget(), "hlsl": HlslHalfTar
 LANGUAGES: tuple[str, ...] = ("glsl", "hlsl", "wgsl")  # the shading languages, in output order
 
 
+def parse_languages(text: str) -> list[str]:
+    """"glsl,wgsl" -> ["glsl", "wgsl"]; ValueError naming the problem for an unknown, repeated or missing name."""
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    bad = [x for x in items if x not in LANGUAGES]
+    if not items or bad or len(set(items)) != len(items):
+        raise ValueError(f"{text!r} is not a comma-separated list of {', '.join(LANGUAGES)}, each at most once")
+    return items
+
+
 def get_target(name: str, precision: str = "fp32") -> Target:
     """The emitter for `name`: "glsl", "hlsl", "wgsl" or "numpy"; precision "fp16" gives a shading
     language's half variant (the NumPy target takes its dtype at load() instead)."""

@@ -33,12 +33,14 @@ def add_arguments(p) -> None:
                    "filler at least once; see --all-combinations), or one scene file (.toml): its materials, "
                    "each at its own parameters")
     p.add_argument("--all-combinations", action="store_true",
-                   help="by default, every combination of slot fillers instead of each filler once")
+                   help="without SPECs: every combination of slot fillers (default: each filler at least once)")
     p.add_argument("--targets", metavar="LIST",
                    help=f"comma-separated, from {', '.join(ACCURACY_TARGETS)} (default: all; the GPU languages "
                         "need a lavapipe device: without one, exit 3 unless --targets leaves them out)")
-    p.add_argument("--dtypes", default=",".join(DTYPES), metavar="LIST",
-                   help="comma-separated, from float64, float32, float16 (GPU targets run float32, and float16 where the device reports shaderFloat16)")
+    p.add_argument("--dtypes", metavar="LIST",
+                   help="comma-separated, from float64, float32, float16 (default all; GPU targets run float32, and "
+                        "float16 where the device reports shaderFloat16: by default a device without it skips the "
+                        "GPU float16 runs with the reason; asked for by --dtypes and --targets, exit 3)")
     p.add_argument("--format", choices=("md", "json"), default="md", help="report format (default md)")
     p.add_argument("--out", metavar="FILE", help="write the report to FILE (atomically) instead of stdout")
     p.add_argument("--samples", type=int, default=12, metavar="K",
@@ -91,7 +93,7 @@ def run(args) -> int:
         if not 1 <= args.samples <= MAX_STRATA:
             raise UsageError(f"--samples {args.samples} is outside 1 … {MAX_STRATA} (K⁴ sample pairs) — "
                              f"give a number of strata in that range (default 12)")
-        dtypes = _list(args.dtypes, DTYPES, "dtype")
+        dtypes = _list(args.dtypes or ",".join(DTYPES), DTYPES, "dtype")
         if args.targets:
             targets = _list(args.targets, ACCURACY_TARGETS, "target")
         else:
@@ -101,10 +103,15 @@ def run(args) -> int:
                                         "why; `make setup` installs it) — or pass --targets numpy to run without")
         lib = load_library(args.bricks or ())
         materials = None
-        if any(_is_scene(s) for s in args.specs):
+        if args.all_combinations and args.specs:
+            raise UsageError("--all-combinations chooses the specs itself — give it without SPECs or a scene")
+        scenes = [s for s in args.specs if _is_scene(s)]
+        if len(scenes) > 1:
+            raise UsageError(f"one scene file at a time — run shadermatrix accuracy {scenes[0]}, then the others")
+        if scenes:
             if len(args.specs) != 1:
                 raise UsageError("give either BRDF specs or one scene file, not both — "
-                                 f"e.g. shadermatrix accuracy {next(s for s in args.specs if _is_scene(s))}")
+                                 f"e.g. shadermatrix accuracy {scenes[0]}")
             materials = scene_materials(Path(args.specs[0]), lib)
             specs = list(materials)
         else:
@@ -132,11 +139,22 @@ def run(args) -> int:
     failed = [v for v in report["verdicts"] if not v["pass"]]
     for v in failed:
         if v["hemisphere_max_rel"] is not None and v["hemisphere_max_rel"] > tol:
-            print(f"error: {v['spec']} {v['hemisphere_target']}/float32: hemisphere max relative error "
-                  f"{v['hemisphere_max_rel']:.3g} exceeds the tolerance {tol:g} (--fail-above)", file=sys.stderr)
+            print(f"error: {v['spec']} {v['hemisphere_target']}/{'/'.join(v['dtypes'])}: hemisphere max relative "
+                  f"error {v['hemisphere_max_rel']:.3g} exceeds the tolerance {tol:g} (--fail-above)", file=sys.stderr)
+    skipped = report.get("skipped", [])
+    for sk in (x for x in skipped if not x["run"].endswith("/float64")):  # float64 on a GPU: never, by design
+        print(f"note: not run: {sk['run']} — {sk['why']}", file=sys.stderr)
     too_big = bool(failed)
     print(f"{len(specs) - len(failed)} of {len(specs)} specs pass; {len(specs)} specs × {', '.join(report['runs'])}: "
           f"{'no' if not bad else len(bad)} float32 NaN/Inf"
           + (f"; worst float32 hemisphere error {worst['max_rel']:.2e} ({worst['spec']}, {worst['target']})"
              if worst else "") + (f" → {args.out}" if args.out else ""), file=sys.stderr)
-    return 1 if bad or too_big else 0
+    if bad or too_big:
+        return 1
+    asked = args.dtypes and args.targets and "float16" in dtypes
+    missing = [sk for sk in skipped if sk["run"].endswith("/float16") and sk["run"].split("/")[0] in GPU_TARGETS]
+    if asked and missing:  # asked for by name and the device cannot: the environment, never silently skipped
+        from ...runtime.device import Fp16Unsupported
+        raise Fp16Unsupported(f"{', '.join(sk['run'] for sk in missing)}: {missing[0]['why']} "
+                              "(the report above leaves them out)")
+    return 0

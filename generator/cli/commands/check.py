@@ -20,23 +20,23 @@ def add_arguments(p) -> None:
     p.add_argument("scene", help="scene file (TOML)")
     p.add_argument("--golden", metavar="DIR", help="compare the emitted sources with DIR/<language>/<hash>.<stage>.<ext>")
     p.add_argument("--update-golden", action="store_true", help="with --golden: write the emitted sources there")
-    p.add_argument("--languages", default="glsl,hlsl,wgsl", metavar="LIST",
-                   help="comma-separated, from glsl, hlsl, wgsl (default all)")
+    p.add_argument("--languages", metavar="LIST", help="comma-separated, from glsl, hlsl, wgsl (default all)")
     p.add_argument("--cache-dir", metavar="DIR", help="the compile cache (default: as `build`'s)")
     p.add_argument("--bricks", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
 
 
 def run(args) -> int:
-    from ...build.checks import checks, default_store, golden_diff, run_check
+    from ...build.checks import checks, default_store, golden_diff, run_check, stale_golden
     from ...io import atomic_write
     from ...library.bricks import load_library
     from ...matrix.scene import load_scene
-    from ...targets import LANGUAGES
+    from ...targets import LANGUAGES, parse_languages
 
-    langs = [x.strip() for x in args.languages.split(",") if x.strip()]
-    if not langs or any(x not in LANGUAGES for x in langs):
-        raise UsageError(f"--languages {args.languages!r}: use a comma-separated list from {', '.join(LANGUAGES)}")
+    try:
+        langs = parse_languages(args.languages) if args.languages else list(LANGUAGES)
+    except ValueError as e:
+        raise UsageError(f"--languages: {e}") from None
     if args.update_golden and not args.golden:
         raise UsageError("--update-golden needs --golden DIR — e.g. --golden tests/golden/scene --update-golden")
     lib = load_library(args.bricks)
@@ -44,8 +44,10 @@ def run(args) -> int:
     store = default_store(args.cache_dir)
     failed = drifted = 0
     todo = checks(scene, langs)
+    emitted: set[str] = set()
     for c in todo:
         errors, sources = run_check(scene, lib, c, store)
+        emitted.update(sources)
         if errors:
             failed += 1
             print(f"FAIL {c.id} ({', '.join(c.objects)}):", file=sys.stderr)
@@ -63,6 +65,17 @@ def run(args) -> int:
                 sys.stderr.writelines(diff)
                 continue
         print(f"ok {c.id}")
+    stale = []
+    if args.golden and not failed:  # golden sources of permutations that left the scene
+        stale = stale_golden(Path(args.golden), langs, emitted)
+        for rel in stale:
+            if args.update_golden:
+                (Path(args.golden) / rel).unlink()
+            else:
+                print(f"DRIFT {rel}: a golden source no permutation of the scene emits "
+                      "(--update-golden removes it)", file=sys.stderr)
+        stale = [] if args.update_golden else stale
     print(f"{len(todo) - failed - drifted} of {len(todo)} checks pass ({len(scene.permutations)} permutations × "
-          f"{len(langs)} languages); {failed} failed, {drifted} drifted from the golden sources", file=sys.stderr)
-    return 1 if failed or drifted else 0
+          f"{len(langs)} languages); {failed} failed, {drifted} drifted from the golden sources"
+          + (f"; {len(stale)} golden files left over" if stale else ""), file=sys.stderr)
+    return 1 if failed or drifted or stale else 0

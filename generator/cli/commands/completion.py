@@ -19,7 +19,11 @@ def add_arguments(p) -> None:
 
 
 def run(args) -> int:
-    import shtab
+    try:
+        import shtab
+    except ImportError:
+        from ...lang.errors import EnvironmentMissing
+        raise EnvironmentMissing("shtab is not installed — run `make setup` (scripts/setup.sh)") from None
 
     from .. import parser
     sys.stdout.write(shtab.complete(parser(), shell=args.shell))

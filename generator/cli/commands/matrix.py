@@ -30,17 +30,17 @@ def add_arguments(p) -> None:
                    help="an extra brick directory (repeatable)")
 
 
-def spirv_identities(scene, lib, cache_dir) -> dict[str, tuple]:
-    """{permutation hash: its SPIR-V files, every language and stage} from a build into a temporary directory."""
+def spirv_identities(scene, lib, cache_dir) -> tuple[dict[str, tuple], list[str]]:
+    """({permutation hash: its SPIR-V (sha256 per language and stage)}, the build's failures), from a build into a
+    temporary directory through the compile cache."""
     from ...build import build_scene
-    from ...io import Store, default_cache_dir
-    root = cache_dir or default_cache_dir()
-    store = Store(root) if root else None
+    from ...build.checks import default_store
     with tempfile.TemporaryDirectory(prefix="shadermatrix-matrix-") as tmp:
-        res = build_scene(scene, lib, Path(tmp), store=store)
-        return {p["hash"]: tuple(sorted((lang, stage, item["spirv"]) for lang, stages in p["languages"].items()
-                                        for stage, item in stages.items()))
-                for p in res.manifest["permutations"] if p.get("status") == "ok"}
+        res = build_scene(scene, lib, Path(tmp), store=default_store(cache_dir))
+        ids = {p["hash"]: tuple(sorted((lang, stage, item.get("spirv_sha256") or item["spirv"])
+                                       for lang, stages in p["languages"].items() for stage, item in stages.items()))
+               for p in res.manifest["permutations"] if p.get("status") == "ok"}
+        return ids, list(res.failures)
 
 
 def run(args) -> int:
@@ -50,7 +50,9 @@ def run(args) -> int:
 
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)
-    spirv = None if args.no_compile else spirv_identities(scene, lib, args.cache_dir)
+    spirv, failures = (None, []) if args.no_compile else spirv_identities(scene, lib, args.cache_dir)
     rep = report(scene, lib, spirv)
     sys.stdout.write(markdown(rep, args.explain) if args.format == "md" else json.dumps(rep, indent=1) + "\n")
-    return 0
+    for f in failures:  # a permutation that does not compile is not merged with anything: say so, exit 1
+        print(f"error: {f}", file=sys.stderr)
+    return 1 if failures else 0
