@@ -133,7 +133,7 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
               **({"merged_into": merged_into[h]} if h in merged_into and merged_into[h] != h else {})}
              for h, p in scene.permutations.items()]
     return {"scene": scene.name, "stages": stages, "axes": values, "invalid": invalid, "permutations": perms,
-            "constraints": [{"name": c.name, "doc": c.doc} for c in CONSTRAINTS]}
+            "constraints": [{"name": c.name, "doc": c.doc} for c in CONSTRAINTS], "notes": list(scene.notes)}
 
 
 def _names(xs, limit: int = 6) -> str:
@@ -152,8 +152,10 @@ def markdown(rep: dict, explain: bool) -> str:
     out += ([f"- `{x['brdf']}` with `{x['packing']}`: {'; '.join(x['why'])}" for x in rep["invalid"]]
             or ["None: every BRDF × packing pair of the scene is valid."])
     out += ["", "Constraints (generator/matrix/constraints.py): "
-            + "; ".join(f"`{c['name']}` — {c['doc']}" for c in rep["constraints"]) + ".",
-            "", "## Permutations and their objects", "", "| permutation | materials | objects | merged into | key |",
+            + "; ".join(f"`{c['name']}` — {c['doc']}" for c in rep["constraints"]) + "."]
+    if rep.get("notes"):  # what an importer (glTF) accepted without shading it, or left out
+        out += ["", "## Accepted, not applied", ""] + [f"- {n}" for n in rep["notes"]]
+    out += ["", "## Permutations and their objects", "", "| permutation | materials | objects | merged into | key |",
             "|---|---|---|---|---|"]
     out += [f"| `{p['hash']}` | {', '.join(p['materials'])} | {', '.join(p['objects'])} | "
             f"{('`' + p['merged_into'] + '`') if 'merged_into' in p else ''} | `{p['key']}` |"

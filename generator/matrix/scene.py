@@ -127,6 +127,8 @@ class Scene:
     # ubershader's, which every material feeds, points at [scene]
     where: dict[str, tuple[int, int]] = field(default_factory=dict)
     head_at: tuple[int, int] = (1, 1)
+    notes: list[str] = field(default_factory=list)  # what an importer accepted or did not apply (matrix/gltf.py)
+    extra: dict = field(default_factory=dict)  # an importer's own data: glTF's extensions and pygltflib document
 
 
 def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]:
@@ -150,8 +152,11 @@ MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed
 
 
 def load_scene(path, lib: Library) -> Scene:
-    """Read, validate and reduce a TOML scene to its permutations."""
+    """Read, validate and reduce a TOML scene (or a glTF 2.0 .gltf/.glb: matrix/gltf.py) to its permutations."""
     path = Path(path)
+    if path.suffix.lower() in (".gltf", ".glb"):
+        from .gltf import load_gltf
+        return load_gltf(path, lib)
     shown = str(path)
     if path.is_dir():
         raise SourceError(shown, 1, 1, "is a directory, not a scene file", "pass a .toml scene file")

@@ -1,6 +1,6 @@
 """`shadermatrix accuracy`: error of every target and dtype against the float64 references.
 
-    shadermatrix accuracy [SPEC ... | SCENE.toml] [--targets numpy,glsl,hlsl,wgsl] [--dtypes float64,float32,float16]
+    shadermatrix accuracy [SPEC ... | SCENE] [--targets numpy,glsl,hlsl,wgsl] [--dtypes float64,float32,float16]
                           [--format md|json] [--out FILE] [--samples K] [--fail-above TOL]
 
 Without SPECs: every BRDF brick (each diffuse term, each specular term with
@@ -30,7 +30,7 @@ MAX_STRATA = 40  # K⁴ = 2,560,000 (l, v) pairs; one spec takes ~1.5 GB and 10 
 
 def add_arguments(p) -> None:
     p.add_argument("specs", nargs="*", metavar="SPEC|SCENE", help="BRDF specs (default: every BRDF brick, each slot "
-                   "filler at least once; see --all-combinations), or one scene file (.toml): its materials, "
+                   "filler at least once; see --all-combinations), or one scene file (.toml, .gltf, .glb): its materials, "
                    "each at its own parameters")
     p.add_argument("--all-combinations", action="store_true",
                    help="without SPECs: every combination of slot fillers (default: each filler at least once)")
@@ -64,7 +64,7 @@ def _list(value: str, allowed: tuple, what: str) -> list[str]:
 
 
 def _is_scene(arg: str) -> bool:
-    return arg.endswith(".toml")
+    return arg.lower().endswith((".toml", ".gltf", ".glb"))
 
 
 def scene_materials(path: Path, lib) -> dict:

@@ -12,7 +12,7 @@ HELP = "build a scene's shader matrix: sources + SPIR-V per language and manifes
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("scene", help="scene file (TOML, or glTF 2.0 .gltf/.glb)")
     p.add_argument("--out", required=True, help="output directory")
     p.add_argument("--bricks", action="append", metavar="DIR",
                    help="an extra brick directory (repeatable)")

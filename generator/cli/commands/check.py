@@ -17,7 +17,7 @@ HELP = "compile and validate every permutation × language of a scene (a CI's ch
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("scene", help="scene file (TOML, or glTF 2.0 .gltf/.glb)")
     p.add_argument("--golden", metavar="DIR", help="compare the emitted sources with DIR/<language>/<hash>.<stage>.<ext>")
     p.add_argument("--update-golden", action="store_true", help="with --golden: write the emitted sources there")
     p.add_argument("--languages", metavar="LIST", help="comma-separated, from glsl, hlsl, wgsl (default all)")

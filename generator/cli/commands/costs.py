@@ -14,7 +14,7 @@ BUDGET_NAMES = ("texture", "alu", "transcendental", "alu_t", "branches", "regist
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scene", nargs="?", help="scene file (TOML): one row per permutation and stage")
+    p.add_argument("scene", nargs="?", help="scene file (TOML, or glTF 2.0 .gltf/.glb): one row per permutation and stage")
     p.add_argument("--per-brick", action="store_true",
                    help="per-brick table instead: each brick's cost against a trivial stand-in")
     p.add_argument("--bricks", action="append", metavar="DIR", default=[],
@@ -105,7 +105,7 @@ def run(args) -> int:
     if args.gpu is not None:
         from ...measure.gpu import GpuRequest
         from ...runtime.gpu_stats import DEFAULT_FAMILIES, check_families
-        if "/" in args.gpu or args.gpu.endswith(".toml"):  # `costs --gpu SCENE`: the scene taken for families
+        if "/" in args.gpu or args.gpu.lower().endswith((".toml", ".gltf", ".glb")):  # `costs --gpu SCENE`: the scene taken for families
             raise UsageError(f"--gpu {args.gpu}: that is a file, not AMD families — put the scene first "
                              f"(`costs SCENE --gpu`) or write `--gpu=navi21,...`")
         try:

@@ -18,7 +18,7 @@ HELP = "how a scene's matrix is pruned: full product, valid, used, merged; --exp
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("scene", help="scene file (TOML, or glTF 2.0 .gltf/.glb)")
     p.add_argument("--explain", action="store_true",
                    help="every axis value kept or dropped and why, the forbidden combinations, each permutation's "
                         "objects")

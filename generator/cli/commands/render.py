@@ -11,7 +11,7 @@ HELP = "render a scene offscreen on lavapipe: specialized, ubershader or hybrid;
 
 
 def add_arguments(p) -> None:
-    p.add_argument("scene", help="scene file (TOML)")
+    p.add_argument("scene", help="scene file (TOML, or glTF 2.0 .gltf/.glb)")
     p.add_argument("--mode", choices=("specialized", "ubershader", "hybrid"), default="hybrid")
     p.add_argument("--frames", type=int, default=3, help="frames to draw (default 3)")
     p.add_argument("--out", required=True, help="output directory: frame_NNNN.png, report.json, the pipeline cache")
