@@ -35,22 +35,41 @@ def checks(scene: Scene, languages=LANGUAGES) -> list[Check]:
     return [Check(h, lang, tuple(scene.users.get(h, ()))) for h in sorted(scene.permutations) for lang in languages]
 
 
-def run_check(scene: Scene, lib: Library, check: Check, store=None) -> tuple[list[str], dict[str, str]]:
-    """(errors, {golden-relative path: emitted source}) of one check; no errors when it compiles and validates."""
+def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> list[tuple[list[str], dict[str, str]]]:
+    """Per check, (errors, {golden-relative path: emitted source}); no errors when it compiles and validates.
+
+    Every check's shaders are compiled in one batch (the tool processes run in parallel, identical shaders
+    once), as `build` does, then the results are split per check."""
     from ..compose import compose_permutation
     from ..lang import SourceError
     from ..toolchain import compile_many
     from ..toolchain.scenes import source_jobs
 
-    perm = scene.permutations[check.hash]
-    try:
-        composed = compose_permutation(perm, lib, (check.language,))
-    except SourceError as e:
-        return [str(e)], {}
-    sources = {f"{s.language}/{check.hash}.{s.stage}.{s.language}": s.text for s in composed.sources}
-    results = compile_many(source_jobs(check.hash, composed.sources), optimize=True, validate=True, store=store)
-    errors = [line for r in results.values() if not r.ok for line in r.errors()]
-    return errors, sources
+    composed: dict[Check, object] = {}
+    failed: dict[Check, list[str]] = {}
+    jobs = []
+    for c in todo:
+        try:
+            composed[c] = compose_permutation(scene.permutations[c.hash], lib, (c.language,))
+        except SourceError as e:
+            failed[c] = [str(e)]
+            continue
+        jobs += source_jobs(c.hash, composed[c].sources)
+    results = compile_many(jobs, optimize=True, validate=True, store=store) if jobs else {}
+    out = []
+    for c in todo:
+        if c in failed:
+            out.append((failed[c], {}))
+            continue
+        mine = [results[j.key] for j in source_jobs(c.hash, composed[c].sources)]
+        out.append(([line for r in mine if not r.ok for line in r.errors()],
+                    {f"{s.language}/{c.hash}.{s.stage}.{s.language}": s.text for s in composed[c].sources}))
+    return out
+
+
+def run_check(scene: Scene, lib: Library, check: Check, store=None) -> tuple[list[str], dict[str, str]]:
+    """(errors, sources) of one check (the pytest plugin runs one per test item)."""
+    return run_checks(scene, lib, [check], store)[0]
 
 
 def golden_diff(golden: Path, sources: dict[str, str]) -> list[str]:
