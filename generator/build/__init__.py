@@ -69,7 +69,7 @@ class BuildResult:
 
 
 def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None, depfile=None,
-                workers: int | None = None, executor=None, keep_removed: bool = False) -> BuildResult:
+                workers: int | None = None, executor=None, keep_removed: bool = False, pack: bool = False) -> BuildResult:
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     store: an io.Store (the content-addressed cache): compiled shaders and their costs are served from it
@@ -77,6 +77,8 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     workers: tool processes at once (default: the core count); executor: where compiles run instead
     (toolchain/dask.py). Neither changes a byte of the output. keep_removed: the outputs of permutations that
     left the scene stay, listed under the manifest's ``removed`` (marked so), instead of being deleted.
+    pack: also write one shader pack per language (build/pack.py), listed under the manifest's ``packs``;
+    without it the manifest is what it always was.
 
     Incremental: each permutation's manifest entry records ``input_key``, the sha256 of everything its
     outputs depend on (its key, the source of every brick it reads, the scene values of the objects that
@@ -95,7 +97,7 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     out = Path(out)
     with locked(out):
         clean_leftovers(out)
-        res = _build(scene, lib, out, languages, store, workers, executor, keep_removed)
+        res = _build(scene, lib, out, languages, store, workers, executor, keep_removed, pack)
         if depfile is not None:
             write_depfile(depfile, shown(out / "manifest.json"), _deps(scene, lib, out))
     return res
@@ -118,7 +120,7 @@ def _templates_read(also=()) -> list[str]:
 
 
 def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None, executor=None,
-           keep_removed: bool = False) -> BuildResult:
+           keep_removed: bool = False, pack: bool = False) -> BuildResult:
     res = BuildResult(out, store=store)
     base = _globals(languages)
     users: dict[str, list[dict]] = {}
@@ -133,7 +135,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
     scene_key = content_key(base, scene.name, sorted((k, list(v)) for k, v in scene.light_sets.items()),
                             [[o["name"], o["material"], o["light_set"], o["permutation"]] for o in scene.objects],
                             sorted(repr(m) for m in scene.materials.values()), sorted(repr(x) for x in scene.lights.values()),
-                            keep_removed)
+                            keep_removed, *(["pack"] if pack else []))
     files = _up_to_date(out, keys, uber_key, scene_key)
     if files is not None:  # the record of the last build says every key and file is as it left them
         res.up_to_date, res.kept, res.unchanged = True, len(keys), files + 1
@@ -206,6 +208,9 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
                 and _intact(out, e)]
         res.manifest["removed"] = [{**e, "status": "removed"} for e in sorted({e["hash"]: e for e in gone}.values(),
                                                                              key=lambda e: e["hash"])]
+    if pack:  # written before the manifest that names them (content-named: the old ones stay until after it)
+        from .pack import write_packs
+        res.manifest["packs"] = write_packs(out, res.manifest, lambda changed: _count(res, changed))
     if res.manifest == previous and (out / "manifest.json").is_file():  # nothing changed: not even re-encoded
         _count(res, False)
         text = (out / "manifest.json").read_bytes()
@@ -213,6 +218,8 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         text = (json.dumps(res.manifest, indent=2, sort_keys=False) + "\n").encode()
         _count(res, atomic_write(out / "manifest.json", text))
     collect_garbage(out, res.manifest)  # the new manifest is in place: drop what it no longer names
+    from .pack import collect_packs
+    collect_packs(out, res.manifest)
     _record(out, res.manifest, text, keys, uber_key, res.kept, scene_key, res.templates)  # last: the no-op check trusts it
     return res
 
@@ -257,7 +264,8 @@ def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, k
         (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
     entries = [*manifest["permutations"], *manifest.get("removed", []), manifest.get("ubershader") or {}]
     state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys, "ubershader": uber_key, "scene": scene_key,
-             "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)},
+             "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)}
+             | {p["path"]: p["size"] for p in manifest.get("packs", [])},
              "templates": sorted(templates)}
     atomic_write(out / STATE, (json.dumps(state, sort_keys=True) + "\n").encode())
 

@@ -838,7 +838,7 @@ def _light(rd: _Reader, lib: Library, L, ptr: str, name: str, world: np.ndarray)
 
 def _mesh(rd: _Reader, prim: dict, pptr: str, mode: int, m: GltfMaterial):
     """(runtime Mesh, tangents "file" | "generated", has COLOR_0) of one primitive."""
-    from ..runtime.meshes import Mesh
+    from .mesh import Mesh
 
     aptr = f"{pptr}/attributes"
     attrs = rd.get(prim, "attributes", pptr, "obj")

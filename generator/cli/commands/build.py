@@ -30,6 +30,9 @@ def add_arguments(p) -> None:
     p.add_argument("--keep-removed", action="store_true",
                    help="keep the outputs of permutations that left the scene, listed under the manifest's "
                         "\"removed\" (default: they are deleted)")
+    p.add_argument("--pack", action="store_true",
+                   help="also write one shader pack per language, DIR/packs/<language>.<key16>.smpack (an index and "
+                        "the optimized SPIR-V; format: generator/build/pack.py), listed under the manifest's \"packs\"")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
     p.add_argument("--json", action="store_true",
@@ -38,7 +41,7 @@ def add_arguments(p) -> None:
                    help="write a Make-syntax depfile (Ninja: deps = gcc): OUT/manifest.json and every file read")
 
 
-def summary(scene, res, out, seconds: float) -> dict:
+def summary(scene, res, out, seconds: float, pack: bool = False) -> dict:
     """`build --json`: what the summary line says, as data (an engine's build reads it instead of parsing text)."""
     c = res.compile
     perms = [] if res.up_to_date else res.manifest["permutations"]
@@ -51,7 +54,8 @@ def summary(scene, res, out, seconds: float) -> dict:
             "shaders": c.jobs, "distinct": c.distinct, "merged": c.jobs - c.distinct, "from_cache": c.cached,
             "compiled": c.compiled, "files_written": res.written, "files_unchanged": res.unchanged,
             "spirv_shared": res.aliased, "seconds": round(seconds, 3), "ok": res.ok,
-            "failures": list(res.failures)}
+            "failures": list(res.failures),
+            **({"packs": [p["path"] for p in res.manifest.get("packs", [])]} if pack else {})}
 
 
 def run(args) -> int:
@@ -92,7 +96,7 @@ def run(args) -> int:
         executor = DaskExecutor(args.executor)
     try:
         res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile, workers=args.jobs,
-                          executor=executor, keep_removed=args.keep_removed)
+                          executor=executor, keep_removed=args.keep_removed, pack=args.pack)
     finally:
         if executor is not None:
             executor.close()
@@ -100,7 +104,7 @@ def run(args) -> int:
             os.environ.pop("SHADERMATRIX_QUIET", None)
     seconds = time.perf_counter() - started
     if args.json:
-        print(json.dumps(summary(scene, res, args.out, seconds), indent=2))
+        print(json.dumps(summary(scene, res, args.out, seconds, args.pack), indent=2))
         for f in res.failures:
             print(f"error: {f}", file=sys.stderr)
         return 0 if res.ok else 1
@@ -128,6 +132,8 @@ def run(args) -> int:
           f"({c.jobs - c.distinct} merged), {c.cached} from the cache, {c.compiled} compiled; "
           f"{res.written} files written, {res.unchanged} unchanged, {res.aliased} SPIR-V shared → "
           f"{args.out}/manifest.json ({seconds:.1f} s)")
+    for p in res.manifest.get("packs", []) if args.pack else []:
+        print(f"  pack {p['path']}: {p['entries']} entries, {p['size']} bytes")
     for f in res.failures:
         print(f"error: {f}", file=sys.stderr)
     return 0 if res.ok else 1
