@@ -23,10 +23,13 @@ placed objects' bounds (:func:`~.graphics.directional_shadow_matrix`), a point l
 perspective one from its position (:func:`~.graphics.point_shadow_matrix`); the matrix is
 written into the light's shadow_matrix parameter of both paths (the specialized Lights
 blocks and the ubershader's LightEntry data), and the depth map is bound as the light's
-shadow map. Other textures are generated: an sRGB albedo checker, a normal map of known
-bumps. Pipelines are created through a persisted pipeline cache (runtime/pipeline_cache.py), and
-when the render opens its own device, Mesa's shader disk cache lives in out/shader_cache and
-the driver's hit and miss counts go into the report (runtime/shader_cache.py).
+shadow map (pcf: a `pcf_texel` the scene leaves unset is written as 1 / shadow_size, in both
+paths too) — or, for a brick texture named `shadow_moments` (vsm), the depth's moments (d, d²),
+box-filtered on the host (:func:`moments_map`) and uploaded as an RGBA32F image. Other textures
+are generated: an sRGB albedo checker, a normal map of known bumps. Pipelines are created through
+a persisted pipeline cache (runtime/pipeline_cache.py), and when the render opens its own device,
+Mesa's shader disk cache lives in out/shader_cache and the driver's hit and miss counts go into the
+report (runtime/shader_cache.py).
 """
 from __future__ import annotations
 
@@ -79,8 +82,8 @@ class Report:
 
 
 def _textures(device):
-    """A 16×16 sRGB checker albedo, a 32×32 normal map of bumps, a lit (depth 1) stand-in shadow map (bound
-    where an ubershader shadow-map slot is unused by a draw's lights)."""
+    """A 16×16 sRGB checker albedo, a 32×32 normal map of bumps, a lit (depth 1) stand-in shadow map and
+    moments map (E[d] = E[d²] = 1; bound where an ubershader shadow slot is unused by a draw's lights)."""
     j, i = np.meshgrid(np.arange(16), np.arange(16))
     albedo = np.where(((i // 4 + j // 4) % 2 == 0)[..., None], [230, 200, 120], [90, 140, 200]).astype(np.uint8)
     v, u = np.meshgrid((np.arange(32) + 0.5) / 32, (np.arange(32) + 0.5) / 32, indexing="ij")
@@ -90,7 +93,8 @@ def _textures(device):
     shadow = np.ones((4, 4, 4), np.float32)
     grey = np.full((1, 1, 4), 0.5, np.float32)  # any other texture a brick samples (a lookup table, …)
     return _TestTextures({"albedo_map": device.image(albedo, srgb=True), "normal_map": device.image(nmap),
-                          "shadow_map": device.image(shadow)}, lambda: device.image(grey))
+                          "shadow_map": device.image(shadow), "shadow_moments": device.image(shadow)},
+                         lambda: device.image(grey))
 
 
 class _TestTextures(dict):
@@ -135,12 +139,43 @@ def shadow_matrix(light, values: dict, points) -> np.ndarray:
                     "— use shadow = \"none\" for it")
 
 
-def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict) -> bytes:
-    """A specialized Lights block with each shadowed light's l<i>_shadow_matrix slot replaced."""
+PCF_TEXEL = "pcf_texel"  # a shadow parameter of this name the scene leaves unset is 1 / shadow_size (pcf)
+MOMENTS = "shadow_moments"  # a shadow brick texture of this name gets the depth pass's moments (vsm)
+MOMENTS_BOX = 5  # the moments' prefilter: a box of this many texels a side
+
+
+def moments_map(depth: np.ndarray, box: int = MOMENTS_BOX) -> np.ndarray:
+    """(H, W, 4) float32 (E[d], E[d²], 0, 1) of a depth map, box-filtered over box × box texels (box odd; edges
+    clamped). The variance shadow map's contents (bricks/shadow/vsm.py): moments, unlike depths, may be
+    filtered. Computed in float64 and rounded once."""
+    if box < 1 or box % 2 == 0:
+        raise ValueError(f"moments box {box}: use an odd number of texels")
+    d = np.asarray(depth, np.float64)
+    m = np.stack([d, d * d], -1)
+    r = box // 2
+    if r > 0:
+        for axis in (0, 1):
+            pad = [(0, 0)] * 3
+            pad[axis] = (r, r)
+            c = np.cumsum(np.pad(m, pad, mode="edge"), axis=axis)
+            c = np.concatenate([np.zeros_like(np.take(c, [0], axis=axis)), c], axis=axis)
+            n = m.shape[axis]
+            m = (np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)) / box
+    out = np.zeros(d.shape + (4,), np.float32)
+    out[..., :2] = m
+    out[..., 3] = 1.0
+    return out
+
+
+def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict, texels: dict | None = None) -> bytes:
+    """A specialized Lights block with each shadowed light's l<i>_shadow_matrix slot replaced (and its
+    l<i>_pcf_texel, for the lights in `texels`)."""
     data = np.frombuffer(raw, np.float32).reshape(-1, 4).copy()
     for s in slots:
         if s.param == "shadow_matrix" and s.light is not None and lights[s.light] in matrices:
             data[s.index:s.index + 4] = np.asarray(matrices[lights[s.light]], np.float32).reshape(4, 4)
+        if s.param == PCF_TEXEL and s.light is not None and lights[s.light] in (texels or {}):
+            data[s.index, 0] = texels[lights[s.light]]
     return data.tobytes()
 
 
@@ -207,6 +242,11 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     matrices = {ln: gx.column_major(shadow_matrix(scene.lights[ln], light_vals[ln], points)) for ln in shadowed}
     for ln in shadowed:
         light_vals[ln]["shadow_matrix"] = matrices[ln]
+    # pcf's tap spacing: one texel of the map this render makes, unless the scene says otherwise
+    texels = {ln: 1.0 / shadow_size for ln in shadowed
+              if PCF_TEXEL in light_vals[ln] and PCF_TEXEL not in scene.lights[ln].params}
+    for ln, v in texels.items():
+        light_vals[ln][PCF_TEXEL] = v
 
     own_device = device is None
     if own_device:  # lavapipe's compiled shaders persist under out/, and the driver counts its hits
@@ -259,7 +299,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         object_bufs = [buf(gx.object_bytes(o.model), U) for o in placed.objects]
 
         # Depth passes: one DepthTarget per shadowed light, every object drawn by a vertex-only pipeline.
-        shadow_maps = {}
+        shadow_maps, moments = {}, {}
         if shadowed:
             ifaces = [(tag, composed[tag].interface) for tag in composed] + [("ubershader", uber.interface)]
             vtag, viface = max(ifaces, key=lambda x: len(x[1].vertex_inputs))  # all read the same Frame / Object
@@ -280,6 +320,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                                                                (ob.set, ob.binding): object_bufs[i]})
                                for i in range(len(placed.objects))])
                 shadow_maps[ln] = dt
+                if MOMENTS in shadow_textures(lib, scene.lights[ln].shadow):  # vsm: (d, d²), prefiltered
+                    moments[ln] = device.image(moments_map(dt.read()))
+                    owned.append(moments[ln])
                 report.shadow_maps[ln] = {"size": [shadow_size, shadow_size], "gpu_ms": gpu, "sampled": dt.sampled,
                                           "pipeline_ms": pipe_ms, "vertex_shader": vtag,
                                           "shadow_matrix": matrices[ln]}
@@ -324,7 +367,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             return light_buffers["empty"]
 
         def light_texture(t, light_name):
-            """A light's texture: its depth pass's map, or the lit stand-in."""
+            """A light's texture: its depth pass's map (or its moments), or the lit stand-in."""
+            if t.param == MOMENTS and light_name in moments:
+                return moments[light_name]
             return shadow_maps[light_name] if light_name in shadow_maps else textures[t.param]
 
         frame_buf = buf(gx.frame_bytes(vp, eye), U)
@@ -339,7 +384,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             lb = c.interface.block("Lights")
             if lb:
                 spec[(lb.set, lb.binding)] = buf(_override_lights(bytes.fromhex(up["Lights"]), lb.slots, obj["lights"],
-                                                                  matrices), U)
+                                                                  matrices, texels), U)
             if c.interface.block("Material"):
                 spec[(1, 0)] = buf(bytes.fromhex(up["Material"]), U)
             for t in c.interface.textures:
