@@ -22,6 +22,7 @@ def add_arguments(p) -> None:
     p.add_argument("--update-golden", action="store_true", help="with --golden: write the emitted sources there")
     p.add_argument("--languages", metavar="LIST", help="comma-separated, from glsl, hlsl, wgsl (default all)")
     p.add_argument("--cache-dir", metavar="DIR", help="the compile cache (default: as `build`'s)")
+    p.add_argument("--no-cache", action="store_true", help="compile everything; read and write no cache")
     p.add_argument("--bricks", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
 
@@ -41,7 +42,7 @@ def run(args) -> int:
         raise UsageError("--update-golden needs --golden DIR — e.g. --golden tests/golden/scene --update-golden")
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)
-    store = default_store(args.cache_dir)
+    store = None if args.no_cache else default_store(args.cache_dir)
     failed = drifted = 0
     todo = checks(scene, langs)
     emitted: set[str] = set()

@@ -26,17 +26,18 @@ def add_arguments(p) -> None:
     p.add_argument("--no-compile", action="store_true",
                    help="leave out the merged count (it builds the scene, through the compile cache)")
     p.add_argument("--cache-dir", metavar="DIR", help="the compile cache (default: as `build`'s)")
+    p.add_argument("--no-cache", action="store_true", help="compile everything; read and write no cache")
     p.add_argument("--bricks", action="append", metavar="DIR", default=[],
                    help="an extra brick directory (repeatable)")
 
 
-def spirv_identities(scene, lib, cache_dir) -> tuple[dict[str, tuple], list[str]]:
+def spirv_identities(scene, lib, cache_dir, no_cache: bool = False) -> tuple[dict[str, tuple], list[str]]:
     """({permutation hash: its SPIR-V (sha256 per language and stage)}, the build's failures), from a build into a
     temporary directory through the compile cache."""
     from ...build import build_scene
     from ...build.checks import default_store
     with tempfile.TemporaryDirectory(prefix="shadermatrix-matrix-") as tmp:
-        res = build_scene(scene, lib, Path(tmp), store=default_store(cache_dir))
+        res = build_scene(scene, lib, Path(tmp), store=None if no_cache else default_store(cache_dir))
         ids = {p["hash"]: tuple(sorted((lang, stage, item.get("spirv_sha256") or item["spirv"])
                                        for lang, stages in p["languages"].items() for stage, item in stages.items()))
                for p in res.manifest["permutations"] if p.get("status") == "ok"}
@@ -50,7 +51,7 @@ def run(args) -> int:
 
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)
-    spirv, failures = (None, []) if args.no_compile else spirv_identities(scene, lib, args.cache_dir)
+    spirv, failures = (None, []) if args.no_compile else spirv_identities(scene, lib, args.cache_dir, args.no_cache)
     rep = report(scene, lib, spirv)
     sys.stdout.write(markdown(rep, args.explain) if args.format == "md" else json.dumps(rep, indent=1) + "\n")
     for f in failures:  # a permutation that does not compile is not merged with anything: say so, exit 1
