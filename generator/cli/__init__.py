@@ -1,4 +1,4 @@
-"""shadermatrix: compose shading bricks into a shader matrix (HLSL, GLSL, WGSL → SPIR-V)."""
+"""shadermatrix: compose shading bricks into a shader matrix (GLSL, HLSL, WGSL → SPIR-V)."""
 from __future__ import annotations
 
 import argparse
