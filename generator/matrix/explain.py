@@ -71,7 +71,6 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
     valid_pairs = [k for k, v in pairs.items() if not v]
     valid = len(valid_pairs) * len(ax["lights"]) * len(ax["output"]) * len(ax["precision"])
 
-    objects_of: dict[str, list[str]] = {h: list(users) for h, users in scene.users.items()}
     materials_of: dict[str, list[str]] = {}
     for o in scene.objects:
         ms = materials_of.setdefault(o["permutation"], [])
@@ -98,25 +97,24 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
                        "of": "used permutations with identical optimized SPIR-V in every language and stage "
                              "are one shader"})
 
-    drawn = {h: p for h, p in scene.permutations.items()}
     values = []
     for axis, vals in ax.items():
         for v in vals:
             if axis == "brdf":
                 mats = [m.name for m in scene.materials.values() if m.brdf == v]
-                hs = [h for h, p in drawn.items() if p.brdf == v]
+                hs = [h for h, p in scene.permutations.items() if p.brdf == v]
             elif axis == "packing":
                 mats = [m.name for m in scene.materials.values() if m.packing == v]
-                hs = [h for h, p in drawn.items() if p.packing == v]
+                hs = [h for h, p in scene.permutations.items() if p.packing == v]
             elif axis == "lights":
                 sets = [n for n, members in scene.light_sets.items()
                         if tuple((scene.lights[x].type, scene.lights[x].shadow) for x in members) == v]
                 mats = sets
                 key = tuple(LightKey(t, s) for t, s in v)
-                hs = [h for h, p in drawn.items() if p.lights == key]
+                hs = [h for h, p in scene.permutations.items() if p.lights == key]
             else:
-                mats, hs = [], list(drawn)
-            objs = [o for h in hs for o in objects_of.get(h, [])]
+                mats, hs = [], list(scene.permutations)
+            objs = [o for h in hs for o in scene.users.get(h, [])]
             if objs:
                 why = f"kept: drawn by {len(objs)} object(s) ({_names(objs)}) in {len(hs)} permutation(s)"
             elif not mats:
@@ -129,7 +127,7 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
                            "kept": bool(objs), "why": why, "declared_by": mats, "permutations": hs})
     invalid = [{"brdf": b, "packing": p, "why": [f"{n}: {w}" for n, w in pairs[(b, p)]]}
                for (b, p) in pairs if pairs[(b, p)]]
-    perms = [{"hash": h, "key": p.canonical(), "materials": materials_of.get(h, []), "objects": objects_of.get(h, []),
+    perms = [{"hash": h, "key": p.canonical(), "materials": materials_of.get(h, []), "objects": scene.users.get(h, []),
               **({"merged_into": merged_into[h]} if h in merged_into and merged_into[h] != h else {})}
              for h, p in scene.permutations.items()]
     return {"scene": scene.name, "stages": stages, "axes": values, "invalid": invalid, "permutations": perms,

@@ -148,13 +148,14 @@ def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]
     return data, Locator(shown, text)
 
 
+SCENE_SUFFIXES = (".toml", ".gltf", ".glb")  # what a SCENE argument may be: TOML, or glTF 2.0 (matrix/gltf.py)
 MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed SPIR-V's 255 function arguments
 
 
 def load_scene(path, lib: Library) -> Scene:
     """Read, validate and reduce a TOML scene (or a glTF 2.0 .gltf/.glb: matrix/gltf.py) to its permutations."""
     path = Path(path)
-    if path.suffix.lower() in (".gltf", ".glb"):
+    if path.suffix.lower() in SCENE_SUFFIXES[1:]:
         from .gltf import load_gltf
         return load_gltf(path, lib)
     shown = str(path)

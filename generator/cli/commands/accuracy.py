@@ -64,7 +64,8 @@ def _list(value: str, allowed: tuple, what: str) -> list[str]:
 
 
 def _is_scene(arg: str) -> bool:
-    return arg.lower().endswith((".toml", ".gltf", ".glb"))
+    from ...matrix.scene import SCENE_SUFFIXES
+    return arg.lower().endswith(SCENE_SUFFIXES)
 
 
 def scene_materials(path: Path, lib) -> dict:

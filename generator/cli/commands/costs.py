@@ -105,7 +105,8 @@ def run(args) -> int:
     if args.gpu is not None:
         from ...measure.gpu import GpuRequest
         from ...runtime.gpu_stats import DEFAULT_FAMILIES, check_families
-        if "/" in args.gpu or args.gpu.lower().endswith((".toml", ".gltf", ".glb")):  # `costs --gpu SCENE`: the scene taken for families
+        from ...matrix.scene import SCENE_SUFFIXES
+        if "/" in args.gpu or args.gpu.lower().endswith(SCENE_SUFFIXES):  # `costs --gpu SCENE`: the scene taken for families
             raise UsageError(f"--gpu {args.gpu}: that is a file, not AMD families — put the scene first "
                              f"(`costs SCENE --gpu`) or write `--gpu=navi21,...`")
         try:
