@@ -425,6 +425,19 @@ def declared_params(spec: str, lib) -> dict:
     return brdf_parameters(parse_brdf(spec, lib))
 
 
+def spec_tolerance(spec: str, lib, tol: float) -> float:
+    """The hemisphere tolerance a spec is judged at: tol, or the largest `tolerance` its bricks declare for
+    their approximation (a baked table, a fit), whichever is larger."""
+    from ..matrix.permutation import parse_brdf
+    if lib is None:
+        return tol
+    try:
+        nodes = parse_brdf(spec, lib)
+    except Exception:
+        return tol
+    return max([tol] + [n.brick.tolerance for top in nodes for n in top.walk()])
+
+
 def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:
     """(L, V, N, T) rounded to `dtype`, as float64: what the target gets, and what its reference is computed at.
 
@@ -499,7 +512,7 @@ def run(specs, targets, dtypes, lib, hemisphere_k: int = 12, tol: float = DEFAUL
 
 def verdicts(results: list[dict], specs, tol: float, lib=None) -> list[dict]:
     """Per spec: pass when float32 gives no NaN or Inf anywhere and its hemisphere max relative error is at most
-    tol on every target; with the worst hemisphere error (and where) and the worst stress case (and which).
+    tol (or the tolerance its bricks declare for their approximation: spec_tolerance) on every target; with the worst hemisphere error (and where) and the worst stress case (and which).
     Where no float32 ran (--dtypes float64), float64 is judged instead; float16 alone is reported, never
     judged (pass stays True)."""
     out = []
@@ -510,7 +523,10 @@ def verdicts(results: list[dict], specs, tol: float, lib=None) -> list[dict]:
         stress = max((r for r in f32 if r["set"] == "stress"), key=lambda r: r["max_rel"], default=None)
         nonfinite = sum(r["nan"] + r["inf"] for r in f32)
         case = stress["worst"] if stress and stress["worst"] else None
-        out.append({"spec": spec, "pass": not nonfinite and (hemi is None or hemi["max_rel"] <= tol),
+        brdf = mine[0].get("brdf", spec) if mine else spec
+        own = spec_tolerance(brdf, lib, tol)
+        out.append({"spec": spec, "pass": not nonfinite and (hemi is None or hemi["max_rel"] <= own),
+                    "tolerance": own,
                     "dtypes": sorted({r["dtype"] for r in f32}),
                     "float32_nan_inf": nonfinite,
                     "hemisphere_max_rel": hemi["max_rel"] if hemi else None,

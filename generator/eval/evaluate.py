@@ -172,11 +172,23 @@ def resolve_textures(ep: EvalProgram, textures: dict | None) -> list:
     if unknown:
         raise EvalError(f"unknown texture{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))} "
                         f"for BRDF '{ep.spec}'", f"its textures: {', '.join(names) or 'none'}")
+    for n, _ty, d in ep.textures:  # a lookup table the generator bakes from its reference
+        if n not in textures and d.get("table"):
+            textures[n] = baked_table(d)
     missing = [n for n in names if n not in textures]
     if missing:
         raise EvalError(f"BRDF '{ep.spec}' samples texture{'s' if len(missing) > 1 else ''} {', '.join(missing)}",
                         "pass textures={name: array (H, W, 4)} (float32 texels, or uint8 for an 8-bit image)")
     return [textures[n] for n in names]
+
+
+def baked_table(decl: dict) -> np.ndarray:
+    """The stored texels of a texture declaration's baked table (EvalError for a table the generator lacks)."""
+    from ..reference.tables import TableError, baked
+    try:
+        return baked(decl["table"], decl["size"], decl["format"])
+    except TableError as e:
+        raise EvalError(str(e), "name a table of generator/reference/tables_*.py in the brick's texture") from None
 
 
 def _numpy_texels(data, srgb: bool):
@@ -186,6 +198,8 @@ def _numpy_texels(data, srgb: bool):
         a = a.astype(np.float64) / 255.0
         if srgb:
             a = np.where(a <= 0.04045, a / 12.92, ((a + 0.055) / 1.055) ** 2.4)
+    elif a.dtype == np.float16:  # an fp16 table: the sampler returns its values exactly
+        a = a.astype(np.float64)
     return a
 
 

@@ -27,7 +27,7 @@ BUILTIN_BRICKS = REPO / "bricks"
 
 
 PARAM_TYPES = ("float", "vec2", "vec3", "vec4", "mat4")
-META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc", "fp16"}
+META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc", "fp16", "tolerance"}
 
 
 @dataclass
@@ -56,6 +56,9 @@ class Brick:
     # "fp16": "unsafe: why" where the brick cannot be made safe in half (build warns for an fp16
     # permutation using it); "" or any other note ("guarded: ...") otherwise
     fp16: str = ""
+    # the float32 hemisphere max relative error the brick's approximation (a baked table, a fit) is chosen
+    # for: `accuracy` passes it up to max(tolerance, --fail-above); 0: exact up to rounding
+    tolerance: float = 0.0
 
     @property
     def fp16_unsafe(self) -> str:
@@ -70,7 +73,7 @@ class Brick:
         k = KINDS[self.kind]
         if k.prefix_entries:
             return [f for n, f in self.module.functions.items() if n.startswith(k.prefix_entries)]
-        return [self.module.functions[e.name] for e in k.entries]
+        return [self.module.functions[e.name] for e in k.entries if e.name in self.module.functions]
 
 
 _SERIALS = itertools.count(1)
@@ -195,6 +198,18 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     textures = meta.get("textures", {})
     if not isinstance(textures, dict):
         raise _meta_error(shown, loc, "'textures' must be a dict", 'write "textures": {"albedo_map": {"srgb": True}}')
+    for tname, t in textures.items():
+        baked = [k for k in ("size", "format") if k in t]
+        if "table" in t and len(baked) < 2:
+            missing = "size" if "size" not in t else "format"
+            raise _meta_error(shown, loc, f"texture '{tname}' names table '{t['table']}' without its '{missing}'",
+                              'add "size": [W, H] and "format": "unorm8" | "fp16" | "fp32" (chosen by measured error)')
+        if baked and "table" not in t:
+            raise _meta_error(shown, loc, f"texture '{tname}' has a '{baked[0]}' but no 'table'",
+                              "size and format describe a baked table: add \"table\": NAME, or remove them")
+        if "table" in t and t.get("srgb"):
+            raise _meta_error(shown, loc, f"table texture '{tname}' is marked sRGB",
+                              "baked tables hold linear values: remove \"srgb\": True")
     externals = {}
     for sname, s in slots.items():
         k = KINDS[s["kind"]]
@@ -219,7 +234,7 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         raise _meta_error(shown, loc, "a packing brick needs a 'normal' slot (the shading normal it provides)",
                           '"slots": {"normal": {"kind": "normal", "default": "vertex"}}')
     brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip(),
-                  str(meta.get("fp16", "")).strip())
+                  str(meta.get("fp16", "")).strip(), float(meta.get("tolerance", 0.0)))
     _check_entries(brick, loc)
     return brick
 
@@ -308,7 +323,7 @@ def _check_entries(b: Brick, loc) -> None:
     k = KINDS[b.kind]
     fns = b.module.functions
     for e in k.entries:
-        if e.name not in fns:
+        if e.name not in fns and not e.optional:
             args = ", ".join(f"{a.name}: {a.ty}" for a in e.args if a.required)
             raise _meta_error(b.display_path, loc, f"a {b.kind} brick must define '{e.name}'",
                               f"add def {e.name}({args}) -> {e.ret}")

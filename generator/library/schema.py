@@ -30,6 +30,7 @@ BRICK_SCHEMA = {
         "doc": {"type": "string"},
         "fp16": {"type": "string", "maxLength": 1000},  # "unsafe: why" makes an fp16 build warn
         "needs": {"type": "array", "items": IDENT},
+        "tolerance": {"type": "number", "minimum": 0.0, "maximum": 1.0},
         "params": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type", "default"],
             "properties": {"type": {"type": "string"}, "default": VALUE, "doc": {"type": "string"},
@@ -40,7 +41,13 @@ BRICK_SCHEMA = {
             "properties": {"kind": {"type": "string"}, "default": IDENT}}},
         "textures": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
             "type": "object", "additionalProperties": False,
-            "properties": {"srgb": {"type": "boolean"}, "doc": {"type": "string"}}}},
+            "properties": {"srgb": {"type": "boolean"}, "doc": {"type": "string"},
+                           # a lookup table the generator bakes (generator/reference/tables.py), its size
+                           # [W, H] (a cube: [S, S]) and stored format, chosen by measured error
+                           "table": IDENT,
+                           "size": {"type": "array", "items": {"type": "integer", "minimum": 1, "maximum": 4096},
+                                    "minItems": 2, "maxItems": 2},
+                           "format": {"enum": ["unorm8", "fp16", "fp32"]}}}},
     },
 }
 

@@ -120,6 +120,13 @@ def oren_nayar(g: Geometry, p: dict, slots: dict) -> np.ndarray:
     return _on_qualitative(g, p, 0.33)
 
 
+@reference("diffuse", "oren_nayar_factored")
+def oren_nayar_factored(g: Geometry, p: dict, slots: dict) -> np.ndarray:
+    """The model the factored brick approximates with its table: Oren & Nayar 1994 eq. 30 exactly, as
+    `oren_nayar` (the table's error is what accuracy measures)."""
+    return _on_qualitative(g, p, 0.33)
+
+
 @reference("diffuse", "oren_nayar_simplified")
 def oren_nayar_simplified(g: Geometry, p: dict, slots: dict) -> np.ndarray:
     """RTR3 eqs. 7.57-7.59: the qualitative Oren-Nayar model (Oren & Nayar 1994 eq. 30).

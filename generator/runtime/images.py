@@ -24,19 +24,23 @@ def _image_format(vk, dtype, srgb: bool):
         if srgb:
             raise ValueError("srgb=True needs uint8 texels (sRGB formats are 8-bit); float data is linear")
         return vk.VK_FORMAT_R32G32B32A32_SFLOAT
+    if dtype == np.float16:  # a baked fp16 table (reference/tables.py)
+        if srgb:
+            raise ValueError("srgb=True needs uint8 texels (sRGB formats are 8-bit); float data is linear")
+        return vk.VK_FORMAT_R16G16B16A16_SFLOAT
     if dtype == np.uint8:
         return vk.VK_FORMAT_R8G8B8A8_SRGB if srgb else vk.VK_FORMAT_R8G8B8A8_UNORM
-    raise TypeError(f"texels must be float32 or uint8, got {dtype}")
+    raise TypeError(f"texels must be float32, float16 or uint8, got {dtype}")
 
 
 def texels(data, cube: bool | None = None) -> tuple[np.ndarray, bool]:
-    """(array, cube): `data` as a C-contiguous (layers, H, W, 4) float32 or uint8 array.
+    """(array, cube): `data` as a C-contiguous (layers, H, W, 4) float32, float16 or uint8 array.
 
     (H, W, C) is a 2D texture, (6, H, W, C) a cube (faces +X, -X, +Y, -Y, +Z, -Z, as
     Vulkan orders layers of a cube view); C ≤ 4 channels, the missing ones filled as
     Vulkan expands formats with fewer components (0, alpha 1 / 255); a 2D texture
-    may also come as (1, H, W, C), the shape this returns. Other float
-    dtypes become float32; integer data other than uint8 is refused.
+    may also come as (1, H, W, C), the shape this returns. float16 stays (R16G16B16A16_SFLOAT),
+    other float dtypes become float32; integer data other than uint8 is refused.
     """
     a = np.asarray(data)
     if cube is None:
@@ -46,10 +50,10 @@ def texels(data, cube: bool | None = None) -> tuple[np.ndarray, bool]:
     if a.ndim != (4 if cube else 3) or (cube and a.shape[0] != 6):
         raise ValueError(f"a {'cube' if cube else '2D'} texture is {'(6, H, W, C)' if cube else '(H, W, C)'}, "
                          f"got shape {a.shape}")
-    if a.dtype.kind == "f" and a.dtype != np.float32:
+    if a.dtype.kind == "f" and a.dtype not in (np.float32, np.float16):
         a = a.astype(np.float32)
-    if a.dtype not in (np.float32, np.uint8):
-        raise TypeError(f"texels must be float32 or uint8, got {a.dtype}")
+    if a.dtype not in (np.float32, np.float16, np.uint8):
+        raise TypeError(f"texels must be float32, float16 or uint8, got {a.dtype}")
     if not cube:
         a = a[None]
     h, w, c = a.shape[1:]
@@ -68,7 +72,7 @@ def texels(data, cube: bool | None = None) -> tuple[np.ndarray, bool]:
 class Image:
     """A sampled image of level 0 only: 2D, or cube (6 layers, CUBE_COMPATIBLE, a CUBE view).
 
-    Formats: float32 texels are VK_FORMAT_R32G32B32A32_SFLOAT; uint8 texels are
+    Formats: float32 texels are VK_FORMAT_R32G32B32A32_SFLOAT, float16 R16G16B16A16_SFLOAT; uint8 texels are
     R8G8B8A8_UNORM, or R8G8B8A8_SRGB with ``srgb=True`` (sampling then decodes
     rgb with the sRGB EOTF before filtering; alpha stays linear). `data` is
     (H, W, C) or (6, H, W, C) (see :func:`texels`). The texels go through a

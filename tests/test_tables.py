@@ -1,0 +1,79 @@
+"""Baked lookup tables (generator/reference/tables.py): declarations, baking, and the bricks that sample them."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from generator.lang import SourceError
+from generator.reference import tables
+
+TABLE_BRICK = '''"""A diffuse term scaled by a baked table."""
+BRICK = {
+    "kind": "diffuse",
+    "cite": "test",
+    "textures": {"t": TEX},
+}
+
+
+def diffuse(NdotL: float, t: texture2d) -> vec3:
+    return vec3(sample_level(t, vec2(NdotL, 0.5), 0.0).x)
+'''
+
+
+@pytest.mark.parametrize("tex, words", [
+    ('{"table": "oren_nayar_sin_sin", "format": "fp16"}', "without its 'size'"),
+    ('{"table": "oren_nayar_sin_sin", "size": [8, 8]}', "without its 'format'"),
+    ('{"size": [8, 8], "format": "fp16"}', "has a 'size' but no 'table'"),
+    ('{"table": "oren_nayar_sin_sin", "size": [8, 8], "format": "fp16", "srgb": True}', "is marked sRGB"),
+    ('{"table": "oren_nayar_sin_sin", "size": [8, 8], "format": "half"}', "format"),
+])
+def test_a_table_declaration_is_checked_where_it_is_written(tex, words, tmp_path):
+    from generator.library.bricks import load_brick
+
+    path = tmp_path / "tb.py"
+    path.write_text(TABLE_BRICK.replace("TEX", tex))
+    with pytest.raises(SourceError, match=words) as e:
+        load_brick(path)
+    assert str(e.value).startswith(f"{path}:") or "tb.py:" in str(e.value)
+
+
+def test_an_unknown_table_is_an_error_that_names_the_closest_one(tmp_path):
+    from generator.eval.evaluate import EvalError, evaluate
+    from generator.library.bricks import load_library
+
+    (tmp_path / "tb.py").write_text(TABLE_BRICK.replace(
+        "TEX", '{"table": "oren_nayar_sin_sn", "size": [8, 8], "format": "fp16"}'))
+    lib = load_library([tmp_path])
+    L = V = N = np.array([[0.0, 0.0, 1.0]])
+    with pytest.raises(EvalError, match="did you mean 'oren_nayar_sin_sin'"):
+        evaluate("tb", L, V, N, target="numpy", lib=lib)
+
+
+def test_baking_is_deterministic_and_quantizes_to_the_declared_format():
+    a = tables.baked("oren_nayar_sin_sin", (16, 8), "unorm8")
+    assert a.dtype == np.uint8 and a.shape == (8, 16, 4) and not a.flags.writeable
+    tables._BAKED.clear()
+    assert tables.sha256(tables.baked("oren_nayar_sin_sin", (16, 8), "unorm8")) == tables.sha256(a)
+    f = tables.baked("oren_nayar_sin_sin", (16, 8), "fp16")
+    assert f.dtype == np.float16
+    assert np.abs(tables.decoded(a) - tables.decoded(f)).max() <= 0.5 / 255 + 1e-3
+    assert tables.texel_coordinate(np.array([0.0, 1.0]), 64).tolist() == [0.5 / 64, 63.5 / 64]
+
+
+def test_every_registered_table_bakes_and_its_error_shrinks_with_size():
+    for name, d in tables.all_tables().items():
+        if d.exact is None:
+            continue
+        coarse = tables.table_error(name, (16, 16), "fp32")
+        fine = tables.table_error(name, (128, 128), "fp32")
+        assert fine["max_abs"] < coarse["max_abs"], (name, coarse, fine)
+
+
+def test_every_table_a_brick_declares_is_registered_and_bakes_at_its_size():
+    from generator.library.bricks import load_library
+
+    for b in load_library().bricks.values():
+        for tname, t in b.textures.items():
+            if "table" in t:
+                stored = tables.baked(t["table"], t["size"], t["format"])
+                assert stored.shape[-3:-1] == (t["size"][1], t["size"][0]), (b.id, tname)
