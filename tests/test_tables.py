@@ -77,3 +77,50 @@ def test_every_table_a_brick_declares_is_registered_and_bakes_at_its_size():
             if "table" in t:
                 stored = tables.baked(t["table"], t["size"], t["format"])
                 assert stored.shape[-3:-1] == (t["size"][1], t["size"][0]), (b.id, tname)
+
+
+SCENE = '''[scene]
+name = "tables"
+[materials.m]
+brdf = "BRDF"
+[lights.sun]
+type = "directional"
+[light_sets]
+all = ["sun"]
+[[objects]]
+name = "o"
+material = "m"
+lights = "all"
+'''
+
+
+@pytest.mark.toolchain
+def test_a_build_writes_the_tables_its_shaders_sample_as_ktx2_listed_in_the_manifest(tmp_path):
+    import hashlib
+    import json
+    import subprocess
+    import sys
+
+    from generator.build.ktx2 import decode
+
+    def build(brdf):
+        scene = tmp_path / "s.toml"
+        scene.write_text(SCENE.replace("BRDF", brdf))
+        r = subprocess.run([sys.executable, "-m", "generator.cli", "build", str(scene), "--out", str(tmp_path / "out"),
+                            "--no-cache"], capture_output=True, text=True, timeout=300)
+        assert r.returncode == 0, r.stderr
+        return json.loads((tmp_path / "out" / "manifest.json").read_text())
+
+    m = build("oren_nayar_factored")
+    (row,) = m["tables"]
+    assert row["texture"] == "on_sin_sin" and row["table"] == "oren_nayar_sin_sin" and row["format"] == "unorm8"
+    data = (tmp_path / "out" / row["path"]).read_bytes()
+    assert hashlib.sha256(data).hexdigest() == row["sha256"] and row["path"].endswith(f".{row['sha256'][:12]}.ktx2")
+    texels, fmt, cube = decode(data, row["path"])
+    assert fmt == "unorm8" and not cube
+    assert np.array_equal(texels, tables.baked("oren_nayar_sin_sin", (64, 64), "unorm8"))
+    assert row["error"]["max_rel"] < 0.05 and "Oren & Nayar" in row["reference"]
+    assert set(row["used_by"]) == {m["permutations"][0]["hash"], "ubershader"}
+    # a scene that no longer samples it: no table in the manifest, and the file is gone
+    m = build("oren_nayar")
+    assert "tables" not in m and not any((tmp_path / "out" / "tables").iterdir())

@@ -208,6 +208,10 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
                 and _intact(out, e)]
         res.manifest["removed"] = [{**e, "status": "removed"} for e in sorted({e["hash"]: e for e in gone}.values(),
                                                                              key=lambda e: e["hash"])]
+    from .tables import write_tables  # baked lookup tables the shaders sample (content-named, like packs)
+    tables = write_tables(out, lib, res.manifest, lambda changed: _count(res, changed))
+    if tables:
+        res.manifest["tables"] = tables
     if pack:  # written before the manifest that names them (content-named: the old ones stay until after it)
         from .pack import write_packs
         res.manifest["packs"] = write_packs(out, res.manifest, lambda changed: _count(res, changed))
@@ -219,7 +223,9 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         _count(res, atomic_write(out / "manifest.json", text))
     collect_garbage(out, res.manifest)  # the new manifest is in place: drop what it no longer names
     from .pack import collect_packs
+    from .tables import collect_tables
     collect_packs(out, res.manifest)
+    collect_tables(out, res.manifest)
     _record(out, res.manifest, text, keys, uber_key, res.kept, scene_key, res.templates)  # last: the no-op check trusts it
     return res
 
@@ -265,7 +271,8 @@ def _record(out: Path, manifest: dict, text: bytes, keys: dict, uber_key: str, k
     entries = [*manifest["permutations"], *manifest.get("removed", []), manifest.get("ubershader") or {}]
     state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys, "ubershader": uber_key, "scene": scene_key,
              "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in _items(e)}
-             | {p["path"]: p["size"] for p in manifest.get("packs", [])},
+             | {p["path"]: p["size"] for p in manifest.get("packs", [])}
+             | {t["path"]: t["bytes"] for t in manifest.get("tables", [])},
              "templates": sorted(templates)}
     atomic_write(out / STATE, (json.dumps(state, sort_keys=True) + "\n").encode())
 

@@ -1,0 +1,88 @@
+"""Baked tables as build artifacts: KTX2 files beside the shaders, listed in the manifest (issue 13, item 4).
+
+A permutation (or the ubershader) that samples a texture a brick declares as a table
+(reference/tables.py) needs the table's texels at run time; the engine loads them from
+``OUT/tables/<table>.<W>x<H>.<format>.<sha12>.ktx2`` (build/ktx2.py: one level, RGBA, linear). The file
+name carries the texels' sha256, so a changed baker writes a new file and never overwrites one a
+manifest names; the manifest's ``tables`` list says, per table: the texture name the shaders bind, the
+table, path, sha256 of the file, format, size, bytes, the reference it is baked from, its filtered error
+against that reference (`table_error`; None for a painted or fitted table, whose error is on the BRDF:
+`shadermatrix accuracy`), and which permutations (and whether the ubershader) sample it. Files of
+``tables/`` that the new manifest no longer names are removed after it is in place.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from .. import __version__
+from ..io import atomic_write
+
+TABLES_DIR = "tables"
+
+
+def declared(lib) -> dict[str, dict]:
+    """{texture name: its declaration} of every texture a brick of `lib` declares as a baked table."""
+    out = {}
+    for b in lib.bricks.values():
+        for name, d in b.textures.items():
+            if d.get("table"):
+                out[name] = {**d, "brick": b.id}
+    return out
+
+
+def _users(manifest: dict, names) -> dict[str, list[str]]:
+    """{texture name: hashes of the ok permutations (and "ubershader") that bind it}."""
+    users: dict[str, list[str]] = {}
+    entries = [*manifest.get("permutations", []), {**(manifest.get("ubershader") or {}), "hash": "ubershader"}]
+    for e in entries:
+        stages = [s for s in (e.get("interface") or {}).values() if isinstance(s, dict)]
+        bound = {t.get("name") for s in stages for t in s.get("textures", [])}
+        for name in sorted(bound & set(names)):
+            users.setdefault(name, []).append(e["hash"])
+    return users
+
+
+def write_tables(out: Path, lib, manifest: dict, count=None) -> list[dict]:
+    """Bake and write every table the manifest's shaders sample; their manifest entries, by texture name.
+    count(changed: bool) is told of each file (written, or already there with these bytes)."""
+    from ..reference.tables import baked, lookup, sha256, table_error
+    from .ktx2 import encode
+
+    decl = declared(lib)
+    users = _users(manifest, decl)
+    rows = []
+    for name in sorted(users):
+        d = decl[name]
+        w, h = d["size"]
+        stored = baked(d["table"], d["size"], d["format"])
+        cube = lookup(d["table"]).cube
+        data = encode(stored, d["format"], cube=cube, writer=f"shadermatrix {__version__}")
+        import hashlib
+        digest = hashlib.sha256(data).hexdigest()
+        rel = f"{TABLES_DIR}/{d['table']}.{w}x{h}.{d['format']}.{digest[:12]}.ktx2"
+        path = out / rel
+        changed = not (path.is_file() and path.read_bytes() == data)
+        if changed:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            atomic_write(path, data)
+        if count is not None:
+            count(changed)
+        err = table_error(d["table"], d["size"], d["format"])
+        rows.append({"texture": name, "table": d["table"], "brick": d["brick"], "path": rel, "sha256": digest,
+                     "texels_sha256": sha256(stored), "format": d["format"], "size": [w, h],
+                     "dimension": "cube" if cube else "2d", "bytes": len(data), "reference": lookup(d["table"]).reference,
+                     "error": err, "used_by": sorted(users[name])})
+    return rows
+
+
+def collect_tables(out: Path, manifest: dict) -> int:
+    """Remove the files of OUT/tables that the (new, already written) manifest does not name."""
+    keep = {t["path"] for t in manifest.get("tables", [])}
+    d, gone = out / TABLES_DIR, 0
+    if not d.is_dir():
+        return 0
+    for p in d.iterdir():
+        if p.is_file() and not p.name.startswith(".") and f"{TABLES_DIR}/{p.name}" not in keep:
+            p.unlink(missing_ok=True)
+            gone += 1
+    return gone
