@@ -124,3 +124,29 @@ def test_a_build_writes_the_tables_its_shaders_sample_as_ktx2_listed_in_the_mani
     # a scene that no longer samples it: no table in the manifest, and the file is gone
     m = build("oren_nayar")
     assert "tables" not in m and not any((tmp_path / "out" / "tables").iterdir())
+
+
+def test_the_tables_command_lists_and_bakes(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from generator.build.ktx2 import decode
+
+    def cli(*a):
+        return subprocess.run([sys.executable, "-m", "generator.cli", "tables", *a], capture_output=True, text=True,
+                              timeout=120)
+
+    r = cli("--format", "json")
+    assert r.returncode == 0, r.stderr
+    rows = {x["texture"]: x for x in json.loads(r.stdout)}
+    assert rows["on_sin_sin"]["table"] == "oren_nayar_sin_sin" and rows["on_sin_sin"]["error"]["max_rel"] > 0
+    r = cli("--bake", "oren_nayar_sin_sin", "--out", str(tmp_path / "t.ktx2"), "--size", "8x4", "--texel-format", "fp16")
+    assert r.returncode == 0, r.stderr
+    texels, fmt, _ = decode((tmp_path / "t.ktx2").read_bytes())
+    assert fmt == "fp16" and texels.shape == (4, 8, 4)
+    r = cli("--bake", "oren_nayar_sin_sn", "--out", str(tmp_path / "u.ktx2"))
+    assert r.returncode == 2 and "did you mean 'oren_nayar_sin_sin'" in r.stderr and not (tmp_path / "u.ktx2").exists()
+    r = cli("--bake", "oren_nayar_sin_sin", "--out", str(tmp_path / "v.ktx2"), "--image", str(tmp_path / "none.png"))
+    assert r.returncode == 2 and "not painted" in r.stderr
+    assert cli("--out", "x.ktx2").returncode == 2
