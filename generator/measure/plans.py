@@ -208,13 +208,14 @@ def is_standin(b: Brick) -> bool:
 
 
 def _consumer(lib: Library, packing: Brick, pair) -> str | None:
-    """A BRDF reading every material input a packing provides (the same in both measured shaders)."""
+    """A BRDF reading every material input a packing provides and no tangent frame (the packing's normal slot
+    holds a stand-in), the same in both measured shaders."""
     wanted = {f.name[len("get_"):] for f in packing.entries}
     if not wanted:
         return pair("diffuse", standin(lib, "diffuse").id)
     for kind in BRDF_KINDS:
         for b in lib.of_kind(kind):
-            if not is_standin(b) and wanted <= set(b.params):
+            if not is_standin(b) and wanted <= set(b.params) and not _reads_tangent(b.id, lib):
                 return pair(kind, b.id)
     # what no one term reads, a diffuse + specular pair may (the course's specular map: rho_d, f0, n)
     for d in (x for x in lib.of_kind("diffuse") if not is_standin(x) and not x.slots):
