@@ -126,6 +126,8 @@ def test_float32_microfacet_peaks_keep_their_digits_down_to_alpha_1e_4(numpy_flo
             continue  # the NDFs, under the default geometry term (Torrance-Sparrow's n·l cap is measured below;
             # the other geometry terms' own grazing errors are in their accuracy verdicts)
         by_param = numpy_float32[(spec, "stress")]["by_param"]
+        if accuracy.spec_tolerance(spec, LIB, 0.0):  # a filler that approximates (fresnel_ramp's table): its
+            continue  # declared error, judged by the verdicts, not the NDF's digits
         if "_anisotropic" in spec:  # alpha_u and alpha_v sweep down to 1e-4 in every batch: the cap holds
             assert max(by_param.values()) <= 5e-4, (spec, by_param)
             continue
@@ -157,7 +159,9 @@ def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device):
     for r in rep["results"]:
         assert r["nan"] == 0 and r["inf"] == 0, (r["spec"], r["target"], r["set"])
         if r["set"] == "hemisphere":  # defaults: kappa <= 64 (n = 64) -> 64 ulp (1 + 64/16)
-            assert r["max_rel"] <= 64 * EPS32 * 5, (r["spec"], r["target"], r["max_rel"])
+            # plus what a brick's approximation (a baked table, a fit) declares
+            assert r["max_rel"] <= 64 * EPS32 * 5 + accuracy.spec_tolerance(r["spec"], LIB, 0.0), \
+                (r["spec"], r["target"], r["max_rel"])
 
 
 

@@ -30,7 +30,7 @@ BRICK_SCHEMA = {
         "doc": {"type": "string"},
         "fp16": {"type": "string", "maxLength": 1000},  # "unsafe: why" makes an fp16 build warn
         "needs": {"type": "array", "items": IDENT},
-        "tolerance": {"type": "number", "minimum": 0.0, "maximum": 1.0},
+        "tolerance": {"type": "number", "minimum": 0.0, "maximum": 100.0},  # a 3-factor fit: ~36 (homomorphic_factorization)
         "params": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type", "default"],
             "properties": {"type": {"type": "string"}, "default": VALUE, "doc": {"type": "string"},

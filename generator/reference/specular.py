@@ -174,6 +174,37 @@ def ashikhmin_shirley_ndf(cos_h, phi_h, n_u, n_v) -> np.ndarray:
     return np.sqrt((n_u + 1.0) * (n_v + 1.0)) / (2.0 * np.pi) * cos_h ** e
 
 
+# ------------------------------------------------------------------ factored forms (Hoffman & Baker 2006, "BRDF Costs")
+# The model each factored brick approximates with its baked tables (tables_specular.py) is the direct
+# model, exactly: the tables' error is what accuracy measures against these.
+
+@reference("specular", "blinn_phong_factored")
+def blinn_phong_factored(g: Geometry, p: dict, slots: dict) -> np.ndarray:
+    """The normalized Blinn-Phong of `blinn_phong_normalized`, (n+4)/(8π) R_F(0) cos^n θ_h (Hoffman & Baker 2006)."""
+    from .models import blinn_phong_normalized
+    return blinn_phong_normalized(g, p, slots)
+
+
+@reference("specular", "banks_factored")
+def banks_factored(g: Geometry, p: dict, slots: dict) -> np.ndarray:
+    """Banks 1994 as `banks`: (k_s/π) max(0, v·r')^n for n·l > 0."""
+    return banks(g, p, slots)
+
+
+@reference("specular", "ashikhmin_shirley_factored")
+def ashikhmin_shirley_factored(g: Geometry, p: dict, slots: dict) -> np.ndarray:
+    """Ashikhmin & Shirley 2000 eq. 4 with Schlick's F, as `ashikhmin_shirley`."""
+    return ashikhmin_shirley(g, p, slots)
+
+
+@reference("diffuse", "ashikhmin_shirley_diffuse_factored")
+def ashikhmin_shirley_diffuse_factored(g: Geometry, p: dict, slots: dict) -> np.ndarray:
+    """Ashikhmin & Shirley 2000 eq. 5, as `ashikhmin_shirley_diffuse` (the diffuse half of the course's
+    "Ashikhmin/Shirley factored" row; registered here beside its specular half)."""
+    from .diffuse import ashikhmin_shirley_diffuse
+    return ashikhmin_shirley_diffuse(g, p, slots)
+
+
 # ------------------------------------------------------------------ Lafortune 1997
 
 @reference("specular", "lafortune")
@@ -213,3 +244,26 @@ def cook_torrance(g: Geometry, p: dict, slots: dict) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         spec = np.where(_rgb(s) > 0.0, _rgb(s) * spec, 0.0)  # s = 0: no specular, even at a Dirac peak
     return _rgb(1.0 - s) * p["rho_d"] / np.pi + spec
+
+
+# ------------------------------------------------------------------ homomorphic factorization (McCool et al. 2001)
+
+# The BRDF the factored brick approximates: Ashikhmin-Shirley (the course's anisotropic model) at fixed
+# parameters, a copper-like Schlick f0 (a coloured Fresnel, so the factors are RGB).
+HOMOMORPHIC_TARGET = {"n_u": 4.0, "n_v": 16.0, "f0": np.array([0.95, 0.64, 0.54])}
+
+
+@reference("specular", "homomorphic_factorization")
+def homomorphic_factorization(g: Geometry, p: dict, slots: dict) -> np.ndarray:
+    """The BRDF that the cube maps P, Q of `homomorphic_factorization` factor (tables_homomorphic.py):
+    Ashikhmin & Shirley 2000 eq. 4 with Schlick's F at HOMOMORPHIC_TARGET (the brick's accuracy is the
+    factorization's error against it)."""
+    t = HOMOMORPHIC_TARGET
+    return ashikhmin_shirley(g, {**t, "f0": np.broadcast_to(t["f0"], (g.count, 3))}, slots)
+
+
+# ------------------------------------------------------------------ hand-painted BRDFs (issue 13)
+
+from .tables_painted import register_references as _painted_references  # noqa: E402
+
+_painted_references()
