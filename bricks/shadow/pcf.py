@@ -15,8 +15,14 @@ it unset (the default, 1/512, is the renderer's default map).
 The compares are made in the shader on the depth texture as the renderer binds it (bilinear sampler,
 sample_level at LOD 0: valid in non-uniform control flow), so each tap compares against depth averaged
 over 2 × 2 texels — not the hardware 2 × 2 compare of a comparison sampler (sampler2DShadow /
-SamplerComparisonState / sampler_comparison), which the brick language does not have yet: with it each
-tap would filter four compares instead of comparing one filtered depth.
+SamplerComparisonState / sampler_comparison), which `pcf_hardware` uses (a texture2d_shadow read by
+sample_compare: each tap filters four compares instead of comparing one filtered depth). Both are kept:
+this one runs on any sampleable depth copy (the renderer's R32_SFLOAT fallback where a device cannot
+filter D32_SFLOAT) and, comparing against the interpolated depth of a plane, needs less bias on tilted
+receivers; pcf_hardware gives a visibility continuous in P from one tap on. Measured on the tilted floor
+of tests/scenes/shadow.toml (256² map, lavapipe), the least bias that leaves the lit floor unshadowed:
+pcf 0.003 at k = 1 (as shadow_map), 0.006 at k = 3; pcf_hardware 0.006 at k = 1, 0.01 at k = 3. Offset
+taps reach texels nearer the light, so the bias must cover the depth slope over the kernel in both.
 """
 BRICK = {
     "kind": "shadow",

@@ -12,7 +12,7 @@ import ast
 
 from . import ir
 from .intrinsics import CONSTANTS, INTRINSICS
-from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, TEXTURE2D, TEXTURECUBE, UINT, Type, vector
+from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, TEXTURE2D, TEXTURE2D_SHADOW, TEXTURECUBE, UINT, Type, vector
 
 ARITH = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Mod: "%"}
 _CMP = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
@@ -261,7 +261,7 @@ class ExprChecker:
         sig = INTRINSICS[name]["sig"]
         arity = {"gen": 1, "gen2": 2, "gen3": 3, "mix": 3, "minmax": 2, "absign": 1, "dot": 2, "length": 1,
                  "cross": 2, "normalize": 1, "reflect": 2, "step": 2, "select": 3, "sample": 2, "sample_lod": 3,
-                 "buffer_length": 1}[sig]
+                 "sample_compare": 3, "buffer_length": 1}[sig]
         if len(args) != arity:
             raise self.err(n, f"{name} takes {arity} argument{'s' if arity != 1 else ''}, got {len(args)}",
                            "see the intrinsics table in generator/lang/intrinsics.py")
@@ -307,6 +307,16 @@ class ExprChecker:
             if types[0] != BOOL or types[1] != types[2] or types[1].kind not in ("scalar", "vector"):
                 raise fail("(bool, T, T) with T a scalar or vector (WGSL select)")
             return ir.Intrinsic(types[1], loc, name, args)
+        if sig in ("sample", "sample_lod") and types[0] == TEXTURE2D_SHADOW:
+            raise self.err(n, f"{name}() cannot read a texture2d_shadow: a depth texture is read through its "
+                           "comparison sampler", "call sample_compare(shadow_tex, uv, depth_ref), which returns "
+                           "the filtered compare result")
+        if sig == "sample_compare":
+            if types != [TEXTURE2D_SHADOW, vector("float", 2), FLOAT]:
+                raise fail("(texture2d_shadow, vec2 uv, float depth_ref)")
+            if not isinstance(args[0], ir.Var) or args[0].scope != "param":
+                raise self.err(n, f"{name}() takes a texture parameter", "pass the texture as a function parameter")
+            return ir.Intrinsic(FLOAT, loc, name, args)
         if sig in ("sample", "sample_lod"):
             coord = vector("float", 3) if types[0] == TEXTURECUBE else vector("float", 2)
             tex = TEXTURECUBE if types[0] == TEXTURECUBE else TEXTURE2D

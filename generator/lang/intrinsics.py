@@ -19,6 +19,13 @@ Typing rules (`sig`):
   select     f(bool, T, T) -> T           select(cond, if_true, if_false)
   sample     f(texture2d, vec2) -> vec4       also f(texturecube, vec3 direction) -> vec4
   sample_lod f(texture2d, vec2, float) -> vec4  also f(texturecube, vec3, float) -> vec4
+  sample_compare f(texture2d_shadow, vec2 uv, float ref) -> float
+                                          the hardware depth compare (ref <= stored depth: 1,
+                                          else 0) of each texel of the bilinear 2×2 footprint,
+                                          weighted by the bilinear weights, at LOD 0 (valid in
+                                          non-uniform control flow): GLSL textureLod on a
+                                          sampler2DShadow, HLSL SampleCmpLevelZero, WGSL
+                                          textureSampleCompareLevel
   buffer_length f(buffer) -> uint         elements in a storage buffer (run time),
                                           a uniform buffer's capacity (constant)
 
@@ -62,6 +69,7 @@ INTRINSICS: dict[str, dict] = {
     "select": {"sig": "select", "cls": "alu"},
     "sample": {"sig": "sample", "cls": "texture"},
     "sample_level": {"sig": "sample_lod", "cls": "texture"},
+    "sample_compare": {"sig": "sample_compare", "cls": "texture"},
     "buffer_length": {"sig": "buffer_length", "cls": "alu"},
 }
 

@@ -17,7 +17,7 @@ built IR too; the emitters assume them:
   the base of an Index (the element, a struct) or the argument of
   Intrinsic(UINT, loc, "buffer_length", [var]). They are never written, passed or
   stored.
-- Textures (`TEXTURE2D`, `TEXTURECUBE`) are parameters or globals, passed by name.
+- Textures (`TEXTURE2D`, `TEXTURECUBE`, `TEXTURE2D_SHADOW`) are parameters or globals, passed by name.
 - Switch selectors are int or uint; case values are distinct ints in the
   selector's range; a case never falls through.
 - A runtime For bound is an int or uint expression that the body does not change

@@ -15,16 +15,17 @@ class Type:
     size: vector width or matrix order (mat3 → 3); 1 for scalars; the element count N of
         array[T, N]; a buffer's capacity (0: a runtime-sized storage buffer).
     name: the struct name for structs, the canonical spelling otherwise
-        ("texture2d", "texturecube", "array[Lobe, 4]", "storage_buffer[Light]").
+        ("texture2d", "texturecube", "texture2d_shadow", "array[Lobe, 4]", "storage_buffer[Light]").
     fields: for structs, ((field, Type), ...).
     elem: the element type of an array or buffer (None otherwise).
     space: for buffers, "storage" (read-only storage buffer, runtime-sized array of
         structs) or "uniform" (uniform block holding array[elem, size]); "" otherwise.
 
-    Construct arrays, buffers and cube textures with array(), storage_buffer(),
-    uniform_buffer() and TEXTURECUBE below; buffers are global resources only
-    (never parameters, locals or struct fields) and their element structs obey
-    buffer_layout_error().
+    Construct arrays, buffers and textures with array(), storage_buffer(),
+    uniform_buffer(), TEXTURE2D, TEXTURECUBE and TEXTURE2D_SHADOW below (a
+    texture2d_shadow is a depth texture read only through its comparison sampler,
+    by sample_compare); buffers are global resources only (never parameters, locals
+    or struct fields) and their element structs obey buffer_layout_error().
     """
 
     kind: str
@@ -56,8 +57,13 @@ class Type:
 
     @property
     def dim(self) -> str:
-        """A texture's dimension: "2d" or "cube" ("" for other types)."""
-        return {"texture2d": "2d", "texturecube": "cube"}.get(self.name, "") if self.kind == "texture" else ""
+        """A texture's dimension: "2d" or "cube" ("" for other types); a texture2d_shadow is "2d"."""
+        return _TEXTURE_DIMS.get(self.name, "") if self.kind == "texture" else ""
+
+    @property
+    def compare(self) -> bool:
+        """A depth texture sampled through a comparison sampler (texture2d_shadow)."""
+        return self.kind == "texture" and self.name == "texture2d_shadow"
 
     @property
     def components(self) -> int:
@@ -110,10 +116,16 @@ VEC2, VEC3, VEC4 = vector("float", 2), vector("float", 3), vector("float", 4)
 MAT3, MAT4 = matrix(3), matrix(4)
 TEXTURE2D = Type("texture", "float", 1, "texture2d")
 TEXTURECUBE = Type("texture", "float", 1, "texturecube")
+# A depth image (D32_SFLOAT) and a comparison sampler (compareOp LESS_OR_EQUAL, linear): read only by
+# sample_compare, which returns the filtered result of the depth compares (percentage-closer filtering in
+# hardware: GLSL sampler2DShadow, HLSL SamplerComparisonState, WGSL texture_depth_2d + sampler_comparison).
+TEXTURE2D_SHADOW = Type("texture", "float", 1, "texture2d_shadow")
+_TEXTURE_DIMS = {"texture2d": "2d", "texturecube": "cube", "texture2d_shadow": "2d"}
 
 BUILTIN_TYPES: dict[str, Type] = {
     "float": FLOAT, "int": INT, "uint": UINT, "bool": BOOL,
     "mat3": MAT3, "mat4": MAT4, "texture2d": TEXTURE2D, "texturecube": TEXTURECUBE,
+    "texture2d_shadow": TEXTURE2D_SHADOW,
 }
 for _s, _p in _VEC_PREFIX.items():
     for _n in (2, 3, 4):

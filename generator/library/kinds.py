@@ -31,6 +31,7 @@ class Entry:
     name: str
     ret: Type | None  # None: the type of what it provides (a packing's get_<input>)
     args: tuple[Arg, ...] = ()
+    optional: bool = False  # a brick of the kind may leave it out (the glue then does without it)
 
 
 @dataclass(frozen=True)
@@ -78,7 +79,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
          doc="a light: the unit direction to it and c_light, the game intensity"),
     Kind("shadow", (Entry("shadow", FLOAT),), "surface", doc="a shadow filter: visibility of the light in [0, 1]"),
     Kind("packing", (), "surface", prefix_entries="get_", doc="a texture packing: get_<param> supplies a material input"),
-    Kind("normal", (Entry("normal", VEC3),), "surface", doc="the shading normal"),
+    # `tangent` (optional): the shading tangent T' of the perturbed frame, for BRDFs reading the tangent frame;
+    # the glue passes the shading normal N' (what `normal` returned) as Np and sets B' = N' × T' (link/glue.py)
+    Kind("normal", (Entry("normal", VEC3), Entry("tangent", VEC3, (Arg("Np", VEC3, required=True),), optional=True)),
+         "surface", doc="the shading normal (and, optionally, the shading tangent)"),
     Kind("output", (Entry("output", VEC4, (Arg("color", VEC3, required=True),)),), "surface",
          doc="the output transform of the outgoing radiance"),
 )}

@@ -67,6 +67,11 @@ def _eval_interface(specs: dict[str, ParamSpec], reads: list[str], textures) -> 
                                                   "array_stride": 16}])
     result = Block("Result", 0, 1, "storage", [{"name": "data", "type": "vec4[]", "offset": 0, "size": 0,
                                                 "array_stride": 16}], readonly=False)
+    shadow = [n for n, ty, _ in textures if ty.compare]
+    if shadow:  # the eval kernel binds every texture with the bilinear sampler (runtime/eval_kernel.py)
+        raise SourceError("<eval>", 1, 1, f"the BRDF reads '{shadow[0]}' as a texture2d_shadow, a depth texture "
+                          "that only a comparison sampler reads, and an eval kernel binds colour textures",
+                          "declare it texture2d: texture2d_shadow is for shadow filters")
     texs = [Texture(n, n, "material", bool(d.get("srgb")), ty.dim) for n, ty, d in textures]
     assign_bindings(texs, {"material": 3})
     for t in texs:

@@ -16,7 +16,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from ..lang import SourceError, ir
-from ..lang.types import FLOAT, INT, MAT4, TEXTURE2D, TEXTURECUBE, UINT, VEC3, VEC4, Type, storage_buffer, struct
+from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, storage_buffer, struct
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
 from ..library.params import ParamSpec, flat, spec_params
 from ..matrix.permutation import Node, Resolved
@@ -151,7 +151,8 @@ class _Binder:
                 name = ("t_" if group == "material" else prefix) + p.name
                 if name not in {t.name for t in self.textures}:
                     decl = _texture_decl([node], p.name)
-                    self.textures.append(Texture(name, p.name, group, bool(decl.get("srgb")), p.ty.dim, light))
+                    self.textures.append(Texture(name, p.name, group, bool(decl.get("srgb")), p.ty.dim, light,
+                                                 compare=p.ty.compare))
                 out.append(self.b.var(name, p.ty, "param"))
             elif p.name == "N":
                 self.surface.add("N")
@@ -194,6 +195,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             stmts.append(b.decl(f"p_{name}", call))
             provided[name] = b.var(f"p_{name}", call.ty)
         stmts.append(b.decl("N", bind.call(prog, normal, normal.brick.entries[0].name, "m_", "material", None, {})))
+        stmts.extend(b.decl(n, e) for n, e in shading_tangent(prog, b, bind, normal, bg.tangent))
         stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
         locals_ = {"N": VEC3}
         for n, k, _, ty, _ in flat(bg.params):
@@ -216,6 +218,8 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
                     brdf_args.append(b.var(Li, VEC3))
                 elif n == "N":
                     brdf_args.append(b.var("N", VEC3))
+                elif n in ("T", "B") and has_tangent(normal):
+                    brdf_args.append(b.var(f"{n}s", t))
                 elif n in ("V", "T", "B"):
                     brdf_args.append(b.var(n, t, "param"))
                 elif n in provided:
@@ -257,13 +261,30 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     values = [(n, t) for n, _, _, t, _ in material] + [(n, t) for vals in light_values for n, _, _, t, _ in vals]
     missing = [n for n in bind.params if n not in dict(values)]
     assert not missing, f"shade() binds {missing}, which no brick declares"
-    sig += values + [(t.name, _texture_type(t)) for t in bind.textures]
+    sig += values + [(t.name, t.ty) for t in bind.textures]
 
     def shade_body():
         return stmts
     prog.add(b.function("shade", sig, VEC4, shade_body))
     prog.globals.extend(dynamic_lights)
     return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights)
+
+
+def has_tangent(normal: Node) -> bool:
+    """Whether a normal filler defines the optional `tangent` entry (library/kinds.py)."""
+    return "tangent" in normal.brick.module.functions
+
+
+def shading_tangent(prog: Program, b: Builder, bind: _Binder, normal: Node, needed: bool,
+                    args: dict[str, ir.Expr] | None = None) -> list[tuple[str, ir.Expr]]:
+    """[("Ts", <normal>_tangent(Np = N, ...)), ("Bs", cross(N, Ts))]: the perturbed frame (T', B', N') a BRDF
+    reading the tangent frame gets when the normal filler defines `tangent` (a twist map); [] otherwise, and
+    the BRDF gets the interpolated T and B. B' = N' × T' as in the notes' shader (Hoffman & Baker 2006,
+    "Anisotropic BRDF with Normal Map": `float3x3 inv = float3x3(T, cross(N,T), N)`)."""
+    if not (needed and has_tangent(normal)):
+        return []
+    T = bind.call(prog, normal, "tangent", "m_", "material", None, {}, {**(args or {}), "Np": b.var("N", VEC3)})
+    return [("Ts", T), ("Bs", b.intrinsic("cross", VEC3, b.var("N", VEC3), b.var("Ts", VEC3)))]
 
 
 def _light_buffer(prog: Program, b: Builder, i: int, lb, sh, out: list) -> dict[str, ir.Expr]:
@@ -304,16 +325,12 @@ def _light_buffer(prog: Program, b: Builder, i: int, lb, sh, out: list) -> dict[
     return values
 
 
-def _texture_type(t: Texture) -> Type:
-    return TEXTURECUBE if t.dim == "cube" else TEXTURE2D
-
-
 def bind_texture(bind: _Binder, name: str, ty: Type, nodes) -> ir.Var:
     """A BRDF texture in shade(): a material texture t_<name>."""
     tname = f"t_{name}"
     if tname not in {t.name for t in bind.textures}:
         decl = _texture_decl(nodes, name)
-        bind.textures.append(Texture(tname, name, "material", bool(decl.get("srgb")), ty.dim))
+        bind.textures.append(Texture(tname, name, "material", bool(decl.get("srgb")), ty.dim, compare=ty.compare))
     return bind.b.var(tname, ty, "param")
 
 

@@ -6,14 +6,15 @@ reflection), the runtime (what to bind), measure (stand-ins). Layout (NOTES.md,
 per scalar or vector and four per mat4 (column-major), identical in std140, HLSL
 cbuffers and WGSL uniforms, so one byte block serves all three languages. Set 0:
 frame (b0), lights (b1), light textures (b2+); set 1: material (b0), material
-textures (b1+); a texture takes two bindings, the image at B and its sampler at B+1.
+textures (b1+); a texture takes two bindings, the image at B and its sampler at B+1 (a
+texture2d_shadow: a depth image and a comparison sampler, reflected as such in the manifest).
 """
 from __future__ import annotations
 
 import struct
 from dataclasses import dataclass, field
 
-from ..lang.types import Type
+from ..lang.types import TEXTURE2D, TEXTURE2D_SHADOW, TEXTURECUBE, Type
 from ..library.params import ParamSpec
 
 VEC4_BYTES = 16
@@ -140,13 +141,28 @@ class Texture:
     light: int | None = None
     set: int = 0
     binding: int = 0
+    compare: bool = False  # a depth texture read through a comparison sampler (texture2d_shadow)
+
+    @property
+    def ty(self) -> Type:
+        """The brick-language type of the texture."""
+        return texture_type(self.dim, self.compare)
 
     def as_dict(self) -> dict:
         d = {"name": self.param, "set": self.set, "binding": self.binding, "sampler_binding": self.binding + 1,
              "dimension": self.dim, "color_space": "srgb" if self.srgb else "linear"}
+        if self.compare:  # a depth format image and a comparison sampler (compareOp LESS_OR_EQUAL, linear)
+            d.update(format="depth", sampler="comparison", compare_op="less_or_equal")
         if self.light is not None:
             d["light"] = self.light
         return d
+
+
+def texture_type(dim: str, compare: bool = False) -> Type:
+    """The brick-language type of a texture of dimension `dim` ("2d", "cube"; compare: a 2D depth texture)."""
+    if compare:
+        return TEXTURE2D_SHADOW
+    return TEXTURECUBE if dim == "cube" else TEXTURE2D
 
 
 def assign_bindings(textures: list[Texture], first: dict[str, int]) -> None:

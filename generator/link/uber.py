@@ -21,11 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..lang import SourceError, ir
-from ..lang.types import FLOAT, INT, MAT4, TEXTURE2D, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
+from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
 from ..library.inputs import SURFACE
 from ..library.params import flat, spec_params
 from ..matrix.permutation import Node, Permutation, parse_brdf, parse_spec
-from .glue import _Binder, brdf_glue
+from .glue import _Binder, brdf_glue, has_tangent, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture
 from .irgen import Builder
 from .program import Program
@@ -193,6 +193,8 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
         for f in pk.brick.entries:
             provided[f.name[len("get_"):]] = f.ret
 
+    twisted = any(g.tangent and has_tangent(dict(pk.fillers)["normal"]) for g, pk in zip(glues, packings))
+
     def material_args(k) -> dict[str, ir.Expr]:
         """Variant k's parameters read from the entry, by the name an entry binds (alpha, lobes_0, ev)."""
         return {s.name[2:]: _read(b, me, mat_data, s.index, s.ty) for s in variants[k].slots}
@@ -203,6 +205,8 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
         for name, ty in provided.items():
             stmts.append(b.decl(f"p_{name}", _zero(b, ty)))
         stmts.append(b.decl("N", b.construct(VEC3, b.const(0.0))))
+        if twisted:  # the BRDFs' frame: the interpolated T, B unless the variant's normal filler gives T'
+            stmts += [b.decl("Ts", b.var("T", VEC3, "param")), b.decl("Bs", b.var("B", VEC3, "param"))]
         cases = []
         for k, pk in enumerate(packings):
             args = material_args(k)
@@ -211,12 +215,14 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
             normal = dict(pk.fillers)["normal"]
             case.append(b.assign(b.var("N", VEC3), bind.call(prog, normal, normal.brick.entries[0].name, "m_",
                                                             "material", None, {}, args)))
+            case += [b.assign(b.var(n, VEC3), e) for n, e in shading_tangent(prog, b, bind, normal, glues[k].tangent,
+                                                                             args)]
             cases.append(case)
         stmts.append(_switch(b, b.copy(variant), cases))
         stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
         if lnodes:  # a scene without lights shades black: no loop, the light buffer is still bound
             stmts.append(_light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues,
-                                     packings, provided, material_args, variant, shadowed))
+                                     packings, provided, material_args, variant, shadowed, twisted))
         stmts.append(b.decl("color", b.construct(VEC4, b.const(0.0))))
         outs = [[b.assign(b.var("color", VEC4), bind.call(prog, on, "output", "o_", "material", None, {},
                                                           {**material_args(k), "color": b.var("Lo", VEC3)}))]
@@ -234,7 +240,7 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
     surface = ["P", "N"] + (["T", "B"] if tangent or bind.surface & {"T", "B"} else []) \
         + (["uv"] if "uv" in bind.surface else [])
     sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")]
-    sig += [("material", INT)] + [(t.name, TEXTURE2D) for t in bind.textures]
+    sig += [("material", INT)] + [(t.name, t.ty) for t in bind.textures]
     prog.add(b.function("shade", sig, VEC4, lambda: stmts))
     reads = list(dict.fromkeys(r for g in glues for r in g.reads))
     where = UBER_KERNEL if kernel else UBER_FRAGMENT
@@ -256,13 +262,19 @@ def _shadow_textures(lib, shadow: str) -> list[str]:
     return [t for n in node.walk() for t in n.brick.textures]
 
 
+def _texture_types(node) -> dict[str, Type]:
+    """The type of each texture a node's bricks sample, by name (as their functions declare it)."""
+    return {p.name: p.ty for n in node.walk() for f in n.brick.module.functions.values() for p in f.params
+            if p.ty.kind == "texture" and p.name in n.brick.textures}
+
+
 def _vec4s(specs) -> int:
     """vec4s a parameter set occupies (four per mat4)."""
     return sum(4 if ty == MAT4 else 1 for _, _, _, ty, _ in flat(specs))
 
 
 def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues, packings, provided,
-                material_args, variant, shadowed) -> ir.For:
+                material_args, variant, shadowed, twisted=False) -> ir.For:
     """for i in range(buffer_length(light_buffer)): switch on light type, on shadow filter, on variant."""
     le = b.var("le", LightEntry)
     ids = ir.Member(IVEC4, b.here(), b.copy(le), "ids")
@@ -289,6 +301,7 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
     shadow_cases = []
     for s, sn in snodes.items():
         texnames = [x for n in sn.walk() for x in n.brick.textures]
+        textype = _texture_types(sn)
         args = light_args(first_light, s)
         if not texnames:
             shadow_cases.append([b.assign(b.var("s", FLOAT), bind.call(prog, sn, sn.brick.entries[0].name, "l_",
@@ -300,8 +313,8 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
             for tex in texnames:
                 name = f"shadow{j}_{tex}"
                 if name not in {t.name for t in bind.textures}:
-                    bind.textures.append(Texture(name, tex, "light", False, "2d", j))
-                targs[tex] = b.var(name, TEXTURE2D, "param")
+                    bind.textures.append(Texture(name, tex, "light", False, "2d", j, compare=textype[tex].compare))
+                targs[tex] = b.var(name, textype[tex], "param")
             per_map.append([b.assign(b.var("s", FLOAT), bind.call(prog, sn, sn.brick.entries[0].name, "l_", "light",
                                                                   None, {"N": VEC3}, targs))])
         shadow_cases.append([_switch(b, sel("z"), per_map)])
@@ -317,6 +330,8 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
                 args.append(b.var("L", VEC3))
             elif n == "N":
                 args.append(b.var("N", VEC3))
+            elif n in ("T", "B") and twisted:
+                args.append(b.var(f"{n}s", t))
             elif n in ("V", "T", "B"):
                 args.append(b.var(n, t, "param"))
             elif n in own:
@@ -324,7 +339,7 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
             elif t.kind == "texture":
                 tname = f"t_{n}"
                 if tname not in {x.name for x in bind.textures}:
-                    bind.textures.append(Texture(tname, n, "material", False, t.dim))
+                    bind.textures.append(Texture(tname, n, "material", False, t.dim, compare=t.compare))
                 args.append(b.var(tname, t, "param"))
             else:
                 args.append(b.copy(margs[n]))

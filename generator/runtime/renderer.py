@@ -25,7 +25,10 @@ written into the light's shadow_matrix parameter of both paths (the specialized 
 blocks and the ubershader's LightEntry data), and the depth map is bound as the light's
 shadow map (pcf: a `pcf_texel` the scene leaves unset is written as 1 / shadow_size, in both
 paths too) — or, for a brick texture named `shadow_moments` (vsm), the depth's moments (d, d²),
-box-filtered on the host (:func:`moments_map`) and uploaded as an RGBA32F image. Other textures
+box-filtered on the host (:func:`moments_map`) and uploaded as an RGBA32F image. A `texture2d_shadow`
+(pcf_hardware) reads the depth pass's D32_SFLOAT image itself through a comparison sampler
+(runtime/depth_images.py: linear, compareOp LESS_OR_EQUAL), where no map is drawn a lit 1×1 depth image
+(depth 1.0); a device that cannot linearly filter D32_SFLOAT is refused for it. Other textures
 are generated: an sRGB albedo checker, a normal map of known bumps. Pipelines are created through
 a persisted pipeline cache (runtime/pipeline_cache.py), and when the render opens its own device,
 Mesa's shader disk cache lives in out/shader_cache and the driver's hit and miss counts go into the
@@ -81,9 +84,10 @@ class Report:
         return asdict(self)
 
 
-def _textures(device):
+def _textures(device, lib=None):
     """A 16×16 sRGB checker albedo, a 32×32 normal map of bumps, a lit (depth 1) stand-in shadow map and
-    moments map (E[d] = E[d²] = 1; bound where an ubershader shadow slot is unused by a draw's lights)."""
+    moments map (E[d] = E[d²] = 1; bound where an ubershader shadow slot is unused by a draw's lights);
+    the baked table of a texture a brick declares as a table (reference/tables.py)."""
     j, i = np.meshgrid(np.arange(16), np.arange(16))
     albedo = np.where(((i // 4 + j // 4) % 2 == 0)[..., None], [230, 200, 120], [90, 140, 200]).astype(np.uint8)
     v, u = np.meshgrid((np.arange(32) + 0.5) / 32, (np.arange(32) + 0.5) / 32, indexing="ij")
@@ -94,18 +98,31 @@ def _textures(device):
     grey = np.full((1, 1, 4), 0.5, np.float32)  # any other texture a brick samples (a lookup table, …)
     return _TestTextures({"albedo_map": device.image(albedo, srgb=True), "normal_map": device.image(nmap),
                           "shadow_map": device.image(shadow), "shadow_moments": device.image(shadow)},
-                         lambda: device.image(grey))
+                         lambda: device.image(grey), _table_images(device, lib))
+
+
+def _table_images(device, lib) -> dict:
+    """{texture name: a function making its image} for every texture a brick of `lib` declares as a table."""
+    from ..reference.tables import baked
+    out = {}
+    for b in (lib.bricks.values() if lib is not None else ()):
+        for name, d in b.textures.items():
+            if d.get("table"):
+                out[name] = (lambda d=d: device.image(baked(d["table"], d["size"], d["format"])))
+    return out
 
 
 class _TestTextures(dict):
-    """The generated textures by brick texture name; a name without a test image gets a linear 0.5 grey."""
+    """The generated textures by brick texture name: a baked table where a brick declares one, else a test
+    image; a name with neither gets a linear 0.5 grey."""
 
-    def __init__(self, known, make_grey):
+    def __init__(self, known, make_grey, tables=None):
         super().__init__(known)
         self._make_grey = make_grey
+        self._tables = tables or {}
 
     def __missing__(self, name):
-        self[name] = self._make_grey()
+        self[name] = self._tables[name]() if name in self._tables else self._make_grey()
         return self[name]
 
     def destroy(self) -> None:
@@ -201,6 +218,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from .device import Device, validation_requested
     from ..link.uber import SPEC_VARIANT
     from .pipeline_cache import PipelineCacheFile
+    from .depth_images import ComparisonSampler, DepthImage
     from . import shader_cache
 
     if mode not in MODES:
@@ -268,7 +286,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         # One bilinear sampler for every texture, shadow maps included: the one tap of the shadow brick then
         # compares against depth averaged over 2×2 texels, which with one bias is what keeps a point
         # light's perspective map free of acne here (a nearest sampler acnes: NOTES.md, "Renderer").
-        textures, sampler = _textures(device), device.sampler()
+        textures, sampler = _textures(device, lib), device.sampler()
         owned += [textures, sampler]
         vk = device.vk
         U, S = vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
@@ -370,7 +388,36 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             """A light's texture: its depth pass's map (or its moments), or the lit stand-in."""
             if t.param == MOMENTS and light_name in moments:
                 return moments[light_name]
+            if t.compare:  # a depth image for a comparison sampler: the depth pass's own, or a lit (1.0) one
+                return depth_compared(shadow_maps.get(light_name))
             return shadow_maps[light_name] if light_name in shadow_maps else textures[t.param]
+
+        def stand_in(t):
+            """A texture no light's depth pass provides: the generated one (a lit depth image if compared)."""
+            return depth_compared(None) if t.compare else textures[t.param]
+
+        compared = {}  # a texture2d_shadow's sampler and lit stand-in, made on first use
+
+        def sampler_of(t):
+            """The sampler bound with texture t: the comparison sampler for a texture2d_shadow."""
+            if not t.compare:
+                return sampler
+            if "sampler" not in compared:
+                compared["sampler"] = ComparisonSampler(device)
+                owned.append(compared["sampler"])
+            return compared["sampler"]
+
+        def depth_compared(dt):
+            """What a texture2d_shadow reads: depth target dt (its D32_SFLOAT image), or a lit 1×1 stand-in."""
+            if dt is not None:
+                if dt.sampled != "depth":
+                    raise UserError(f"{device.name} cannot linearly filter {dt.depth_format} depth: no comparison "
+                                    "sampler for a texture2d_shadow (pcf_hardware) — use pcf")
+                return dt
+            if "lit" not in compared:
+                compared["lit"] = DepthImage(device, np.ones((1, 1), np.float32))
+                owned.append(compared["lit"])
+            return compared["lit"]
 
         frame_buf = buf(gx.frame_bytes(vp, eye), U)
         for i, obj in enumerate(scene.objects):
@@ -388,8 +435,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             if c.interface.block("Material"):
                 spec[(1, 0)] = buf(bytes.fromhex(up["Material"]), U)
             for t in c.interface.textures:
-                res = light_texture(t, obj["lights"][t.light]) if t.group == "light" else textures[t.param]
-                spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = res, sampler
+                res = light_texture(t, obj["lights"][t.light]) if t.group == "light" else stand_in(t)
+                spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = res, sampler_of(t)
             ub = {(0, 0): frame, (2, 0): obj_buf,
                   (1, 0): buf(np.array([materials.index(obj["material"]), 0, 0, 0], np.int32), U),
                   (1, 1): material_buffer}
@@ -397,11 +444,11 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             if lbuf is not None:  # a scene without lights has an ubershader without a light buffer
                 ub[(lbuf.set, lbuf.binding)] = light_buffers.get(obj["light_set"]) or empty_lights()
             for t in uber.interface.textures:
-                res = textures[t.param]
+                res = stand_in(t)
                 if t.group == "light":
                     slots = slot_lights[obj["light_set"]]
-                    res = light_texture(t, slots[t.light]) if t.light < len(slots) else textures[t.param]
-                ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, sampler
+                    res = light_texture(t, slots[t.light]) if t.light < len(slots) else res
+                ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, sampler_of(t)
             draws.append((h, spec, ub, mesh_of[i]))
 
         specialized: dict[str, object] = {}

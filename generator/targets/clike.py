@@ -27,6 +27,7 @@ HALF_MAX = 65504.0  # the largest finite fp16 value
 MIRROR_PREFIX = "_w32_"  # the 32-bit twin of a buffer's element struct
 LOAD_PREFIX = "_load_"  # the function converting a buffer's 32-bit element to its half struct
 ENTRY32_PREFIX = "_f32_"  # the 32-bit wrapper of an entry point (entry32), and its half copies of arrays
+SAMPLING = ("sample", "sample_level", "sample_compare")  # the intrinsics that read a texture
 
 
 class Writer:
@@ -88,7 +89,9 @@ class CLikeTarget(ControlMixin, ResourceMixin):
     MATRIX = ""                     # format with {n}
     TEXTURE = ""                    # texture2d parameter type
     TEXTURE_CUBE = ""               # texturecube parameter type
+    TEXTURE_SHADOW = ""             # texture2d_shadow parameter type (a depth texture)
     SAMPLER = ""                    # separate sampler parameter type ("" = combined)
+    SAMPLER_COMPARE = ""            # the comparison sampler of a texture2d_shadow
     FLOAT_SUFFIX = ""
     INT_SUFFIX = ""
     UINT_SUFFIX = "u"
@@ -201,9 +204,21 @@ class CLikeTarget(ControlMixin, ResourceMixin):
             return ""
         return f'#line {int(line)} "{directive_path(path)}"'
 
-    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
-        """A global texture resource NAME ("2d" or "cube") and its sampler at bindings B and B+1 of set S."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
+        """A global texture resource NAME ("2d" or "cube") and its sampler at bindings B and B+1 of set S
+        (compare: a 2D depth texture and a comparison sampler, for sample_compare)."""
         raise NotImplementedError
+
+    def image_type(self, dim: str, compare: bool = False) -> str:
+        """The spelling of a texture of dimension `dim` ("2d", "cube"; compare: a 2D depth texture)."""
+        if compare:
+            assert dim == "2d", "comparison textures are 2D"
+            return self.TEXTURE_SHADOW
+        return {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
+
+    def sampler_type(self, compare: bool = False) -> str:
+        """The sampler that travels with a texture (compare: a comparison sampler)."""
+        return self.SAMPLER_COMPARE if compare else self.SAMPLER
 
     def type_name(self, t: Type) -> str:
         if t.kind == "scalar":
@@ -213,7 +228,7 @@ class CLikeTarget(ControlMixin, ResourceMixin):
         if t.kind == "matrix":
             return self.MATRIX.format(n=t.size)
         if t.kind == "texture":
-            return self.TEXTURE_CUBE if t.dim == "cube" else self.TEXTURE
+            return self.image_type(t.dim, t.compare)
         if t.kind == "struct":
             return self.ident(t.name)
         if t.kind == "array":
@@ -275,14 +290,18 @@ class CLikeTarget(ControlMixin, ResourceMixin):
         """Parameter declarations for one brick parameter (a texture brings its sampler)."""
         out = [self.var_decl(self.ident(p.name), p.ty)]
         if p.ty.kind == "texture" and self.SAMPLER:
-            out.append(self.var_decl(self.sampler_name(p.name), None))
+            out.append(self.sampler_decl(self.sampler_name(p.name), p.ty.compare))
         return out
 
-    def var_decl(self, name: str, t: Type | None) -> str:
-        """`T name` (None = the sampler type); `T name[N]` for arrays."""
-        if t is not None and t.kind == "array":
+    def sampler_decl(self, name: str, compare: bool = False) -> str:
+        """A sampler parameter `name` (compare: a comparison sampler)."""
+        return f"{self.sampler_type(compare)} {name}"
+
+    def var_decl(self, name: str, t: Type) -> str:
+        """`T name`; `T name[N]` for arrays."""
+        if t.kind == "array":
             return f"{self.type_name(t.elem)} {name}[{t.size}]"
-        return f"{self.type_name(t) if t is not None else self.SAMPLER} {name}"
+        return f"{self.type_name(t)} {name}"
 
     def param_list(self, f: ir.Function) -> list[str]:
         return [d for p in f.params for d in self.params(p)]
@@ -438,7 +457,7 @@ class CLikeTarget(ControlMixin, ResourceMixin):
             return f"{e.name}({', '.join(self.expr(a) for a in e.args)})"
         args = [self.expr(a) for a in e.args]
         smp = self.sampler_name(e.args[0].name) if e.args[0].ty.kind == "texture" else ""
-        if self.half and e.name in ("sample", "sample_level"):  # textures are 32-bit: coordinates and texels convert
+        if self.half and e.name in SAMPLING:  # textures are 32-bit: coordinates, references and texels convert
             args = [args[0]] + [self.to32(a.ty, x) for a, x in zip(e.args[1:], args[1:])]
             return self.from32(e.ty, fmt.format(*args, smp=smp))
         return fmt.format(*args, smp=smp)

@@ -41,7 +41,7 @@ class ResourceMixin(Target):
         if g.ty.kind == "buffer":
             return self.declare_buffer(g.name, g.ty.elem, g.set, g.binding, g.ty.space, g.ty.size)
         if g.ty.kind == "texture":
-            return self.declare_texture(g.name, g.set, g.binding, g.ty.dim)
+            return self.declare_texture(g.name, g.set, g.binding, g.ty.dim, g.ty.compare)
         if g.ty.kind == "scalar" and g.ty.scalar in ("int", "uint"):
             return self.declare_spec_constant(g.name, g.ty, g.binding)
         raise ValueError(f"global '{g.name}' is {g.ty}: only buffers, textures and int specialization constants "

@@ -2,7 +2,8 @@
 
 Textures are a `texture2D` (or `textureCube`) and a `sampler` (Vulkan GLSL), joined
 at the call as `sampler2D(t, s)` (`samplerCube(t, s)`), so the descriptor layout is the
-same as HLSL's and WGSL's: image at binding B, sampler at B+1. Buffers are interface
+same as HLSL's and WGSL's: image at binding B, sampler at B+1. A texture2d_shadow is a
+`texture2D` and a `samplerShadow`, joined as `sampler2DShadow(t, s)`. Buffers are interface
 blocks with one member `data` (clike_resources.py).
 """
 from __future__ import annotations
@@ -21,7 +22,9 @@ class GlslTarget(CLikeTarget):
     MATRIX = "mat{n}"
     TEXTURE = "texture2D"
     TEXTURE_CUBE = "textureCube"
+    TEXTURE_SHADOW = "texture2D"  # a depth texture; joined with a samplerShadow as sampler2DShadow
     SAMPLER = "sampler"
+    SAMPLER_COMPARE = "samplerShadow"
     INTRINSICS = {
         "rsqrt": "inversesqrt({0})",
         "saturate": "clamp({0}, 0.0, 1.0)",  # GLSL clamp takes float bounds for any genFType
@@ -30,6 +33,9 @@ class GlslTarget(CLikeTarget):
         "sample_level": "textureLod(sampler2D({0}, {smp}), {1}, {2})",
         "sample@cube": "texture(samplerCube({0}, {smp}), {1})",
         "sample_level@cube": "textureLod(samplerCube({0}, {smp}), {1}, {2})",
+        # GLSL 4.50 has textureLod for sampler2DShadow (not for the cube and array shadow samplers):
+        # level 0 explicitly, valid in non-uniform control flow; the reference is P's third component
+        "sample_compare": "textureLod(sampler2DShadow({0}, {smp}), vec3({1}, {2}), 0.0)",
     }
 
     def header(self) -> str:
@@ -39,12 +45,14 @@ class GlslTarget(CLikeTarget):
     def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
         return f"layout(constant_id = {int(constant_id)}) const {self.type_name(ty)} {self.ident(name)} = 0;"
 
-    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
-        """texture2D (textureCube) NAME at binding B and sampler _smp_NAME at B+1 of set S (as HLSL and WGSL)."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
+        """texture2D (textureCube) NAME at binding B and sampler (compare: samplerShadow) _smp_NAME at B+1 of
+        set S (as HLSL and WGSL)."""
         s, b = int(set), int(binding)
-        image = {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
+        image = self.image_type(dim, compare)
         return (f"layout(set = {s}, binding = {b}) uniform {image} {self.ident(name)};\n"
-                f"layout(set = {s}, binding = {b + 1}) uniform sampler {self.sampler_name(name)};")
+                f"layout(set = {s}, binding = {b + 1}) uniform {self.sampler_type(compare)} "
+                f"{self.sampler_name(name)};")
 
     def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
         if kind == "storage":

@@ -13,7 +13,7 @@ from __future__ import annotations
 from ..lang import ir
 from ..lang.types import Type
 from . import reserved
-from .clike import CLikeTarget, Writer
+from .clike import SAMPLING, CLikeTarget, Writer
 
 _COMPONENT = {"x": 0, "y": 1, "z": 2, "w": 3}
 
@@ -27,24 +27,29 @@ class HlslTarget(CLikeTarget):
     MATRIX = "float{n}x{n}"
     TEXTURE = "Texture2D"
     TEXTURE_CUBE = "TextureCube"
+    TEXTURE_SHADOW = "Texture2D"  # a depth texture is a Texture2D; its sampler makes the compare
     SAMPLER = "SamplerState"
+    SAMPLER_COMPARE = "SamplerComparisonState"
     INTRINSICS = {
         "fract": "frac({0})",
         "mix": "lerp({0}, {1}, {2})",
         "select": "({0} ? {1} : {2})",
         "sample": "{0}.Sample({smp}, {1})",
         "sample_level": "{0}.SampleLevel({smp}, {1}, {2})",
+        # level 0 (valid in non-uniform control flow, unlike SampleCmp's implicit LOD)
+        "sample_compare": "{0}.SampleCmpLevelZero({smp}, {1}, {2})",
     }
 
     def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
         return f"[[vk::constant_id({int(constant_id)})]] const {self.type_name(ty)} {self.ident(name)} = 0;"
 
-    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
-        """Texture2D (TextureCube) NAME at binding B and SamplerState _smp_NAME at B+1 of set S (t/s registers alike)."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
+        """Texture2D (TextureCube) NAME at binding B and SamplerState (compare: SamplerComparisonState)
+        _smp_NAME at B+1 of set S (t/s registers alike)."""
         s, b = int(set), int(binding)
-        image = {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
+        image = self.image_type(dim, compare)
         return (f"[[vk::binding({b}, {s})]] {image} {self.ident(name)} : register(t{b}, space{s});\n"
-                f"[[vk::binding({b + 1}, {s})]] SamplerState {self.sampler_name(name)} : "
+                f"[[vk::binding({b + 1}, {s})]] {self.sampler_type(compare)} {self.sampler_name(name)} : "
                 f"register(s{b + 1}, space{s});")
 
     def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
@@ -191,7 +196,7 @@ class HlslHalfTarget(HlslTarget):
         HLSL's fp16 errors are somewhat below GLSL's and WGSL's (phong_normalized: 3.5e-2 against 9.3e-2;
         DXC would keep them half). +, -, *, / and the brick's own functions are half as in GLSL."""
         text = super().expr_intrinsic(e)
-        if _has_float_value(e.ty) and e.name not in ("sample", "sample_level"):
+        if _has_float_value(e.ty) and e.name not in SAMPLING:
             return self.convert(e.ty, text)
         return text
 

@@ -260,6 +260,8 @@ class _FunctionEmitter(ControlEmitter):
         n = e.name
         if n in ("sample", "sample_level"):  # level 0 only: the lod of sample_level is not read
             return f"{'_texcube' if e.args[0].ty.dim == 'cube' else '_tex2d'}({args[0]}, {args[1]})"
+        if n == "sample_compare":
+            return f"_tex2d_compare({args[0]}, {args[1]}, {args[2]})"
         if n == "buffer_length":
             buf = e.args[0].ty
             return f"np.uint32({buf.size})" if buf.space == "uniform" else f"_blen({args[0]})"

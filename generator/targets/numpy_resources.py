@@ -24,6 +24,12 @@ them to its sub-texel precision (Vulkan requires ≥ 4 bits, subTexelPrecisionBi
 compare with a tolerance of that fraction of the texel differences. lavapipe filters
 float formats in float32: on R32G32B32A32_SFLOAT it agrees to ~1e-6
 (tests/test_lang_ext_textures.py).
+A texture2d_shadow is an array (H, W) (or (H, W, C), channel 0 read) of depths, read by
+sample_compare(t, uv, ref) as a linear comparison sampler with compareOp LESS_OR_EQUAL reads a
+depth image (Vulkan, "Depth Compare Operation" then "Texel Filtering"): each texel of the
+bilinear 2×2 footprint is compared first (1 where ref <= D, else 0) and the four results are
+weighted by the bilinear weights (percentage-closer filtering of Reeves et al. 1987 over 2×2
+texels, what lavapipe does); ref is not clamped, as the D32_SFLOAT depth format asks.
 Cube maps pick the face by the major axis (ties: X over Y over Z) and then
 filter within that face, clamped to its edge; Vulkan filters seamlessly across
 faces, so values within half a texel of a face edge differ from a GPU's.
@@ -118,15 +124,21 @@ def _image(t, cube: bool):
     return img
 
 
-def _bilinear(img, face, s, t):
-    """Bilinear clamp-to-edge fetch at normalized (s, t) of img[face] ((F, H, W, 4), face int array)."""
-    h, w = img.shape[1], img.shape[2]
+def _footprint(h, w, s, t):
+    """The bilinear clamp-to-edge footprint at normalized (s, t) of an H × W image: texel columns i0, i1,
+    rows j0, j1 and the weights ax, ay of i1 and j1."""
     x = np.nan_to_num(s * w - 0.5)
     y = np.nan_to_num(t * h - 0.5)
     x0, y0 = np.floor(x), np.floor(y)
-    ax, ay = (x - x0)[..., None], (y - y0)[..., None]
     i0, i1 = np.clip(x0, 0, w - 1).astype(np.intp), np.clip(x0 + 1, 0, w - 1).astype(np.intp)
     j0, j1 = np.clip(y0, 0, h - 1).astype(np.intp), np.clip(y0 + 1, 0, h - 1).astype(np.intp)
+    return i0, i1, j0, j1, x - x0, y - y0
+
+
+def _bilinear(img, face, s, t):
+    """Bilinear clamp-to-edge fetch at normalized (s, t) of img[face] ((F, H, W, 4), face int array)."""
+    i0, i1, j0, j1, ax, ay = _footprint(img.shape[1], img.shape[2], s, t)
+    ax, ay = ax[..., None], ay[..., None]
     return ((img[face, j0, i0] * (1 - ax) + img[face, j0, i1] * ax) * (1 - ay)
             + (img[face, j1, i0] * (1 - ax) + img[face, j1, i1] * ax) * ay)
 
@@ -138,6 +150,22 @@ def _tex2d(t, uv):
     c = uv.astype(np.float64)
     face = np.zeros(c.shape[:-1], np.intp)
     return _bilinear(img, face, c[..., 0], c[..., 1]).astype(uv.dtype)
+
+
+def _tex2d_compare(t, uv, ref):
+    """sample_compare of a texture2d_shadow: the bilinear weights of the 2×2 footprint applied to the four
+    compares (ref <= depth), level 0, clamp-to-edge (see the module docstring)."""
+    uv = np.asarray(uv)
+    depth = _image(t, cube=False)[..., 0]  # (H, W): the depth channel
+    c = uv.astype(np.float64)
+    i0, i1, j0, j1, ax, ay = _footprint(depth.shape[0], depth.shape[1], c[..., 0], c[..., 1])
+    r = np.asarray(ref, np.float64)
+
+    def lit(j, i):
+        return (r <= depth[j, i]).astype(np.float64)
+
+    out = (lit(j0, i0) * (1 - ax) + lit(j0, i1) * ax) * (1 - ay) + (lit(j1, i0) * (1 - ax) + lit(j1, i1) * ax) * ay
+    return out.astype(uv.dtype)
 
 
 def _texcube(t, d):

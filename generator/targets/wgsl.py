@@ -23,7 +23,9 @@ class WgslTarget(CLikeTarget):
     MATRIX = "mat{n}x{n}<f32>"
     TEXTURE = "texture_2d<f32>"
     TEXTURE_CUBE = "texture_cube<f32>"
+    TEXTURE_SHADOW = "texture_depth_2d"
     SAMPLER = "sampler"
+    SAMPLER_COMPARE = "sampler_comparison"
     DEFAULT_REQUIRED = True
     CASE_BREAK = False
     # Typed literals keep constant folding in f32/i32, as GLSL and HLSL do (abstract numbers fold in f64).
@@ -35,18 +37,20 @@ class WgslTarget(CLikeTarget):
         "select": "select({2}, {1}, {0})",  # WGSL: select(if_false, if_true, cond)
         "sample": "textureSample({0}, {smp}, {1})",
         "sample_level": "textureSampleLevel({0}, {smp}, {1}, {2})",
+        # level 0: valid in non-uniform control flow, unlike textureSampleCompare
+        "sample_compare": "textureSampleCompareLevel({0}, {smp}, {1}, {2})",
     }
 
     def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
         zero = "0i" if ty.scalar == "int" else "0u"
         return f"@id({int(constant_id)}) override {self.ident(name)}: {self.type_name(ty)} = {zero};"
 
-    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d") -> str:
-        """texture_2d<f32> (texture_cube<f32>) NAME at binding B and sampler _smp_NAME at B+1 of group S."""
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
+        """texture_2d<f32> (texture_cube<f32>; compare: texture_depth_2d) NAME at binding B and sampler
+        (compare: sampler_comparison) _smp_NAME at B+1 of group S."""
         s, b = int(set), int(binding)
-        image = {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
-        return (f"@group({s}) @binding({b}) var {self.ident(name)}: {image};\n"
-                f"@group({s}) @binding({b + 1}) var {self.sampler_name(name)}: sampler;")
+        return (f"@group({s}) @binding({b}) var {self.ident(name)}: {self.image_type(dim, compare)};\n"
+                f"@group({s}) @binding({b + 1}) var {self.sampler_name(name)}: {self.sampler_type(compare)};")
 
     def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
         if kind == "storage":
@@ -59,8 +63,11 @@ class WgslTarget(CLikeTarget):
     def array_type(self, t: Type) -> str:
         return f"array<{self.type_name(t.elem)}, {t.size}>"
 
-    def var_decl(self, name: str, t: Type | None) -> str:
-        return f"{name}: {self.type_name(t) if t is not None else self.SAMPLER}"
+    def var_decl(self, name: str, t: Type) -> str:
+        return f"{name}: {self.type_name(t)}"
+
+    def sampler_decl(self, name: str, compare: bool = False) -> str:
+        return f"{name}: {self.sampler_type(compare)}"
 
     def declare_local(self, name: str, t: Type) -> str:
         return f"var {self.var_decl(name, t)};"

@@ -4,7 +4,7 @@
 // eval: blinn_phong_normalized
 // hash: 9a8398637d4c
 // brick bricks/brdf/specular/blinn_phong_normalized.py sha256:1f8c5ef77dfc
-// template glsl/eval.glsl.j2 sha256:9df531e080fc
+// template glsl/eval.glsl.j2 sha256:2a6650fd24f0
 // template glsl/macros.glsl.j2 sha256:0712fef74734
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -7,7 +7,7 @@
 // brick bricks/brdf/microfacet/ndf/ggx_anisotropic.py sha256:6b91257b0372
 // brick bricks/brdf/microfacet/visibility/smith_ggx_height_correlated_anisotropic.py sha256:bc459008c8c9
 // brick bricks/brdf/specular/cook_torrance.py sha256:9934eded63fa
-// template glsl/eval.glsl.j2 sha256:9df531e080fc
+// template glsl/eval.glsl.j2 sha256:2a6650fd24f0
 // template glsl/macros.glsl.j2 sha256:0712fef74734
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per

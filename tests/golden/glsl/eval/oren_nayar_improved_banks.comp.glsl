@@ -5,7 +5,7 @@
 // hash: 672b392541e1
 // brick bricks/brdf/diffuse/oren_nayar_improved.py sha256:c3bc02210fd8
 // brick bricks/brdf/specular/banks.py sha256:4c7e94fa0027
-// template glsl/eval.glsl.j2 sha256:9df531e080fc
+// template glsl/eval.glsl.j2 sha256:2a6650fd24f0
 // template glsl/macros.glsl.j2 sha256:0712fef74734
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per

@@ -4,7 +4,7 @@
 // eval: phong_normalized
 // hash: bcf91138f6f2
 // brick bricks/brdf/specular/phong_normalized.py sha256:a73e1d4c856d
-// template glsl/eval.glsl.j2 sha256:9df531e080fc
+// template glsl/eval.glsl.j2 sha256:2a6650fd24f0
 // template glsl/macros.glsl.j2 sha256:0712fef74734
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

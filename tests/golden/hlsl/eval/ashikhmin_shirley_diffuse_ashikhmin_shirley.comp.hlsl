@@ -3,7 +3,7 @@
 // hash: 6a324f846cfa
 // brick bricks/brdf/diffuse/ashikhmin_shirley_diffuse.py sha256:5b5a2131352e
 // brick bricks/brdf/specular/ashikhmin_shirley.py sha256:374f44e9585c
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per

@@ -5,7 +5,7 @@
 // brick bricks/brdf/microfacet/ndf/ggx_anisotropic.py sha256:6b91257b0372
 // brick bricks/brdf/microfacet/visibility/smith_ggx_height_correlated_anisotropic.py sha256:bc459008c8c9
 // brick bricks/brdf/specular/cook_torrance.py sha256:9934eded63fa
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per

@@ -3,7 +3,7 @@
 // hash: d232fbbea256
 // brick bricks/brdf/diffuse/gotanda_fitted.py sha256:c8ae8831043c
 // brick bricks/brdf/specular/ward_anisotropic.py sha256:e743ab202e70
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per

@@ -5,7 +5,7 @@
 // brick bricks/brdf/microfacet/ndf/ggx.py sha256:ed8f1053ce9f
 // brick bricks/brdf/microfacet/visibility/smith_schlick_ggx.py sha256:4f6d1fd41968
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

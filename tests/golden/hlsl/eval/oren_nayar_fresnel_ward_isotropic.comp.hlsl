@@ -3,7 +3,7 @@
 // hash: f2208d10893c
 // brick bricks/brdf/diffuse/oren_nayar_fresnel.py sha256:5096c852ae4a
 // brick bricks/brdf/specular/ward_isotropic.py sha256:363a0b0e1c9a
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

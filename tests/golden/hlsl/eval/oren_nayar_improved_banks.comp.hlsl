@@ -3,7 +3,7 @@
 // hash: 672b392541e1
 // brick bricks/brdf/diffuse/oren_nayar_improved.py sha256:c3bc02210fd8
 // brick bricks/brdf/specular/banks.py sha256:4c7e94fa0027
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per

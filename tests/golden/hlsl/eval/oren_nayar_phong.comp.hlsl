@@ -3,7 +3,7 @@
 // hash: 3c28c8934ca3
 // brick bricks/brdf/diffuse/oren_nayar.py sha256:f2a947285e5e
 // brick bricks/brdf/specular/phong.py sha256:2ca679aee7f6
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

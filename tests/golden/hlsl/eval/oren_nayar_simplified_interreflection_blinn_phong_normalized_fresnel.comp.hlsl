@@ -3,7 +3,7 @@
 // hash: b16b403e47ed
 // brick bricks/brdf/diffuse/oren_nayar_simplified_interreflection.py sha256:82cb5a5bc9da
 // brick bricks/brdf/specular/blinn_phong_normalized_fresnel.py sha256:a5cf5ed269db
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

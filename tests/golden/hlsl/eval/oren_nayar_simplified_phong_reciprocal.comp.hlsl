@@ -3,7 +3,7 @@
 // hash: 1076a352e5dd
 // brick bricks/brdf/diffuse/oren_nayar_simplified.py sha256:025aaa87202a
 // brick bricks/brdf/specular/phong_reciprocal.py sha256:085d4c244074
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

@@ -23,7 +23,7 @@
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
-// template hlsl/ubershader.hlsl.j2 sha256:7f2531609f51
+// template hlsl/ubershader.hlsl.j2 sha256:4670f43438ef
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 

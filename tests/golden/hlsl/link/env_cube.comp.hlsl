@@ -2,7 +2,7 @@
 // eval: env_cube
 // hash: 3ba03c205706
 // brick tests/link_bricks/specular/env_cube.py sha256:ea1de37e890d
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

@@ -2,7 +2,7 @@
 // eval: lobes(lobes=2)
 // hash: ccf2080ae645
 // brick tests/link_bricks/specular/lobes.py sha256:889e667a483b
-// template hlsl/eval.hlsl.j2 sha256:0c8ad266737a
+// template hlsl/eval.hlsl.j2 sha256:ab8ec79af2b0
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per

@@ -3,7 +3,7 @@
 // hash: 6a324f846cfa
 // brick bricks/brdf/diffuse/ashikhmin_shirley_diffuse.py sha256:5b5a2131352e
 // brick bricks/brdf/specular/ashikhmin_shirley.py sha256:374f44e9585c
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per

@@ -2,7 +2,7 @@
 // eval: blinn_phong_normalized
 // hash: 9a8398637d4c
 // brick bricks/brdf/specular/blinn_phong_normalized.py sha256:1f8c5ef77dfc
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

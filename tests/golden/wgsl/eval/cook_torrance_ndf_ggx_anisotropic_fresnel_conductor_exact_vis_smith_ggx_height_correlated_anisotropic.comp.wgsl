@@ -5,7 +5,7 @@
 // brick bricks/brdf/microfacet/ndf/ggx_anisotropic.py sha256:6b91257b0372
 // brick bricks/brdf/microfacet/visibility/smith_ggx_height_correlated_anisotropic.py sha256:bc459008c8c9
 // brick bricks/brdf/specular/cook_torrance.py sha256:9934eded63fa
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per

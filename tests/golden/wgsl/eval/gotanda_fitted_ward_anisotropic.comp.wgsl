@@ -3,7 +3,7 @@
 // hash: d232fbbea256
 // brick bricks/brdf/diffuse/gotanda_fitted.py sha256:c8ae8831043c
 // brick bricks/brdf/specular/ward_anisotropic.py sha256:e743ab202e70
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per

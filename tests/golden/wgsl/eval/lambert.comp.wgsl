@@ -2,7 +2,7 @@
 // eval: lambert
 // hash: 55679a70c070
 // brick bricks/brdf/diffuse/lambert.py sha256:571e572632b7
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -5,7 +5,7 @@
 // brick bricks/brdf/microfacet/ndf/beckmann.py sha256:3a248d03882c
 // brick bricks/brdf/microfacet/visibility/torrance_sparrow.py sha256:34e07355ff14
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

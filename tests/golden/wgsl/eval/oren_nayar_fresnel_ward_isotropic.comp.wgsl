@@ -3,7 +3,7 @@
 // hash: f2208d10893c
 // brick bricks/brdf/diffuse/oren_nayar_fresnel.py sha256:5096c852ae4a
 // brick bricks/brdf/specular/ward_isotropic.py sha256:363a0b0e1c9a
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -3,7 +3,7 @@
 // hash: 672b392541e1
 // brick bricks/brdf/diffuse/oren_nayar_improved.py sha256:c3bc02210fd8
 // brick bricks/brdf/specular/banks.py sha256:4c7e94fa0027
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per

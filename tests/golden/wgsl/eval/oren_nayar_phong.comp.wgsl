@@ -3,7 +3,7 @@
 // hash: 3c28c8934ca3
 // brick bricks/brdf/diffuse/oren_nayar.py sha256:f2a947285e5e
 // brick bricks/brdf/specular/phong.py sha256:2ca679aee7f6
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -3,7 +3,7 @@
 // hash: b16b403e47ed
 // brick bricks/brdf/diffuse/oren_nayar_simplified_interreflection.py sha256:82cb5a5bc9da
 // brick bricks/brdf/specular/blinn_phong_normalized_fresnel.py sha256:a5cf5ed269db
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

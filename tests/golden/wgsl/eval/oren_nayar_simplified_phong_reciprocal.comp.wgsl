@@ -3,7 +3,7 @@
 // hash: 1076a352e5dd
 // brick bricks/brdf/diffuse/oren_nayar_simplified.py sha256:025aaa87202a
 // brick bricks/brdf/specular/phong_reciprocal.py sha256:085d4c244074
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

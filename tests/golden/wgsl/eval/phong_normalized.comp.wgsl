@@ -2,7 +2,7 @@
 // eval: phong_normalized
 // hash: bcf91138f6f2
 // brick bricks/brdf/specular/phong_normalized.py sha256:a73e1d4c856d
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -23,7 +23,7 @@
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
-// template wgsl/ubershader.wgsl.j2 sha256:50ec0d4730fc
+// template wgsl/ubershader.wgsl.j2 sha256:25862ea49c62
 
 struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;

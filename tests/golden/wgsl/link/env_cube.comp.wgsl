@@ -2,7 +2,7 @@
 // eval: env_cube
 // hash: 3ba03c205706
 // brick tests/link_bricks/specular/env_cube.py sha256:ea1de37e890d
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -2,7 +2,7 @@
 // eval: lobes(lobes=2)
 // hash: ccf2080ae645
 // brick tests/link_bricks/specular/lobes.py sha256:889e667a483b
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -2,7 +2,7 @@
 // eval: lut_diffuse
 // hash: 6dd2efd8fc3c
 // brick tests/link_bricks/diffuse/lut_diffuse.py sha256:b73105ae57a3
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per

@@ -5,7 +5,7 @@
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:df5916f2e496
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // brick tests/link_bricks/ndf/aniso_ggx.py sha256:01caff2cd618
-// template wgsl/eval.wgsl.j2 sha256:f197bbce6026
+// template wgsl/eval.wgsl.j2 sha256:13ca1346a79d
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per
