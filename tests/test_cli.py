@@ -180,7 +180,7 @@ def test_compiler_failure_names_the_brick_line_and_other_permutations_still_buil
     failed = next(p for p in m["permutations"] if p["status"] == "failed")
     # A permutation that never built lists no artifact (never a part of a set); the source that failed is
     # kept for reading under its own name.
-    assert failed["languages"] == {} and failed["failed_sources"] == {"wgsl.frag": f"wgsl/{failed['hash']}.frag.failed.wgsl"}
+    assert failed["languages"] == {} and failed["failed_sources"] == {"wgsl.frag": f"vulkan/wgsl/{failed['hash']}.frag.failed.wgsl"}
     assert (out / failed["failed_sources"]["wgsl.frag"]).is_file()
     assert not list(out.glob(f"*/{failed['hash']}.*.spv"))
 

@@ -82,10 +82,10 @@ def test_a_damaged_output_is_rebuilt(built):
     from generator.build import build_scene
 
     lib, scene, out = built
-    victim = sorted((out / "glsl").glob("*.frag.spv"))[0]
+    victim = sorted((out / "vulkan" / "glsl").glob("*.frag.spv"))[0]
     victim.write_bytes(b"garbage")
     again = build_scene(scene, lib, out)
     users = {e["hash"] for e in json.loads((out / "manifest.json").read_text())["permutations"]
-             for st in e["languages"].values() for it in st.values() if it["spirv"] == f"glsl/{victim.name}"}
+             for st in e["languages"].values() for it in st.values() if it["spirv"] == f"vulkan/glsl/{victim.name}"}
     assert again.ok and again.kept == len(scene.permutations) - len(users) and users  # every one naming it
     assert victim.read_bytes()[:4] == b"\x03\x02\x23\x07"  # SPIR-V again

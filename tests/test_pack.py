@@ -1,4 +1,4 @@
-"""`build --pack` (issue 12 item 4): one shader pack per language, its documented format, its reader."""
+"""`build --pack` (issue 12 item 4): one shader pack per platform, its documented format, its reader."""
 from __future__ import annotations
 
 import hashlib
@@ -37,13 +37,21 @@ def minimal_read(data: bytes) -> dict:
     return {"key": key.hex(), "meta": meta, "entries": entries, "input_keys": {(r[0], r[1]): r[2] for r in rows}}
 
 
-def expected_entries(out: Path, manifest: dict, language: str) -> dict:
-    """{(permutation, stage): SPIR-V bytes} the pack of `language` must hold: every ok entry's file."""
+PRIMARY = {"vulkan": "spirv", "d3d12": "hlsl", "gl": "glsl", "webgpu": "wgsl"}  # no dxc here: d3d12 packs HLSL
+
+
+def expected_entries(out: Path, manifest: dict, platform: str) -> dict:
+    """{(permutation, stage): bytes} the pack of `platform` must hold: every ok entry's artifact (and the
+    ubershader's GLSL SPIR-V in vulkan's)."""
     want = {}
-    for name, e in [*((p["hash"], p) for p in manifest["permutations"]), ("ubershader", manifest["ubershader"])]:
+    for e in manifest["permutations"]:
         if e.get("status") == "ok":
-            for stage, item in e["languages"][language].items():
-                want[(name, stage)] = (out / item["spirv"]).read_bytes()
+            for stage, item in e["platforms"][platform]["stages"].items():
+                kind = "dxil" if "dxil" in item else PRIMARY[platform]
+                want[(e["hash"], stage)] = (out / item[kind]["path"]).read_bytes()
+    if platform == "vulkan" and manifest["ubershader"].get("status") == "ok":
+        for stage, item in manifest["ubershader"]["languages"]["glsl"].items():
+            want[("ubershader", stage)] = (out / item["spirv"]).read_bytes()
     return want
 
 
@@ -68,20 +76,22 @@ def packed(lib_scene, tmp_path_factory):
 
 
 @pytest.mark.toolchain
-def test_build_pack_on_the_command_line_writes_one_pack_per_language_listed_in_the_manifest(tmp_path):
+def test_build_pack_on_the_command_line_writes_one_pack_per_platform_listed_in_the_manifest(tmp_path):
     out = tmp_path / "out"
     r = subprocess.run([sys.executable, "-m", "generator.cli", "build", str(EXAMPLE), "--out", str(out), "--pack",
                         "--json"], capture_output=True, text=True, cwd=REPO)
     assert r.returncode == 0, r.stderr
     manifest = json.loads((out / "manifest.json").read_text())
     packs = manifest["packs"]
-    assert [p["language"] for p in packs] == manifest["languages"] == ["glsl", "hlsl", "wgsl"]
+    assert [p["platform"] for p in packs] == manifest["platforms"] == ["vulkan", "d3d12", "gl", "webgpu"]
     assert json.loads(r.stdout)["packs"] == [p["path"] for p in packs]
     for p in packs:
         data = (out / p["path"]).read_bytes()
-        assert p["path"] == f"packs/{p['language']}.{p['key'][:16]}.smpack"
+        assert p["path"] == f"packs/{p['platform']}.{p['key'][:16]}.smpack"
         assert hashlib.sha256(data).hexdigest() == p["sha256"] and len(data) == p["size"]
-        assert p["entries"] == len(expected_entries(out, manifest, p["language"])) == 2 * (len(manifest["permutations"]) + 1)
+        uber = 1 if p["platform"] == "vulkan" else 0  # the ubershader is built for vulkan only
+        assert p["entries"] == len(expected_entries(out, manifest, p["platform"])) == \
+            2 * (len(manifest["permutations"]) + uber)
     assert sorted(x.name for x in (out / "packs").iterdir()) == sorted(Path(p["path"]).name for p in packs)
 
 
@@ -91,12 +101,13 @@ def test_the_package_reader_and_an_independent_reader_agree_with_the_manifests_s
     out, manifest = packed
     keys = {p["hash"]: p["input_key"] for p in manifest["permutations"]} | {"ubershader": manifest["ubershader"]["input_key"]}
     for p in manifest["packs"]:
-        want = expected_entries(out, manifest, p["language"])
+        want = expected_entries(out, manifest, p["platform"])
         data = (out / p["path"]).read_bytes()
         mine = minimal_read(data)
         pack = read_pack(out / p["path"])
         assert mine["key"] == pack["key"] == p["key"]
-        assert mine["meta"] == pack["meta"] and pack["tools"] == manifest["tools"] and pack["language"] == p["language"]
+        assert mine["meta"] == pack["meta"] and pack["language"] == p["language"] and pack["platform"] == p["platform"]
+        assert pack["tools"] == {**manifest["permutations"][0]["platforms"][p["platform"]]["tools"], **manifest["tools"]}
         assert pack["generator"] == manifest["generator"]
         assert mine["entries"] == {k: e.data for k, e in pack["entries"].items()} == want
         assert mine["input_keys"] == {k: e.input_key for k, e in pack["entries"].items()} == \
@@ -272,10 +283,11 @@ def test_only_ok_entries_are_packed_and_a_damaged_tree_is_refused(tmp_path):
     def entry(h, status, spv):
         (tmp_path / "glsl").mkdir(exist_ok=True)
         (tmp_path / "glsl" / f"{h}.spv").write_bytes(spv)
-        item = {"spirv": f"glsl/{h}.spv", "spirv_sha256": hashlib.sha256(spv).hexdigest()}
-        return {"hash": h, "input_key": "ab" * 32, "status": status, "languages": {"glsl": {"frag": item}}}
+        item = {"spirv": {"path": f"glsl/{h}.spv", "sha256": hashlib.sha256(spv).hexdigest()}}
+        return {"hash": h, "input_key": "ab" * 32, "status": status,
+                "platforms": {"vulkan": {"stages": {"frag": item}}}}
 
-    manifest = {"generator": "shadermatrix test", "tools": {"glslc": "1"}, "languages": ["glsl"], "ubershader": {},
+    manifest = {"generator": "shadermatrix test", "tools": {"glslc": "1"}, "platforms": ["vulkan"], "ubershader": {},
                 "permutations": [entry("aaaaaaaaaaaa", "ok", SPV[0]), entry("bbbbbbbbbbbb", "stale", SPV[1])]}
     [listed] = write_packs(tmp_path, manifest)
     pack = read_pack(tmp_path / listed["path"])

@@ -27,6 +27,7 @@ from ..toolchain import CompileStats, tool_versions
 from ..toolchain.scenes import job_key, source_jobs
 from ..link.values import uploads
 from .outputs import clean_leftovers, collect_garbage, locked, shown, write_depfile
+from .platforms import PLATFORMS, all_tools, dialects_of, platform_files, write_platforms
 from .reflection import scene_tables
 
 _PACKAGE = Path(__file__).resolve().parents[1]  # generator/
@@ -49,6 +50,7 @@ class BuildResult:
     aliased: int = 0  # SPIR-V files another item of this build already wrote (identical modules: one file)
     costs: dict = field(default_factory=dict)  # SPIR-V sha256 -> cost dict: each module analysed once per build
     templates: set = field(default_factory=set)  # template files worker processes read
+    platforms: tuple = PLATFORMS  # what this build writes (build/platforms.py)
     _manifest: dict | None = None
     _done: set = field(default_factory=set)  # files this build has written or found in place
 
@@ -69,7 +71,8 @@ class BuildResult:
 
 
 def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None, depfile=None,
-                workers: int | None = None, executor=None, keep_removed: bool = False, pack: bool = False) -> BuildResult:
+                workers: int | None = None, executor=None, keep_removed: bool = False, pack: bool = False,
+                platforms=PLATFORMS) -> BuildResult:
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     store: an io.Store (the content-addressed cache): compiled shaders and their costs are served from it
@@ -77,8 +80,9 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     workers: tool processes at once (default: the core count); executor: where compiles run instead
     (toolchain/dask.py). Neither changes a byte of the output. keep_removed: the outputs of permutations that
     left the scene stay, listed under the manifest's ``removed`` (marked so), instead of being deleted.
-    pack: also write one shader pack per language (build/pack.py), listed under the manifest's ``packs``;
-    without it the manifest is what it always was.
+    pack: also write one shader pack per platform (build/pack.py), listed under the manifest's ``packs``.
+    platforms: what to write besides the SPIR-V checks of every language (build/platforms.py: vulkan, d3d12,
+    gl, webgpu; one tree each, OUT/<platform>/, and per permutation a ``platforms`` section in the manifest).
 
     Incremental: each permutation's manifest entry records ``input_key``, the sha256 of everything its
     outputs depend on (its key, the source of every brick it reads, the scene values of the objects that
@@ -97,7 +101,7 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     out = Path(out)
     with locked(out):
         clean_leftovers(out)
-        res = _build(scene, lib, out, languages, store, workers, executor, keep_removed, pack)
+        res = _build(scene, lib, out, languages, store, workers, executor, keep_removed, pack, tuple(platforms))
         if depfile is not None:
             write_depfile(depfile, shown(out / "manifest.json"), _deps(scene, lib, out))
     return res
@@ -120,9 +124,9 @@ def _templates_read(also=()) -> list[str]:
 
 
 def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None, executor=None,
-           keep_removed: bool = False, pack: bool = False) -> BuildResult:
-    res = BuildResult(out, store=store)
-    base = _globals(languages)
+           keep_removed: bool = False, pack: bool = False, platforms=PLATFORMS) -> BuildResult:
+    res = BuildResult(out, store=store, platforms=platforms)
+    base = _globals(languages, platforms)
     users: dict[str, list[dict]] = {}
     for o in scene.objects:
         users.setdefault(o["permutation"], []).append(o)
@@ -161,21 +165,32 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         return {"id": perm.canonical(), "hash": h, "input_key": keys[h], "objects": scene.users.get(h, []),
                 "languages": {}}
 
+    dialects = dialects_of(platforms)
+    dxil = _dxil_step() if "d3d12" in platforms else None
+
     def written(pairs, part):  # a compiled chunk: written and analysed while the next chunks compile
+        checked = _validate_dialects(pairs, store) if dialects else {}
         for h, c in pairs:
             entry = {**head(h), "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
                      "uploads": uploads(scene, h, c, users.get(h, []))}
             errs = _write_all(res, out, h, c.sources, part, entry)
+            if not errs:
+                errs = write_platforms(lambda rel, data: _count(res, atomic_write(out / rel, data)), h, c, entry,
+                                       platforms, checked, scene.permutations[h].precision, dxil)
+                if errs:
+                    entry.pop("platforms", None)
+                    entry["languages"] = {}
             built[h] = _settle(res, entry, errs, old.get(h), out, _failure_head(scene, h, users.get(h, [])))
 
     n = workers or os.cpu_count() or 1
     if executor is None and n > 1 and len(todo.permutations) >= MIN_PERMUTATIONS:  # compose and analyse there too
         composed, errors, results = compile_scene_parallel(todo, lib, languages, store=store, stats=res.compile,
                                                            extra=extra, workers=n, on_done=written, costs=res.costs,
-                                                           templates=res.templates)
+                                                           templates=res.templates, dialects=dialects)
     else:
         composed, errors, results = compile_scene(todo, lib, languages, store=store, stats=res.compile, extra=extra,
-                                                  workers=workers, executor=executor, on_done=written)
+                                                  workers=workers, executor=executor, on_done=written,
+                                                  dialects=dialects)
     res.kept = len(kept)
 
     entries = []
@@ -198,6 +213,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         "scene": scene.name,
         "tools": tool_versions(),
         "languages": list(languages),
+        "platforms": list(platforms),
         "permutations": entries,
         "ubershader": uber,
         **scene_tables(scene, composed, previous),
@@ -316,8 +332,9 @@ def _own_sources() -> str:
     return h.hexdigest()
 
 
-def _globals(languages) -> str:
-    return content_key("build-v1", __version__, _own_sources(), tool_versions(), list(languages))
+def _globals(languages, platforms=PLATFORMS) -> str:
+    return content_key("build-v1", __version__, _own_sources(), tool_versions(), list(languages), list(platforms),
+                       all_tools(platforms))
 
 
 def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict], memo: dict) -> tuple[str, str]:
@@ -382,6 +399,7 @@ def _items(entry: dict):
     for stages in entry.get("languages", {}).values():
         for item in stages.values():
             yield from ((item[f], item[f"{f}_sha256"]) for f in ("source", "spirv") if f in item)
+    yield from platform_files(entry)
 
 
 def _files(entry: dict) -> int:
@@ -403,7 +421,7 @@ def _write_all(res: BuildResult, out: Path, name: str, sources, results, entry: 
     for src in sources:
         r = results[job_key(name, src.stage, src.language)]
         if not (r.ok and r.spirv):
-            rel = f"{src.language}/{name}.{src.stage}.failed.{src.language}"
+            rel = f"vulkan/{src.language}/{name}.{src.stage}.failed.{src.language}"
             _count(res, atomic_write(out / rel, src.text.encode()))
             failed[f"{src.language}.{src.stage}"] = rel
             errs += r.errors()
@@ -420,10 +438,12 @@ def _write(res: BuildResult, out: Path, name: str, src, r) -> dict:
     """Write one compiled source and its SPIR-V under content names; returns its manifest item."""
     data = src.text.encode()
     src_sha, spv_sha = sha256(data), sha256(r.spirv)
-    rel_src = f"{src.language}/{name}.{src.stage}.{src_sha[:12]}.{src.language}"
+    if "vulkan" not in res.platforms:  # the SPIR-V checks ran (and their costs are recorded); nothing to ship
+        return {"source_sha256": src_sha, "spirv_sha256": spv_sha, "cost": _cost(res, spv_sha, r.spirv)}
+    rel_src = f"vulkan/{src.language}/{name}.{src.stage}.{src_sha[:12]}.{src.language}"
     # SPIR-V is named by its content alone: identical modules (the vertex shaders of most permutations) are
     # one file, and every manifest item that has them names it (aliased); sources keep their own header
-    rel_spv = f"{src.language}/{spv_sha[:16]}.{src.stage}.spv"
+    rel_spv = f"vulkan/{src.language}/{spv_sha[:16]}.{src.stage}.spv"
     _count(res, atomic_write(out / rel_src, data))
     if rel_spv in res._done:
         res.aliased += 1
@@ -440,6 +460,25 @@ def _cost(res: BuildResult, sha: str, spirv: bytes) -> dict:
     if cost is None:
         cost = res.costs[sha] = cost_dict(spirv, res.store)
     return cost
+
+
+def _validate_dialects(pairs, store) -> dict[str, list[str]]:
+    """glslangValidator's errors (job key -> errors) for the platform dialect sources of a compiled chunk."""
+    from ..toolchain import CompileJob
+    from ..toolchain.platforms import validate_dialects
+    jobs = [CompileJob(job_key(h, s.stage, s.language), s.language, s.stage, s.text, line_map=tuple(s.line_map))
+            for h, c in pairs for s in c.dialects]
+    return validate_dialects(jobs, store) if jobs else {}
+
+
+def _dxil_step():
+    """The DXC step of the d3d12 platform, or None when no dxc is on PATH (README: where to get one)."""
+    from ..toolchain import CompileJob, find_tool
+    from ..toolchain.platforms import compile_dxil
+    if find_tool("dxc") is None:
+        return None
+    return lambda name, src, precision: compile_dxil(
+        CompileJob(job_key(name, src.stage, "dxil"), "hlsl", src.stage, src.text), precision)
 
 
 def _compose_ubershader(scene: Scene, lib: Library, languages):

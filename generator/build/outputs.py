@@ -28,6 +28,8 @@ from ..io import atomic_write
 from ..targets import LANGUAGES
 
 LOCK = ".shadermatrix-lock"
+# the trees a build writes (build/platforms.py), and the language trees of builds before platforms (emptied)
+TREES = (*(f"vulkan/{lang}" for lang in LANGUAGES), "d3d12", "gl", "webgpu", *LANGUAGES)
 TEMP_DIR = re.compile(r"^shadermatrix-(?:radv-)?(\d+)-")
 OWN_TMP = re.compile(r"^\..+\.[^.]+\.tmp$")  # io.atomic_write: .<name>.<random>.tmp
 
@@ -67,7 +69,7 @@ def clean_leftovers(out: Path) -> int:
     no other build writes there) and directories (system temp dir: of a dead process, untouched for
     STALE_S seconds, since a process in another pid namespace that shares /tmp looks dead from here)."""
     gone = 0
-    for d in [out, *(out / lang for lang in LANGUAGES)]:
+    for d in [out, *(out / tree for tree in TREES)]:
         if not d.is_dir():
             continue
         for p in d.glob(".*.tmp"):
@@ -96,20 +98,29 @@ def named(manifest: dict) -> set[str]:
             for item in stages.values():
                 out.update(item[k] for k in ("source", "spirv") if k in item)
         out.update(e.get("failed_sources", {}).values())
+        for p, d in (e.get("platforms") or {}).items():
+            out.update(a["path"] for item in d.get("stages", {}).values() for a in item.values())
+    out.update(t["path"] for t in manifest.get("tables", []))  # baked lookup tables (build/tables.py)
     return out
 
 
 def collect_garbage(out: Path, manifest: dict) -> int:
-    """Remove the files of the language directories that the (new, already written) manifest does not name."""
+    """Remove the files of the output trees that the (new, already written) manifest does not name, and the
+    trees left empty (a platform no longer built, the language trees of an older layout)."""
     keep, gone = named(manifest), 0
-    for lang in LANGUAGES:
-        d = out / lang
+    for tree in TREES:
+        d = out / tree
         if not d.is_dir():
             continue
         for p in d.iterdir():
-            if p.is_file() and not p.name.startswith(".") and f"{lang}/{p.name}" not in keep:
+            if p.is_file() and not p.name.startswith(".") and f"{tree}/{p.name}" not in keep:
                 p.unlink(missing_ok=True)
                 gone += 1
+        for empty in (d, d.parent) if d.parent != out else (d,):
+            try:
+                empty.rmdir()
+            except OSError:  # not empty
+                pass
     return gone
 
 

@@ -1,11 +1,12 @@
-"""Shader packs (`build --pack`): one content-addressed file of optimized SPIR-V per language.
+"""Shader packs (`build --pack`): one content-addressed file per platform, its artifacts by permutation.
 
-Until the platforms of issue 12 exist, a pack is per *language* (every language's SPIR-V is what
-Vulkan loads): ``DIR/packs/<language>.<key16>.smpack``, ``key16`` the first 16 hex digits of the
-pack key. A platform (``vulkan``, ``webgpu``, …) takes the language's place in the name and in the
-metadata when it exists; the layout does not change. The file is named by its key, like every
-artifact of the tree: a rebuild writes a new file beside the old one, the manifest (``packs``: language,
-path, sha256, key, entries, size) is replaced, and only then is the old pack removed.
+A pack holds what its platform loads (build/platforms.py PRIMARY): ``vulkan`` the optimized SPIR-V of
+the GLSL, ``d3d12`` DXIL where dxc built it and the HLSL text otherwise, ``gl`` the GLSL 4.50 core text,
+``webgpu`` the WGSL text; the metadata's ``blob`` says which (``spirv``, ``dxil``, ``hlsl``, ``glsl``,
+``wgsl``). ``DIR/packs/<platform>.<key16>.smpack``, ``key16`` the first 16 hex digits of the pack key.
+The file is named by its key, like every artifact of the tree: a rebuild writes a new file beside the
+old one, the manifest (``packs``: platform, language, path, sha256, key, entries, size) is replaced, and
+only then is the old pack removed. The ubershader is in the vulkan pack (the other platforms do not build it).
 
 Format, version 1 (all integers little-endian, fixed widths; offsets from the start of the file)::
 
@@ -17,8 +18,8 @@ Format, version 1 (all integers little-endian, fixed widths; offsets from the st
      48   4  u32 meta_length  M
      52   4  u32 reserved     0
     meta, M bytes at 56       UTF-8 JSON, sorted keys, separators "," ":" — {"format": "smpack",
-                              "generator": "shadermatrix X.Y.Z", "language": "glsl", "platform": null
-                              (the platform's name once platforms exist), "spirv_version": "1.3",
+                              "generator": "shadermatrix X.Y.Z", "language": "glsl", "platform":
+                              "vulkan", "blob": "spirv", "spirv_version": "1.3",
                               "target_env": "vulkan1.1", "tools": {tool: exact version}}
     zero padding to a multiple of 8
     index, N entries of 104 bytes, sorted by (permutation, stage), no two alike
@@ -215,44 +216,57 @@ def lookup(pack: dict, permutation: str, stage: str) -> bytes:
 
 # ------------------------------------------------------------------ writing (the build)
 
-def pack_meta(language: str, generator: str, tools: dict) -> dict:
+def pack_meta(platform: str, language: str, blob: str, generator: str, tools: dict) -> dict:
     from ..toolchain import SPIRV_VERSION, TARGET_ENV
-    return {"format": "smpack", "generator": generator, "language": language, "platform": None,
+    return {"format": "smpack", "generator": generator, "language": language, "platform": platform, "blob": blob,
             "spirv_version": SPIRV_VERSION, "target_env": TARGET_ENV, "tools": dict(sorted(tools.items()))}
 
 
-def _packed(entry: dict, name: str):
-    """(permutation name, language, stage, input key, spirv path, sha256) of an ok manifest entry."""
+def _packed(entry: dict, name: str, platform: str):
+    """(permutation name, stage, input key, blob kind, path, sha256) of an ok manifest entry on `platform`."""
+    from .platforms import PRIMARY
     if entry.get("status") != "ok":
         return
-    for lang, stages in entry.get("languages", {}).items():
-        for stage, item in stages.items():
-            yield name, lang, stage, entry["input_key"], item["spirv"], item["spirv_sha256"]
+    if name == "ubershader":  # built for vulkan only: its GLSL's SPIR-V
+        if platform == "vulkan":
+            for stage, item in entry.get("languages", {}).get("glsl", {}).items():
+                if "spirv" in item:
+                    yield name, stage, entry["input_key"], "spirv", item["spirv"], item["spirv_sha256"]
+        return
+    for stage, item in entry.get("platforms", {}).get(platform, {}).get("stages", {}).items():
+        kind = "dxil" if "dxil" in item else PRIMARY[platform]
+        yield name, stage, entry["input_key"], kind, item[kind]["path"], item[kind]["sha256"]
 
 
 def write_packs(out: Path, manifest: dict, count=None) -> list[dict]:
-    """Write one pack per language of `manifest` (its ok permutations and ubershader) into out/packs;
-    returns the manifest's ``packs`` list. count(changed): the build's file counter."""
+    """Write one pack per platform of `manifest` (its ok permutations; the ubershader in vulkan's) into
+    out/packs; returns the manifest's ``packs`` list. count(changed): the build's file counter."""
+    from .platforms import PRIMARY, SOURCE_LANGUAGE
     out = Path(out)
-    rows = [r for e in manifest["permutations"] for r in _packed(e, e["hash"])]
-    rows += list(_packed(manifest.get("ubershader") or {}, "ubershader"))
     listed = []
-    for lang in manifest["languages"]:
-        entries = []
-        for name, language, stage, input_key, rel, sha in rows:
-            if language != lang:
-                continue
+    for platform in manifest.get("platforms", []):
+        rows = [r for e in manifest["permutations"] for r in _packed(e, e["hash"], platform)]
+        rows += list(_packed(manifest.get("ubershader") or {}, "ubershader", platform))
+        entries, kinds = [], set()
+        for name, stage, input_key, kind, rel, sha in rows:
             data = (out / rel).read_bytes()
             if hashlib.sha256(data).hexdigest() != sha:
                 raise PackError(f"{out / rel}: its sha256 is not the manifest's — rebuild without --pack first")
             entries.append((name, stage, input_key, data))
-        blob, key = encode_pack(pack_meta(lang, manifest["generator"], manifest["tools"]), entries)
-        rel = f"{PACKS}/{lang}.{key[:16]}{SUFFIX}"
+            kinds.add(kind)
+        blob_kind = "+".join(sorted(kinds)) or PRIMARY[platform]  # d3d12 without dxc for some: "dxil+hlsl"
+        own = next((e["platforms"][platform].get("tools", {}) for e in manifest["permutations"]
+                    if platform in (e.get("platforms") or {})), {})  # as the build recorded them: no tool runs
+        tools = {**own, **manifest["tools"]}
+        meta = pack_meta(platform, SOURCE_LANGUAGE[platform], blob_kind, manifest["generator"], tools)
+        blob, key = encode_pack(meta, entries)
+        rel = f"{PACKS}/{platform}.{key[:16]}{SUFFIX}"
         changed = atomic_write(out / rel, blob)
         if count is not None:
             count(changed)
-        listed.append({"language": lang, "path": rel, "sha256": hashlib.sha256(blob).hexdigest(), "key": key,
-                       "entries": len(entries), "size": len(blob)})
+        listed.append({"platform": platform, "language": SOURCE_LANGUAGE[platform], "blob": blob_kind, "path": rel,
+                       "sha256": hashlib.sha256(blob).hexdigest(), "key": key, "entries": len(entries),
+                       "size": len(blob)})
     return listed
 
 

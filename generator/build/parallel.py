@@ -45,7 +45,8 @@ def chunk_size(permutations: int, workers: int) -> int:
     return max(4, min(64, -(-permutations // (workers * 8))))
 
 
-def _start(build: int, lib_bytes: bytes, env: dict, store_root: str | None, languages: tuple) -> None:
+def _start(build: int, lib_bytes: bytes, env: dict, store_root: str | None, languages: tuple,
+           dialects: tuple = ()) -> None:
     import signal
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole process group: the build ends the workers
     _watch(build)
@@ -53,7 +54,8 @@ def _start(build: int, lib_bytes: bytes, env: dict, store_root: str | None, lang
     os.environ.update(env)
     lib = pickle.loads(lib_bytes)
     lib.memo, lib.serial = {}, next(_bricks._SERIALS)  # this process's own caches
-    _WORKER.update(lib=lib, store=Store(store_root) if store_root else None, languages=languages)
+    _WORKER.update(lib=lib, store=Store(store_root) if store_root else None, languages=languages,
+                   dialects=dialects)
 
 
 def _watch(build: int) -> None:
@@ -92,7 +94,7 @@ def _task(items: list, extra: list) -> tuple:
     try:
         for h, perm in items:
             try:
-                c = composed[h] = compose_permutation(perm, lib, languages)
+                c = composed[h] = compose_permutation(perm, lib, languages, _WORKER["dialects"])
             except SourceError as e:
                 errors[h] = [str(e)]
                 continue
@@ -123,7 +125,7 @@ def _stop(pool: ProcessPoolExecutor) -> None:
 
 
 def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=(), workers: int = 2,
-                           on_done=None, costs: dict | None = None, templates: set | None = None):
+                           on_done=None, costs: dict | None = None, templates: set | None = None, dialects=()):
     """toolchain.scenes.compile_scene's contract, in `workers` processes; also fills `costs` (SPIR-V sha256 ->
     cost dict, for the writer) and `templates` (the template files the workers read)."""
     from tqdm import tqdm
@@ -166,7 +168,8 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     # an executor, so that a worker that dies fails the build (BrokenProcessPool) instead of losing its task
     pool = ProcessPoolExecutor(
         workers, mp_context=context, initializer=_start,
-        initargs=(os.getpid(), lib_bytes, dict(os.environ), str(store.root) if store else private, tuple(languages)))
+        initargs=(os.getpid(), lib_bytes, dict(os.environ), str(store.root) if store else private, tuple(languages),
+                  tuple(dialects)))
     try:
         with tqdm(total=len(items), disable=not show_progress(), unit="permutation", leave=False) as bar:
             # the ubershader's large shaders first, one task each: they spread over the workers

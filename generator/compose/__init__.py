@@ -84,6 +84,7 @@ class Composed:
     interface: Interface
     material: list[Slot] = field(default_factory=list)
     lights: list[list[Slot]] = field(default_factory=list)
+    dialects: list[Source] = field(default_factory=list)  # platform dialects (gl, essl): validated, not SPIR-V
 
 
 def _template_hash(name: str) -> str:
@@ -198,8 +199,9 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
     return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
 
 
-def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) -> Composed:
-    """Vertex and fragment shaders of one permutation in each language."""
+def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES, dialects=()) -> Composed:
+    """Vertex and fragment shaders of one permutation in each language, and in each platform dialect of
+    `dialects` ("gl": GLSL 4.50 core for OpenGL, "essl": GLSL ES 3.10; targets/gl.py) into .dialects."""
     lp = link_permutation(perm, lib)
     prog, iface = lp.program, lp.interface
     h = perm.hash
@@ -223,4 +225,29 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES) ->
                    "iface": iface, "spell": lambda name, _t=get_target(lang): _t.type_name(BUILTIN_TYPES[name])}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
-    return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
+    extra = _dialect_sources(perm, lp, dialects, call_args, mat, lights, bricks, templates) if dialects else []
+    return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights,
+                    dialects=extra)
+
+
+def _dialect_sources(perm, lp, dialects, call_args, mat, lights, bricks, templates) -> list[Source]:
+    """The permutation's vertex and fragment shaders in each platform dialect (templates/gl/)."""
+    from ..targets.gl import DIALECTS, gl_bindings
+    prog, iface, h = lp.program, lp.interface, perm.hash
+    spell = lambda name, _t=get_target("glsl"): _t.type_name(BUILTIN_TYPES[name])  # noqa: E731
+    out = []
+    for d in dialects:
+        target = DIALECTS[d](gl_bindings(iface.blocks, iface.textures), perm.precision)
+        emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted, shade = target.entry32(emitted, _function(prog, "shade"))
+        for stage in ("vertex", "fragment"):
+            tname = f"gl/{stage}.gl.j2"
+            used = {**_templates_used("gl", tname), "glsl/macros.glsl.j2": _template_hash("glsl/macros.glsl.j2")}
+            templates.update(used)
+            ctx = {"provenance": _provenance(f"permutation ({d})", perm.canonical(), h, bricks, used),
+                   "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
+                   "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
+                   "textures": iface.textures, "call_args": call_args, "shade": shade, "iface": iface, "spell": spell}
+            out.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
+                               f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{d}"))
+    return out

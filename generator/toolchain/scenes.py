@@ -28,7 +28,7 @@ CHUNK = 64  # permutations composed per compile batch when pipelining
 
 
 def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, stats=None, extra=(), workers=None,
-                  executor=None, on_done=None
+                  executor=None, on_done=None, dialects=()
                   ) -> tuple[dict[str, Composed], dict[str, list[str]], dict[str, CompileResult]]:
     """Compose and compile every permutation: (composed by hash, compose errors by hash, results by job key).
 
@@ -40,6 +40,7 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
     on_done is called here, in chunk order, for every compiled chunk (as soon as it is, between composing
     later ones), so that writing and analysing overlap the compilers too. Shaders identical across chunks
     are compiled once (an in-memory record beside the store).
+    dialects: platform dialects composed beside the languages (Composed.dialects; not compiled here).
     """
     from collections import deque
     from concurrent.futures import ThreadPoolExecutor
@@ -68,7 +69,7 @@ def compile_scene(scene: Scene, lib: Library, languages=LANGUAGES, store=None, s
             hashes = []
             for h, perm in chunk:
                 try:
-                    c = compose_permutation(perm, lib, languages)
+                    c = compose_permutation(perm, lib, languages, dialects)
                 except SourceError as e:
                     errors[h] = [str(e)]
                     continue

@@ -8,12 +8,17 @@ from pathlib import Path
 
 from ...lang.errors import UsageError, UserError
 
-HELP = "build a scene's shader matrix: sources + SPIR-V per language and manifest.json"
+HELP = "build a scene's shader matrix per platform (vulkan, d3d12, gl, webgpu) and manifest.json"
 
 
 def add_arguments(p) -> None:
     p.add_argument("scene", help="scene file (TOML, or glTF 2.0 .gltf/.glb)")
     p.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--platform", metavar="LIST",
+                   help="comma-separated, from vulkan, d3d12, gl, webgpu (default all): one tree OUT/<platform>/ "
+                        "each; vulkan: SPIR-V (and the GLSL/HLSL/WGSL it was made from), d3d12: HLSL for SM 6 (and "
+                        "DXIL with a dxc on PATH), gl: GLSL 4.50 core and ES 3.10, webgpu: WGSL. Every language is "
+                        "compiled to SPIR-V and validated whichever are chosen")
     p.add_argument("--bricks", action="append", metavar="DIR",
                    help="an extra brick directory (repeatable)")
     p.add_argument("--cache-dir", metavar="DIR",
@@ -31,8 +36,9 @@ def add_arguments(p) -> None:
                    help="keep the outputs of permutations that left the scene, listed under the manifest's "
                         "\"removed\" (default: they are deleted)")
     p.add_argument("--pack", action="store_true",
-                   help="also write one shader pack per language, DIR/packs/<language>.<key16>.smpack (an index and "
-                        "the optimized SPIR-V; format: generator/build/pack.py), listed under the manifest's \"packs\"")
+                   help="also write one shader pack per platform, DIR/packs/<platform>.<key16>.smpack (an index and "
+                        "the platform's artifacts; format: generator/build/pack.py), listed under the manifest's "
+                        "\"packs\"")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
     p.add_argument("--json", action="store_true",
@@ -75,6 +81,11 @@ def run(args) -> int:
         raise UsageError(f"-j {args.jobs}: give at least one job")
     if args.executor and not args.executor.startswith("dask://"):
         raise UsageError(f"--executor {args.executor}: write dask://HOST:PORT")
+    from ...build.platforms import PLATFORMS, parse_platforms
+    try:
+        platforms = parse_platforms(args.platform) if args.platform is not None else list(PLATFORMS)
+    except ValueError as e:
+        raise UsageError(f"--platform: {e}") from None
     try:
         lib = load_library(args.bricks or ())
         scene = load_scene(args.scene, lib)
@@ -96,7 +107,7 @@ def run(args) -> int:
         executor = DaskExecutor(args.executor)
     try:
         res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile, workers=args.jobs,
-                          executor=executor, keep_removed=args.keep_removed, pack=args.pack)
+                          executor=executor, keep_removed=args.keep_removed, pack=args.pack, platforms=platforms)
     finally:
         if executor is not None:
             executor.close()
@@ -117,9 +128,10 @@ def run(args) -> int:
     stale = sum(1 for p in perms if p["status"] == "stale")
     if not args.quiet:
         print(f"{scene.name}: {len(scene.objects)} objects, {len(scene.materials)} materials, "
-              f"{len(scene.lights)} lights → {len(perms)} permutations × {len(res.manifest['languages'])} languages")
+              f"{len(scene.lights)} lights → {len(perms)} permutations × {len(res.manifest['languages'])} languages"
+              f" → {', '.join(res.manifest.get('platforms', []))}")
         for p in perms:
-            print(f"  {p['status']:<6} {p['hash']}  {p['id']}  [{', '.join(p['languages'])}]  ({', '.join(p['objects'])})")
+            print(f"  {p['status']:<6} {p['hash']}  {p['id']}  [{', '.join(p.get('platforms') or p['languages'])}]  ({', '.join(p['objects'])})")
     uber = res.manifest.get("ubershader") or {}
     if uber and not args.quiet:
         t = uber.get("tables", {})

@@ -1,0 +1,121 @@
+"""OpenGL GLSL: 4.50 core and ES 3.10, the `gl` platform's dialects of the GLSL target (issue 12, item 3).
+
+The same IR walk as Vulkan GLSL (glsl.py: this is a subclass, no text is rewritten), spelled for
+OpenGL's binding model (GLSL 4.50 spec §4.4.5 "Uniform and Shader Storage Block Layout Qualifiers",
+§4.4.6 "Opaque-Uniform Layout Qualifiers"; ESSL 3.10 §4.4.5-4.4.6):
+
+- **Combined samplers.** OpenGL has no separate `texture2D`/`sampler` objects (those are
+  GL_KHR_vulkan_glsl): a texture is one `sampler2D` (`samplerCube`, `sampler2DShadow` for a compare)
+  bound to a texture unit, passed to brick functions alone, sampled as `texture(t, uv)`.
+- **No descriptor sets.** `layout(binding = N)` only. Uniform blocks, texture units and shader
+  storage blocks are three separate binding namespaces; Vulkan's (set, binding) pairs are
+  flattened per namespace in (set, binding) order (:func:`gl_bindings`): Frame is always uniform
+  block 0, a permutation's first texture unit 0. The manifest's ``gl`` reflection is that map.
+- **No Vulkan-only features.** No `#extension GL_GOOGLE_cpp_style_line_directive` (no `#line` at
+  all: glslangValidator's messages are mapped back through the line map instead), no
+  `constant_id` specialization constants (GLSL for OpenGL has none without GL_ARB_gl_spirv).
+- **ES 3.10** (`EsslTarget`): `#version 310 es` and default precision qualifiers — `highp`, or
+  `mediump` for a permutation whose key says fp16 (ESSL's way of allowing half precision;
+  ESSL 3.10 §4.7.2: mediump has at least 16-bit float range and 10-bit mantissa).
+
+Desktop GL at fp16 is emitted at 32-bit floats: GL has no portable half arithmetic (the float16
+extension is the Vulkan path's).
+"""
+from __future__ import annotations
+
+from ..lang.types import Type
+from .glsl import GlslTarget
+
+
+def gl_bindings(blocks, textures) -> dict[str, dict[tuple[int, int], int]]:
+    """Vulkan (set, binding) -> OpenGL binding, per namespace: {"uniform": …, "storage": …, "texture": …}.
+
+    blocks: objects with .set, .binding, .kind ("uniform" | "storage"); textures: with .set, .binding.
+    Each namespace is numbered from 0 in (set, binding) order, so the map is a function of the
+    Interface alone and both stages of a program agree on it."""
+    out: dict[str, dict[tuple[int, int], int]] = {"uniform": {}, "storage": {}, "texture": {}}
+    for kind in ("uniform", "storage"):
+        for i, b in enumerate(sorted((b.set, b.binding) for b in blocks if b.kind == kind)):
+            out[kind][b] = i
+    for i, t in enumerate(sorted((t.set, t.binding) for t in textures)):
+        out["texture"][t] = i
+    return out
+
+
+class GlTarget(GlslTarget):
+    """GLSL 4.50 core for OpenGL; `bindings` is gl_bindings() of the program's Interface."""
+
+    name = "gl"
+    ext = "glsl"
+    version = "450 core"
+    line_directives = False  # `#line N "path"` needs a Vulkan-side glslang extension; the line map does it
+    TEXTURE = "sampler2D"
+    TEXTURE_CUBE = "samplerCube"
+    TEXTURE_SHADOW = "sampler2DShadow"
+    SAMPLER = ""  # combined: a texture carries its sampler
+    SAMPLER_COMPARE = ""
+    INTRINSICS = {
+        **GlslTarget.INTRINSICS,
+        "sample": "texture({0}, {1})",
+        "sample_level": "textureLod({0}, {1}, {2})",
+        "sample@cube": "texture({0}, {1})",
+        "sample_level@cube": "textureLod({0}, {1}, {2})",
+        # textureLod on sampler2DShadow exists in GLSL 4.50 and ESSL 3.00+: level 0, valid in non-uniform flow
+        "sample_compare": "textureLod({0}, vec3({1}, {2}), 0.0)",
+    }
+
+    def __init__(self, bindings: dict | None = None, precision: str = "fp32"):
+        self.bindings = bindings or {"uniform": {}, "storage": {}, "texture": {}}
+        self.key_precision = precision  # the permutation's; the arithmetic stays 32-bit (module docstring)
+
+    def header(self) -> str:
+        return ""
+
+    def version_line(self) -> str:
+        return f"#version {self.version}"
+
+    def precision_lines(self, stage: str) -> list[str]:
+        """Default precision statements a stage needs (none in desktop GLSL)."""
+        return []
+
+    def binding(self, kind: str, set: int, binding: int) -> int:
+        """The OpenGL binding of Vulkan (set, binding) in namespace `kind` ("uniform", "storage", "texture")."""
+        try:
+            return self.bindings[kind][(int(set), int(binding))]
+        except KeyError:
+            raise ValueError(f"no OpenGL {kind} binding for set {set}, binding {binding}: the Interface does "
+                             "not declare it (gl_bindings)") from None
+
+    def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
+        raise ValueError(f"specialization constant '{name}': GLSL for OpenGL has none (GL_ARB_gl_spirv only) — "
+                         "the ubershader is built for the Vulkan and WebGPU platforms")
+
+    def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
+        """sampler2D (samplerCube, sampler2DShadow) NAME on the texture unit of Vulkan (set, binding)."""
+        unit = self.binding("texture", set, binding)
+        return f"layout(binding = {unit}) uniform {self.image_type(dim, compare)} {self.ident(name)};"
+
+    def buffer_decl(self, name: str, elem: str, set: int, binding: int, kind: str, capacity: int) -> str:
+        if kind == "storage":
+            return (f"layout(binding = {self.binding('storage', set, binding)}, std430) readonly buffer "
+                    f"{self.block_name(name)} {{ {elem} data[]; }} {name};")
+        return (f"layout(binding = {self.binding('uniform', set, binding)}, std140) uniform "
+                f"{self.block_name(name)} {{ {elem} data[{capacity}]; }} {name};")
+
+
+class EsslTarget(GlTarget):
+    """GLSL ES 3.10 (OpenGL ES 3.1): GlTarget with ES's version line and default precisions."""
+
+    name = "essl"
+    ext = "essl"
+    version = "310 es"
+
+    def precision_lines(self, stage: str) -> list[str]:
+        """ESSL has no default float precision in fragment shaders (§4.7.4), and samplers default to lowp:
+        every type the shaders use gets one. fp16 keys ask for mediump (half where the GPU has it)."""
+        p = "mediump" if self.key_precision == "fp16" else "highp"
+        types = ["float", "int"] + (["sampler2D", "samplerCube", "sampler2DShadow"] if stage == "frag" else [])
+        return [f"precision {p if t == 'float' else 'highp'} {t};" for t in types]
+
+
+DIALECTS = {"gl": GlTarget, "essl": EsslTarget}  # the gl platform's sources, validated by glslangValidator
