@@ -221,17 +221,22 @@ def test_course_models_are_data_and_a_new_brick_adds_its_row(fixture_brick_rows)
     for model, tables in {"Blinn-Phong": {("shift-invariant", 0, "7"), ("shift-variant", 1, "15")},
                           "Cook-Torrance": {("shift-invariant", 0, "35"), ("shift-variant", 1, "40")},
                           "Banks": {("shift-invariant", 0, "12"), ("shift-variant", 1, "25")}}.items():
-        rows = [r for r in fixture_brick_rows if r.table == "model" and r.subject == model]
+        rows = [r for r in fixture_brick_rows if r.table == "model" and r.subject == model
+                and r.course.form == "direct"]
         assert {(r.course.table, r.course.texture, r.course.alu) for r in rows} == tables
         variant = [r for r in rows if r.course.table == "shift-variant"]
         assert all(r.cost.texture == 1 for r in variant)  # the albedo texture
     from generator.measure.plans import brick_rows, course_models, load_cost_library
     assert "Ashikhmin-Shirley" in {m.name for m in course_models()[0]}
-    # every direct-form model has its brick now (issue 11); the factored forms have none: no row
+    # every model has its bricks now (issue 11: the direct forms; issue 13: the factored ones)
     for model in ("Ashikhmin-Shirley", "Lafortune"):
         rows = [r for r in fixture_brick_rows if r.table == "model" and r.subject == model]
         assert {r.course.table for r in rows} == {"shift-invariant", "shift-variant"} and not any(r.error for r in rows)
-    assert not any(r.course.form == "factored" for r in fixture_brick_rows if r.course)
+    factored = {(r.subject, r.course.table): r for r in fixture_brick_rows if r.course and r.course.form == "factored"}
+    assert {m for m, _ in factored} == {"Blinn-Phong", "Banks", "Ashikhmin-Shirley"}
+    # the course's texture counts hold for the invariant forms: the tables each reads
+    assert [factored[(m, "shift-invariant")].cost.texture for m in ("Blinn-Phong", "Banks", "Ashikhmin-Shirley")] \
+        == [1, 1, 4]
 
 
 # ------------------------------------------------------------------ CLI, scene, manifest
@@ -315,7 +320,9 @@ def test_bricks_table_markdown_shows_course_figures():
     assert r.returncode == 0, r.stderr
     assert re.search(r"\| Blinn-Phong \| direct \| shift-invariant \| `lambert\+blinn_phong_normalized` \| 0 \| 7 \|",
                      r.stdout)
-    assert "| Banks | factored | shift-invariant |  | 1 | 5 | no brick yet |" in r.stdout
+    m = re.search(r"\| Banks \| factored \| shift-invariant \| `lambert\+banks_factored` \| 1 \| 5 \| 1 \|.*\| "
+                  r"([0-9.e+-]+) \|\n", r.stdout)  # measured, with its error against the direct Banks
+    assert m and 0 < float(m.group(1)) < 0.06, r.stdout
     assert "| Lafortune | direct | shift-invariant | `lambert+lafortune` | 0 | 10 + 5n |" in r.stdout
     assert "standin" not in r.stdout.split("## The course's models")[0].split("## Per brick")[1]
 

@@ -160,7 +160,7 @@ LEGEND = [
 
 
 def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = None, gpu=None,
-             course: bool = False, languages: bool = False) -> str:
+             course: bool = False, languages: bool = False, model_errors: dict | None = None) -> str:
     """The report as Markdown (per-permutation rows, or per-brick rows); gpu: the
     measure.gpu.GpuRequest that added RADV's figures, or None.
 
@@ -213,9 +213,15 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
                 match = [v for k, v in model_rows if k[1] == m.name and
                          next(iter(v.values())).course == fig]
                 ours = _metric_cells(match[0]) if match else ["no brick yet"] + [""] * (len(MD_COLUMNS) - 1)
+                err = (model_errors or {}).get(m.name, {}).get(m.form)
                 lines.append([m.name, m.form, fig.table, f"`{m.spec}`" if m.spec and match else "",
-                              str(fig.texture), fig.alu, *ours])
-        out += _md_table(["model", "form", "table", "measured", "course tex", "course ALU", *head], lines) + [""]
+                              str(fig.texture), fig.alu, *ours, f"{err:.1e}" if err is not None else ""])
+        out += _md_table(["model", "form", "table", "measured", "course tex", "course ALU", *head,
+                          "error vs direct"], lines) + [""]
+        if model_errors:
+            out += ["Error vs direct: the factored form's float32 hemisphere max relative error against the direct "
+                    "model's float64 reference (NumPy, `shadermatrix accuracy`'s hemisphere), the error its tables add.",
+                    ""]
     out += radv.markdown(rows, groups, gpu)
     diffs = differences(rows) if languages else []
     if diffs:
@@ -317,7 +323,8 @@ def to_csv(rows: list[Row]) -> str:
     return buf.getvalue()
 
 
-def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = None, gpu=None) -> str:
+def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = None, gpu=None,
+            model_errors: dict | None = None) -> str:
     """Rows (with opcode histograms and RADV's figures), the language differences and their explanations."""
     from . import gpu as radv
     out_rows = []
@@ -340,6 +347,7 @@ def to_json(rows: list[Row], subject: str, models: list[CourseModel] | None = No
                       "estimate_check": radv.estimate_check(rows, families)}
     if models is not None:
         doc["course"] = [{"model": m.name, "form": m.form, "spec": m.spec or None, "requires": list(m.requires),
-                          "tables": {f.table: {"texture": f.texture, "alu": f.alu} for f in (m.invariant, m.variant)}}
+                          "tables": {f.table: {"texture": f.texture, "alu": f.alu} for f in (m.invariant, m.variant)},
+                          "error_vs_direct": (model_errors or {}).get(m.name, {}).get(m.form)}
                          for m in models]
     return json.dumps(doc, indent=2, allow_nan=False) + "\n"

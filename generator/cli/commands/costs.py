@@ -89,6 +89,19 @@ def over_budget(rows, budget: dict[str, int]) -> list[str]:
     return lines
 
 
+def factored_errors(models, lib) -> dict:
+    """{model: {"factored": error}}: each factored form's float32 hemisphere max relative error against the
+    direct model's reference (its bricks' references are the direct ones), in NumPy — what its tables add."""
+    from ...eval import accuracy
+    out: dict = {}
+    for m in models:
+        if m.form != "factored" or not m.spec or not set(m.requires) <= {b.id for b in lib.bricks.values()}:
+            continue
+        v = accuracy.run([m.spec], ["numpy"], ["float32"], lib)["verdicts"][0]  # accuracy's default hemisphere
+        out.setdefault(m.name, {})["factored"] = v["hemisphere_max_rel"]
+    return out
+
+
 def run(args) -> int:
     budget = parse_budget(args.budget) if args.budget else None
     old_rows = read_report(args.diff) if args.diff else None
@@ -116,10 +129,12 @@ def run(args) -> int:
         gpu = GpuRequest(families, args.gpu_ir)
     elif args.gpu_ir:
         raise UsageError("--gpu-ir needs --gpu — e.g. `--gpu navi21 --gpu-ir out/isa`")
-    models = None
+    models, model_errors = None, None
     if args.per_brick:
-        rows = brick_rows(load_cost_library(args.bricks), gpu=gpu, store=store)
+        lib = load_cost_library(args.bricks)
+        rows = brick_rows(lib, gpu=gpu, store=store)
         subject, title, models = "bricks", "Costs per brick", course_models()[0]
+        model_errors = factored_errors(models, lib)
     else:
         from ...library.bricks import load_library
         from ...matrix.scene import load_scene
@@ -133,11 +148,12 @@ def run(args) -> int:
     if args.diff:
         sys.stdout.write(diff(rows, old_rows, BUDGET_NAMES, args.diff))
     elif args.format == "md":
-        sys.stdout.write(markdown(rows, title, models, gpu, course=args.course, languages=args.explain_languages))
+        sys.stdout.write(markdown(rows, title, models, gpu, course=args.course, languages=args.explain_languages,
+                                  model_errors=model_errors))
     elif args.format == "csv":
         sys.stdout.write(to_csv(rows))
     else:
-        sys.stdout.write(to_json(rows, subject, models, gpu))
+        sys.stdout.write(to_json(rows, subject, models, gpu, model_errors=model_errors))
     for why in sorted((gpu.errors or {}).values()) if gpu is not None else ():
         print(f"error: {why}", file=sys.stderr)
     failed = sorted({f"{r.subject} ({r.language}): {r.error}" for r in rows if r.error})
