@@ -11,8 +11,10 @@ the error on the y-axis is the approximation's and never a choice between
 models (an implicit or Kelemen geometry term is another model, not an
 approximation of Smith's; it appears in the second part only):
 
-- Fresnel: Schlick (Schlick 1994 eq. 15) and the spherical Gaussian
-  (Gotanda 2014 eq. 3) against the exact dielectric Fresnel written with f0
+- Fresnel: Schlick (Schlick 1994 eq. 15), the spherical Gaussian
+  (Gotanda 2014 eq. 3) and the `fresnel_ramp` table (Hoffman & Baker 2006,
+  "Fresnel Ramps": the exact dielectric R_F baked over (1 − cos α_h, √f0),
+  three bilinear taps) against the exact dielectric Fresnel written with f0
   (Gotanda eq. 2), inside microfacet(ndf=ggx, vis=smith_ggx_height_correlated);
 - Smith for GGX: Smith-Schlick with k = α/2 (Karis) and with k = α·sqrt(2/π)
   (Schlick's Beckmann match) against the exact separable Smith G of GGX
@@ -20,29 +22,51 @@ approximation of Smith's; it appears in the second part only):
 - Smith for Beckmann: Smith-Schlick (k = α·sqrt(2/π)) and the `smith_beckmann`
   brick against the exact Beckmann Λ with erfc (Walter et al. 2007 eq. 27),
   inside microfacet(ndf=beckmann, fresnel=schlick);
-- diffuse: Lambert, the Oren-Nayar family and Gotanda's fit (eq. 8) against the
-  microfacet diffuse model Gotanda integrates (his eq. 4 and footnote 3: GGX D,
-  Schlick-type F_diff, height-correlated Smith G on Lambertian facets),
-  computed by quadrature (generator/reference/diffuse.py), at σ = α = 0.5 (Gotanda's fit reads α),
-  f0 = 0.04, ρ_d = 1.
+- diffuse: Lambert, the Oren-Nayar family (with its factored form) and
+  Gotanda's fit (eq. 8) against the microfacet diffuse model Gotanda integrates
+  (his eq. 4 and footnote 3: GGX D, Schlick-type F_diff, height-correlated Smith G
+  on Lambertian facets), computed by quadrature (generator/reference/diffuse.py),
+  at σ = α = 0.5 (Gotanda's fit reads α), f0 = 0.04, ρ_d = 1;
+- factored against direct (Hoffman & Baker 2006, "BRDF Costs": each model
+  direct and factored into lookup tables the generator bakes from the float64
+  reference): one study per pair, since each pair has its own exact model —
+  blinn_phong_factored against blinn_phong_normalized, banks_factored against
+  banks, ashikhmin_shirley_factored against ashikhmin_shirley,
+  ashikhmin_shirley_diffuse_factored against ashikhmin_shirley_diffuse,
+  oren_nayar_factored against oren_nayar, each at the direct brick's default
+  parameters (the factored brick's are the same); the direct brick's kernel is
+  the exact kernel, so time is × direct;
+- measured: `homomorphic_factorization` (McCool et al. 2001: three cube-map
+  taps p(ω_i) q(ω_h) p(ω_o), fitted by the generator in log space) against the
+  BRDF it factors, direct `ashikhmin_shirley` at the fit's parameters
+  (generator/reference/specular.py HOMOMORPHIC_TARGET), beside
+  ashikhmin_shirley_factored at the same parameters.
+
+The hand-painted bricks (ndf_map, ndf_map_anisotropic, ndf_fresnel_map) have no
+analytic model to approximate (the painting is their reference): they are in the
+second part only.
 
 Time: device time of one dispatch over `--samples` samples (timestamp queries),
 each dispatch of a kernel paired with one of the study's exact kernel (order
 alternating; for the diffuse study, with Lambert: its exact model has no
 kernel), and the ratio is the median of the pairs' ratios, so drift of the
-machine cancels; the error bar is the pairs' interquartile range. Error: the
+machine cancels; the error bar is the pairs' interquartile range. A kernel that
+samples baked tables gets them as eval does (eval.evaluate.resolve_textures),
+uploaded and bound once by `load`, before the warm-up: the timed dispatches
+sample them and upload nothing. Error: the
 cosine-weighted relative RMS sqrt(Σ cosθ_l (f − f*)²) / sqrt(Σ cosθ_l f*²) of the
 first language's kernel on lavapipe against the exact model in float64, over a
 jittered stratified k⁴ grid of (L, V) (at the kernel's float32 inputs); `model`
 is the same for the float64 emission of the kernel (the approximation alone,
-without float32 arithmetic). Pareto front: a kernel is dominated when another
-is more accurate and not slower beyond the noise (their interquartile ranges
-overlap or it is faster); the front is drawn only when two or more kernels are
-on it, that is, when speed really buys error.
+without float32 arithmetic; a table's texels are the same in both). Pareto front:
+a kernel is dominated when another is more accurate and not slower beyond the
+noise (their interquartile ranges overlap or it is faster); the front is drawn
+only when two or more kernels are on it, that is, when speed really buys error.
 
 **Every brick** (the table): each spec of `shadermatrix accuracy`'s default set,
 timed paired with Lambert, with its float32 error against its own float64
-reference (the arithmetic alone).
+reference (the arithmetic alone; for a brick that samples baked tables, its
+reference is the model the tables are baked from, so the error is the table's).
 
 Writes runtime_vs_error.json, .md and .png under --out. A progress bar is shown on a terminal only.
 """
@@ -84,10 +108,16 @@ class Study:
     exact_label: str = ""
     params: dict = field(default_factory=dict)
     exact_fn: object = None  # (L, V, N) -> (n, 3) float64, for models without a brick
+    direct: bool = False  # the exact kernel is the direct form of factored kernels: time is "× direct"
 
     @property
     def baseline(self) -> str:
         return self.exact or LAMBERT
+
+    @property
+    def unit(self) -> str:
+        """What the time ratio is relative to."""
+        return "Lambert" if not self.exact else "direct" if self.direct else "exact"
 
 
 def _microfacet(ndf: str, fresnel: str, vis: str) -> str:
@@ -105,12 +135,39 @@ def _diffuse_exact(L, V, N, params: dict) -> np.ndarray:
     return f[:, None] * np.asarray(params["rho_d"], np.float64)[None, :]
 
 
+def _tables(spec: str, lib) -> str:
+    """The baked tables a spec samples, as "W×H format" (cube maps "W×H cube format"; the same table
+    declared twice counted "2 × ..."), for its label; "" for a spec that samples none."""
+    from collections import Counter
+
+    from generator.eval.evaluate import program
+    seen = Counter()
+    for _n, ty, d in program(spec, lib).textures:
+        w, h = (list(d.get("size", [])) + [1, 1])[:2]
+        seen[f"{w}×{h}{' cube' if ty.name == 'texturecube' else ''} {d.get('format', '?')}"] += 1
+    return ", ".join(t if c == 1 else f"{c} × {t}" for t, c in seen.items())
+
+
+def _factored(name: str, title: str, factored: str, direct: str, params: dict) -> Study:
+    """A factored brick against its direct form (its reference), both at `params`."""
+    return Study(name, f"{title}: factored against direct", {factored: factored},
+                 exact=direct, exact_label=f"{direct} (direct, ALU only)", params=params, direct=True)
+
+
+def _homomorphic_params() -> dict:
+    """The parameters of the BRDF homomorphic_factorization's cube maps are fitted to, as plain lists."""
+    from generator.reference.specular import HOMOMORPHIC_TARGET
+    return {k: (np.asarray(v).tolist() if np.ndim(v) else float(v)) for k, v in HOMOMORPHIC_TARGET.items()}
+
+
 def studies(lib) -> tuple[list[Study], list[str]]:
     """The studies whose bricks the library holds, and a note per study left out (a brick missing)."""
+    notes: list[str] = []
     s = [
         Study("fresnel", "Fresnel, in microfacet(ndf=ggx, vis=smith_ggx_height_correlated)",
               {"schlick": _microfacet("ggx", "schlick", "smith_ggx_height_correlated"),
-               "spherical_gaussian": _microfacet("ggx", "spherical_gaussian", "smith_ggx_height_correlated")},
+               "spherical_gaussian": _microfacet("ggx", "spherical_gaussian", "smith_ggx_height_correlated"),
+               "fresnel_ramp": _microfacet("ggx", "fresnel_ramp", "smith_ggx_height_correlated")},
               exact=_microfacet("ggx", "dielectric_exact", "smith_ggx_height_correlated"),
               exact_label="exact dielectric Fresnel (dielectric_exact)"),
         Study("smith_ggx", "Smith G for GGX, in microfacet(ndf=ggx, fresnel=schlick)",
@@ -125,13 +182,40 @@ def studies(lib) -> tuple[list[Study], list[str]]:
         Study("diffuse", f"Diffuse at σ = α = {DIFFUSE_SIGMA}, f0 = 0.04, ρ_d = 1",
               {"lambert": "lambert", "oren_nayar": "oren_nayar", "oren_nayar_simplified": "oren_nayar_simplified",
                "oren_nayar_improved": "oren_nayar_improved", "oren_nayar_fresnel": "oren_nayar_fresnel",
-               "gotanda_fitted": "gotanda_fitted"},
+               "gotanda_fitted": "gotanda_fitted", "oren_nayar_factored": "oren_nayar_factored"},
               exact_label="Gotanda's microfacet diffuse model (eq. 4, quadrature)",
               params={"sigma": DIFFUSE_SIGMA, "alpha": DIFFUSE_SIGMA, "f0": [0.04] * 3, "rho_d": [1.0] * 3},
               exact_fn=_diffuse_exact),
+        # Factored against direct (Hoffman & Baker 2006, "BRDF Costs"): one exact model per study, at the
+        # direct brick's default parameters, written out so the table states them.
+        _factored("factored_blinn_phong", "Blinn-Phong (normalized)", "blinn_phong_factored",
+                  "blinn_phong_normalized", {"n": 64.0, "f0": [0.04] * 3}),
+        _factored("factored_banks", "Banks", "banks_factored", "banks", {"n": 32.0, "k_s": [0.5] * 3}),
+        _factored("factored_ashikhmin_shirley", "Ashikhmin-Shirley specular", "ashikhmin_shirley_factored",
+                  "ashikhmin_shirley", {"n_u": 100.0, "n_v": 10.0, "f0": [0.04] * 3}),
+        _factored("factored_ashikhmin_shirley_diffuse", "Ashikhmin-Shirley diffuse",
+                  "ashikhmin_shirley_diffuse_factored", "ashikhmin_shirley_diffuse",
+                  {"rho_d": [0.5] * 3, "f0": [0.04] * 3}),
+        _factored("factored_oren_nayar", "Oren-Nayar", "oren_nayar_factored", "oren_nayar",
+                  {"rho_d": [0.5] * 3, "sigma": 0.3}),
     ]
+    try:
+        measured = _homomorphic_params()
+    except ImportError:  # a checkout before the homomorphic factorization
+        measured = None
+    if measured is not None:
+        # Measured: the cube-map factorization against the BRDF it was fitted to, beside the analytic
+        # factored form of the same model at the same parameters (one exact model for both).
+        s.append(Study("measured", "Measured: homomorphic factorization of Ashikhmin-Shirley",
+                       {"homomorphic_factorization": "homomorphic_factorization",
+                        "ashikhmin_shirley_factored": "ashikhmin_shirley_factored"},
+                       exact="ashikhmin_shirley",
+                       exact_label="ashikhmin_shirley (direct) at the factorization's parameters",
+                       params=measured, direct=True))
+    else:
+        notes.append("measured: left out, no HOMOMORPHIC_TARGET in generator/reference/specular.py")
     from generator.matrix.permutation import SpecError, parse_brdf
-    have, notes = [], []
+    have = []
     for st in s:
         specs = list(st.kernels.values()) + ([st.exact] if st.exact else [])
         missing = []
@@ -142,8 +226,11 @@ def studies(lib) -> tuple[list[Study], list[str]]:
                 missing.append(spec)
         if missing:
             notes.append(f"{st.name}: left out, no brick for {', '.join(missing)}")
-        else:
-            have.append(st)
+            continue
+        # a kernel that samples baked tables says which (texture against ALU is what the study is about)
+        st.kernels = {(f"{label} ({t})" if (t := _tables(spec, lib)) else label): spec
+                      for label, spec in st.kernels.items()}
+        have.append(st)
     return have, notes
 
 
@@ -208,10 +295,16 @@ class Timer:
         self.vecs = timing_samples(samples, seed=2)
 
     def kernel(self, spec: str, lang: str, params: dict):
-        from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
+        """The loaded kernel: samples, parameters and the baked tables it samples (as eval binds them:
+        uploaded and bound here, once, so the timed dispatches only sample them)."""
+        from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params, resolve_textures
+        from generator.runtime.eval_kernel import Texture
         ep = program(spec, self.lib)
         k = gpu_kernel(spec, lang, self.lib, self.device)
-        k.load(self.vecs, _param_block(ep, resolve_params(ep, own_params(spec, params, self.lib))))
+        textures = [Texture(np.asarray(x), bool(d.get("srgb")))
+                    for x, (_n, _t, d) in zip(resolve_textures(ep, None), ep.textures)]
+        k.load(self.vecs, _param_block(ep, resolve_params(ep, own_params(spec, params, self.lib))),
+               textures=textures or None)
         return k
 
     def ratio(self, spec: str, baseline: str, lang: str, params: dict) -> dict:
@@ -288,7 +381,8 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
     for st in found:
         rows = []
         exact = st.exact if st.exact_fn is None else _once(lambda L, V, N, st=st: st.exact_fn(L, V, N, st.params))
-        members = list(st.kernels.items()) + ([("exact model's kernel", st.exact)] if st.exact else [])
+        own = f"{st.exact} (direct)" if st.direct else "exact model's kernel"
+        members = list(st.kernels.items()) + ([(own, st.exact)] if st.exact else [])
         for label, spec in members:
             row = {"label": label, "spec": spec, "exact_kernel": spec == st.exact, "time": {}}
             for lang in langs:
@@ -301,7 +395,7 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
         for r, on in zip(rows, front(pts)):
             r["front"] = on
         out_studies.append({"name": st.name, "title": st.title, "exact": st.exact_label, "baseline": st.baseline,
-                            "params": st.params, "rows": rows})
+                            "unit": st.unit, "params": st.params, "rows": rows})
     bricks = []
     for spec in every:
         row = {"spec": spec, "time": {}}
@@ -317,6 +411,11 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
 
 # ------------------------------------------------------------------ reporting
 
+def _unit(st: dict) -> str:
+    """What a study's time ratios are relative to (results recorded before "unit" existed: exact or Lambert)."""
+    return st.get("unit") or ("exact" if st["baseline"] != LAMBERT else "Lambert")
+
+
 def markdown(report: dict) -> str:
     langs = report["langs"]
     env = report["environment"]
@@ -325,7 +424,8 @@ def markdown(report: dict) -> str:
         f"Generated by `benchmarks/runtime_vs_error.py` on {env['device']} ({env['cpus']} CPUs, "
         f"LP_NUM_THREADS={env['lp_num_threads']}); {report['samples']:,} samples per dispatch, "
         f"{report['repeats']} paired dispatches per kernel and language (timestamp queries). Time: the median ratio "
-        "of paired dispatches with the study's exact kernel (× exact; diffuse: × Lambert), in brackets the "
+        "of paired dispatches with the study's exact kernel (× exact; factored and measured forms: × their "
+        "direct form's kernel, the exact model; diffuse: × Lambert), in brackets the "
         "pairs' interquartile range — two kernels whose ranges overlap are equally fast as far as this machine "
         f"can tell. Error: cosine-weighted relative RMS against the exact model in float64 over "
         f"{report['error_samples']:,} stratified hemisphere pairs, of the {langs[0].upper()} kernel on lavapipe "
@@ -333,7 +433,7 @@ def markdown(report: dict) -> str:
         f"{REL_FLOOR:g} sr⁻¹. Front ●: no other kernel is more accurate without being slower beyond the noise. "
         f"Load average (1 min) at start / end: {env['load_average'][0]:.2f} / {env['load_average'][1]:.2f}.", ""]
     for st in report["studies"]:
-        unit = "× exact" if st["baseline"] != LAMBERT else "× Lambert"
+        unit = f"× {_unit(st)}"
         lines += [f"## {st['title']}", "", f"Exact model: {st['exact']}."
                   + (f" Parameters: {', '.join(f'{k} = {v}' for k, v in st['params'].items())}." if st["params"]
                      else " Parameters: the bricks' defaults."), "",
@@ -352,7 +452,9 @@ def markdown(report: dict) -> str:
     lines += ["## Every brick: time × Lambert and float32 error against its own reference", "",
               "Each spec of `shadermatrix accuracy`'s default set at its bricks' defaults; the error is float32 "
               "arithmetic alone (the model is its own reference), so it measures the brick's implementation, not "
-              "its choice of model.", "",
+              "its choice of model — except for bricks that sample baked tables, whose reference is the model the "
+              "tables are baked from (a factored form's direct model, the fitted BRDF of the homomorphic "
+              "factorization, the continuous painting of a painted map): their error includes the tables'.", "",
               "| spec | " + " | ".join(f"{l.upper()} × Lambert" for l in langs) + " | rel RMS (GPU) | max rel (GPU) |",
               "|---|" + "---:|" * (len(langs) + 2)]
     for r in report["bricks"]:
@@ -366,6 +468,57 @@ def markdown(report: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _label_points(ax, fig, rs, x, y, lo, hi, avoid=()) -> None:
+    """Name the points of one panel, after its limits and the figure's layout are final.
+
+    Points that coincide on the plot (equal to 2 % in time and error) share one label; a label takes
+    the first offset around its point whose box lies inside the panel and overlaps no label placed
+    before it and no marker, error bar or `avoid` artist (a note) (offsets rotate with the label's rank down the error axis, so
+    close points stay legible); failing all, the least bad one. A thin leader joins each label to its
+    point."""
+    from matplotlib.transforms import Bbox
+
+    groups: list[list[int]] = []
+    for i in np.argsort(y):
+        near = next((g for g in groups if abs(x[g[0]] - x[i]) < 0.02 * max(x[g[0]], 1e-9)
+                     and abs(np.log10(y[g[0]] / y[i])) < 0.01), None)
+        (near.append(i) if near is not None else groups.append([i]))
+    renderer = fig.canvas.get_renderer()
+    inside = ax.get_window_extent(renderer)
+    to_px = ax.transData.transform
+    marks = []  # markers (6 pt: ± 5 px at 110 dpi) and error bars (caps ± 3 pt) in pixels
+    for i in range(len(x)):
+        (px, py), = to_px([(x[i], y[i])])
+        (bx0, _), (bx1, _) = to_px([(x[i] - lo[i], y[i]), (x[i] + hi[i], y[i])])
+        marks += [Bbox([[px - 5, py - 5], [px + 5, py + 5]]), Bbox([[bx0, py - 5], [bx1, py + 5]])]
+    marks += [a.get_window_extent(renderer) for a in avoid]
+    placed = []  # the boxes of the labels so far
+    offsets = [(8, 4, "left"), (-8, -10, "right"), (8, -12, "left"), (-8, 6, "right"), (8, 14, "left"),
+               (-8, -20, "right"), (8, -22, "left"), (-8, 16, "right"), (0, 10, "center"), (0, -16, "center"),
+               (8, 24, "left"), (-8, -30, "right"), (8, -32, "left"), (-8, 26, "right")]
+    for rank, g in enumerate(groups):
+        text = " = ".join(rs[i]["label"] for i in g)
+        best = None  # (badness, offset, box): 0 fits, 1 covers a marker, bar or note, 2 a label, 3 leaves the panel
+        for k in range(len(offsets)):
+            dx, dy, ha = offsets[(rank + k) % len(offsets)]
+            a = ax.annotate(text, (x[g[0]], y[g[0]]), textcoords="offset points", xytext=(dx, dy), ha=ha,
+                            fontsize=7)
+            box = a.get_window_extent(renderer)
+            a.remove()
+            out = not (inside.x0 <= box.x0 and box.x1 <= inside.x1 and inside.y0 <= box.y0 and box.y1 <= inside.y1)
+            bad = (3 if out else 2 if any(box.overlaps(b) for b in placed)
+                   else 1 if any(box.overlaps(m) for m in marks) else 0)
+            if best is None or bad < best[0]:
+                best = (bad, (dx, dy, ha), box)
+            if bad == 0:
+                break
+        dx, dy, ha = best[1]
+        # a thin leader from the label to its point: close points never leave a label's owner in doubt
+        ax.annotate(text, (x[g[0]], y[g[0]]), textcoords="offset points", xytext=(dx, dy), ha=ha, fontsize=7,
+                    arrowprops={"arrowstyle": "-", "lw": 0.5, "color": "0.45", "shrinkA": 0, "shrinkB": 3})
+        placed.append(best[2])
+
+
 def plot(report: dict, path: Path) -> None:
     """One panel per study: time ratio (error bar: the pairs' interquartile range) against error, log scale."""
     import matplotlib
@@ -374,9 +527,10 @@ def plot(report: dict, path: Path) -> None:
 
     lang = report["langs"][0]
     sts = report["studies"]
-    cols = min(2, len(sts))
+    cols = min(2 if len(sts) <= 4 else 3, len(sts))
     rows_n = math.ceil(len(sts) / cols)
     fig, axes = plt.subplots(rows_n, cols, figsize=(7.0 * cols, 5.0 * rows_n), dpi=110, squeeze=False)
+    panels = []
     for ax, st in zip(axes.flat, sts):
         rs = st["rows"]
         x = np.array([r["time"][lang]["ratio"] for r in rs])
@@ -390,47 +544,32 @@ def plot(report: dict, path: Path) -> None:
             if sel.any():
                 ax.errorbar(x[sel], y[sel], xerr=[lo[sel], hi[sel]], fmt="o", ms=6, color=color, capsize=3,
                             label=label, zorder=3)
+        notes = []
         if on.sum() >= 2:  # a front is drawn only where speed buys error beyond the noise
             order = np.argsort(x[on])
             ax.step(x[on][order], y[on][order], where="post", color="tab:red", lw=1.0, zorder=2)
         else:
-            ax.text(0.02, 0.02, "no front: the more accurate kernels are not slower beyond the noise",
-                    transform=ax.transAxes, fontsize=7, color="0.3")
-        # points that coincide on the plot (equal to 2 % in time and error) share one label; labels alternate
-        # sides down the error axis, so close points stay legible
-        groups: list[list[int]] = []
-        for i in np.argsort(y):
-            near = next((g for g in groups if abs(x[g[0]] - x[i]) < 0.02 * max(x[g[0]], 1e-9)
-                         and abs(np.log10(y[g[0]] / y[i])) < 0.01), None)
-            (near.append(i) if near is not None else groups.append([i]))
-        placed = []  # the labels' boxes so far: a label takes the first offset whose box overlaps none
-        renderer = fig.canvas.get_renderer()
-        offsets = [(8, 4, "left"), (-8, -10, "right"), (8, -12, "left"), (-8, 6, "right"), (8, 14, "left"),
-                   (-8, -20, "right"), (8, -22, "left"), (-8, 16, "right")]
-        for rank, g in enumerate(groups):
-            for k in range(len(offsets)):
-                dx, dy, ha = offsets[(rank + k) % len(offsets)]
-                a = ax.annotate(" = ".join(rs[i]["label"] for i in g), (x[g[0]], y[g[0]]), textcoords="offset points",
-                                xytext=(dx, dy), ha=ha, fontsize=7)
-                box = a.get_window_extent(renderer)
-                if not any(box.overlaps(b) for b in placed) or k == len(offsets) - 1:
-                    placed.append(box)
-                    break
-                a.remove()
-        unit = "exact kernel" if st["baseline"] != LAMBERT else "Lambert"
+            notes.append(ax.text(0.02, 0.02, "no front: the more accurate kernels are not slower beyond the noise",
+                                 transform=ax.transAxes, fontsize=7, color="0.3"))
+        unit = {"exact": "exact kernel", "direct": "direct kernel"}.get(_unit(st), _unit(st))
         ax.set_title(f"{st['title']}\nagainst: {st['exact']}", fontsize=9)
         ax.set_yscale("log")
+        # room for the labels: a third of the time span each side, a factor 4 in error below and above
         span = max(np.max(x + hi) - np.min(x - lo), 0.1)
         ax.set_xlim(np.min(x - lo) - 0.35 * span, np.max(x + hi) + 0.35 * span)
+        ax.set_ylim(np.min(y) / 4.0, np.max(y) * 4.0)
         ax.grid(True, which="both", alpha=0.3)
         ax.set_xlabel(f"time × {unit} ({lang.upper()} on lavapipe; bar: interquartile range of the pairs)", fontsize=8)
         ax.set_ylabel("error vs exact model (cos-weighted rel. RMS)", fontsize=8)
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3, fontsize=7, frameon=False)
+        panels.append((ax, rs, x, y, lo, hi, notes))
     for ax in list(axes.flat)[len(sts):]:
         ax.set_axis_off()
     fig.suptitle(f"Run time against error: approximations against the model they approximate "
                  f"({report['samples']:,} samples per dispatch)", fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 0.98))  # the suptitle keeps its strip
+    for ax, rs, x, y, lo, hi, notes in panels:  # labels last: their boxes are measured in the final layout
+        _label_points(ax, fig, rs, x, y, lo, hi, notes)
     tmp = path.with_suffix(".tmp.png")
     fig.savefig(tmp)
     plt.close(fig)
