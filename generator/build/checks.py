@@ -1,74 +1,151 @@
 """Per-permutation compile checks an engine's CI runs: `shadermatrix check` and the pytest plugin share them.
 
-A check is one permutation of a scene in one language: composed, compiled to
-SPIR-V, validated (spirv-val) and optimized, through the compile cache. A
-failure reads as the brick line that caused it (the compilers' diagnostics are
-mapped back through #line). Golden sources: `<golden>/<language>/<hash>.<stage>.<language>`,
-the emitted source of each permutation (named by permutation, not by content,
-so a drift is a diff of one file).
+A check is one permutation of a scene on one platform (issue 12, items 3 and 5), validated by the
+tools that validate what `build --platform` ships for it (build/platforms.py):
+
+    platform  what a check compiles and validates                       golden sources
+    vulkan    GLSL, HLSL and WGSL to SPIR-V (glslc, glslang, naga),      vulkan/<hash>.<stage>.{glsl,hlsl,wgsl}
+              spirv-val, spirv-opt — every language, one check
+    d3d12     HLSL (Shader Model 6, `register(xN, spaceM)`) by glslang's d3d12/<hash>.<stage>.hlsl
+              HLSL front end, spirv-val; DXIL by dxc when it is on PATH
+    gl        GLSL 4.50 core and GLSL ES 3.10 by glslangValidator in      gl/<hash>.<stage>.glsl, and .essl where
+              OpenGL mode; an ES failure is a note ("unsupported", as     ES validates
+              `build` records it), a core failure fails the check
+    webgpu    WGSL by naga, then spirv-val                               webgpu/<hash>.<stage>.wgsl
+
+All checks asked for at once are composed once per permutation and compiled in one batch (identical
+shaders once, through the compile cache); a failure reads as the brick line that caused it (the
+compilers' diagnostics are mapped back through #line, or the GL sources' line map). Golden sources are
+named by permutation, not by content, so a drift is a diff of one file. `languages` narrows what is
+checked as `build_scene(languages=...)` narrows what is built: a platform is checked when the language it
+is made from (platforms.PLATFORM_LANGUAGE) is one of them, and vulkan compiles only those languages.
 """
 from __future__ import annotations
 
 import difflib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..library.bricks import Library
 from ..matrix.scene import Scene
 from ..targets import LANGUAGES
+from .platforms import DIALECTS, EXT, PLATFORMS
+
+# the languages each platform's check is made from; gl's (GLSL) is composed as its GL dialects and validated
+# as such, the others' are compiled to SPIR-V and validated
+MADE_FROM = {"vulkan": LANGUAGES, "d3d12": ("hlsl",), "gl": ("glsl",), "webgpu": ("wgsl",)}
+SOURCE_EXT = {**EXT, "glsl": "glsl"}  # a golden source's extension, by language or GL dialect
 
 
 @dataclass(frozen=True)
 class Check:
-    """One permutation × language of a scene."""
+    """One permutation × platform of a scene; `languages`: those compiled to SPIR-V for it."""
 
     hash: str
-    language: str
+    platform: str
     objects: tuple[str, ...]
+    languages: tuple[str, ...] = ()
 
     @property
     def id(self) -> str:
-        return f"{self.hash}-{self.language}"
+        return f"{self.hash}-{self.platform}"
+
+    @property
+    def dialects(self) -> tuple[str, ...]:
+        return DIALECTS.get(self.platform, ())
 
 
-def checks(scene: Scene, languages=LANGUAGES) -> list[Check]:
-    return [Check(h, lang, tuple(scene.users.get(h, ()))) for h in sorted(scene.permutations) for lang in languages]
+@dataclass
+class Outcome:
+    """What one check found: errors (none when it passes), its emitted sources by golden-relative path, and
+    notes that do not fail it (GLSL ES unsupported by the permutation's bricks)."""
+
+    errors: list[str]
+    sources: dict[str, str] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
 
 
-def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> list[tuple[list[str], dict[str, str]]]:
-    """Per check, (errors, {golden-relative path: emitted source}); no errors when it compiles and validates.
+def checks(scene: Scene, platforms=PLATFORMS, languages=LANGUAGES) -> list[Check]:
+    """The checks of a scene, permutation by permutation, platforms in PLATFORMS order."""
+    plats = checked_platforms(platforms, languages)
+    return [Check(h, p, tuple(scene.users.get(h, ())),
+                  () if p in DIALECTS else tuple(x for x in MADE_FROM[p] if x in languages))
+            for h in sorted(scene.permutations) for p in plats]
 
-    Every check's shaders are compiled in one batch (the tool processes run in parallel, identical shaders
-    once), as `build` does, then the results are split per check."""
+
+def checked_platforms(platforms=PLATFORMS, languages=LANGUAGES) -> list[str]:
+    """The platforms of `platforms` made from one of `languages` (vulkan from any), in PLATFORMS order."""
+    return [p for p in PLATFORMS if p in platforms and set(MADE_FROM[p]) & set(languages)]
+
+
+def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> list[Outcome]:
+    """An Outcome per check, in order. Every check's shaders are compiled in one batch (the tool processes
+    run in parallel, identical shaders once) and the GL dialects validated in one more, as `build` does."""
     from ..compose import compose_permutation
     from ..lang import SourceError
-    from ..toolchain import compile_many
-    from ..toolchain.scenes import source_jobs
+    from ..toolchain import CompileJob, compile_many
+    from ..toolchain.platforms import validate_dialects
+    from ..toolchain.scenes import job_key, source_jobs
 
-    composed: dict[Check, object] = {}
-    failed: dict[Check, list[str]] = {}
-    jobs = []
+    wanted: dict[str, tuple[set, set]] = {}  # hash -> (languages, dialects) its checks need
     for c in todo:
-        try:
-            composed[c] = compose_permutation(scene.permutations[c.hash], lib, (c.language,))
+        langs, dials = wanted.setdefault(c.hash, (set(), set()))
+        langs.update(c.languages)
+        dials.update(c.dialects)
+    composed, failed = {}, {}
+    for h, (langs, dials) in wanted.items():
+        try:  # in LANGUAGES order: the sources, their jobs and golden files do not depend on the checks' order
+            composed[h] = compose_permutation(scene.permutations[h], lib, [x for x in LANGUAGES if x in langs],
+                                              tuple(d for d in ("gl", "essl") if d in dials))
         except SourceError as e:
-            failed[c] = [str(e)]
-            continue
-        jobs += source_jobs(c.hash, composed[c].sources)
-    results = compile_many(jobs, optimize=True, validate=True, store=store) if jobs else {}
-    out = []
-    for c in todo:
-        if c in failed:
-            out.append((failed[c], {}))
-            continue
-        mine = [results[j.key] for j in source_jobs(c.hash, composed[c].sources)]
-        out.append(([line for r in mine if not r.ok for line in r.errors()],
-                    {f"{s.language}/{c.hash}.{s.stage}.{s.language}": s.text for s in composed[c].sources}))
-    return out
+            failed[h] = [str(e)]
+    jobs = {j.key: j for h, c in composed.items() for j in source_jobs(h, c.sources)}
+    dialect_jobs = [CompileJob(job_key(h, s.stage, s.language), s.language, s.stage, s.text,
+                               line_map=tuple(s.line_map)) for h, c in composed.items() for s in c.dialects]
+    results = compile_many(list(jobs.values()), optimize=True, validate=True, store=store) if jobs else {}
+    gl_errors = validate_dialects(dialect_jobs, store) if dialect_jobs else {}
+    from . import _dxil_step  # build's own DXC step (None without a dxc on PATH)
+    dxil = _dxil_step() if any(c.platform == "d3d12" and c.hash in composed for c in todo) else None
+    return [Outcome(list(failed[c.hash])) if c.hash in failed
+            else _outcome(c, composed[c.hash], results, gl_errors, dxil, scene.permutations[c.hash].precision)
+            for c in todo]
 
 
-def run_check(scene: Scene, lib: Library, check: Check, store=None) -> tuple[list[str], dict[str, str]]:
-    """(errors, sources) of one check (the pytest plugin runs one per test item)."""
+def _outcome(c: Check, comp, results, gl_errors, dxil, precision: str) -> Outcome:
+    """One check's Outcome from the batch's results (job key -> CompileResult / GL errors)."""
+    from ..toolchain.scenes import job_key
+    mine = [s for s in comp.sources if s.language in c.languages]
+    compiled = [results[job_key(c.hash, s.stage, s.language)] for s in mine]
+    errors = [line for r in compiled if not r.ok for line in r.errors()]
+    notes: list[str] = []
+    sources = {f"{c.platform}/{c.hash}.{s.stage}.{SOURCE_EXT[s.language]}": s.text for s in mine}
+    if c.platform == "gl":
+        es = [e for s in comp.dialects if s.language == "essl" for e in gl_errors[job_key(c.hash, s.stage, "essl")]]
+        for s in comp.dialects:
+            if s.language == "gl":
+                errors += gl_errors[job_key(c.hash, s.stage, "gl")]
+            if s.language == "gl" or not es:
+                sources[f"gl/{c.hash}.{s.stage}.{SOURCE_EXT[s.language]}"] = s.text
+        if es:  # as `build` records it: the gl platform ships GLSL 4.50 core only for this permutation
+            notes.append(f"GLSL ES 3.10 unsupported (the build ships GLSL 4.50 core only): {es[0]}"
+                         + (f" (and {len(es) - 1} more)" if len(es) > 1 else ""))
+    elif c.platform == "d3d12" and dxil is not None and not errors:
+        for s in mine:
+            errors += dxil(c.hash, s, precision)[1]
+    return Outcome(errors, dict(sorted(sources.items())), notes)
+
+
+def dxc_note() -> str | None:
+    """What a d3d12 check leaves out without a dxc on PATH (None with one)."""
+    from ..toolchain import find_tool
+    if find_tool("dxc") is not None:
+        return None
+    return ("no dxc on PATH: d3d12 checks validate the HLSL with glslang's HLSL front end only, no DXIL "
+            "(README: where to get dxc)")
+
+
+def run_check(scene: Scene, lib: Library, check: Check, store=None) -> Outcome:
+    """The Outcome of one check."""
     return run_checks(scene, lib, [check], store)[0]
 
 
@@ -84,14 +161,20 @@ def golden_diff(golden: Path, sources: dict[str, str]) -> list[str]:
     return out
 
 
-def stale_golden(golden: Path, languages, emitted: set[str]) -> list[str]:
-    """Golden files (relative paths) under the checked languages that no check emitted: permutations gone."""
+def stale_golden(golden: Path, todo: list[Check], emitted: set[str]) -> list[str]:
+    """Golden files (relative paths) of the kinds the checks emit that no check emitted: permutations gone
+    (or a GLSL ES source the bricks no longer allow). Kinds not checked (another platform's tree, a
+    language left out of vulkan's) are not looked at."""
+    exts: dict[str, set[str]] = {}
+    for c in todo:
+        exts.setdefault(c.platform, set()).update(SOURCE_EXT[x] for x in (*c.languages, *c.dialects))
     out = []
-    for lang in languages:
-        d = golden / lang
+    for plat, kinds in exts.items():
+        d = golden / plat
         if d.is_dir():
-            out += sorted(f"{lang}/{p.name}" for p in d.iterdir() if p.is_file() and f"{lang}/{p.name}" not in emitted)
-    return out
+            out += sorted(f"{plat}/{p.name}" for p in d.iterdir()
+                          if p.is_file() and p.suffix[1:] in kinds and f"{plat}/{p.name}" not in emitted)
+    return sorted(out)
 
 
 def default_store(cache_dir=None):
