@@ -150,3 +150,11 @@ def test_the_tables_command_lists_and_bakes(tmp_path):
     r = cli("--bake", "oren_nayar_sin_sin", "--out", str(tmp_path / "v.ktx2"), "--image", str(tmp_path / "none.png"))
     assert r.returncode == 2 and "not painted" in r.stderr
     assert cli("--out", "x.ktx2").returncode == 2
+    # a painted table from the artist's image: the shipped example gives the default table's texels
+    r = cli("--bake", "ndf_map", "--image", "bricks/brdf/painted/ndf_map.png", "--out", str(tmp_path / "n.ktx2"))
+    assert r.returncode == 0, r.stderr
+    texels, fmt, _ = decode((tmp_path / "n.ktx2").read_bytes())
+    assert np.array_equal(texels, tables.baked("ndf_map", (64, 1), "fp16"))
+    r = cli("--bake", "ndf_map", "--image", "bricks/brdf/painted/ndf_map_anisotropic.png", "--out", str(tmp_path / "m.ktx2"))
+    assert r.returncode == 1 and r.stderr.startswith("error: bricks/brdf/painted/ndf_map_anisotropic.png:1:1: ")
+    assert not (tmp_path / "m.ktx2").exists()

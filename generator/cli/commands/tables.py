@@ -49,19 +49,6 @@ def listing(lib) -> list[dict]:
     return rows
 
 
-def _image(path: str) -> "np.ndarray":
-    import numpy as np
-    from PIL import Image, UnidentifiedImageError
-    try:
-        with Image.open(path) as im:
-            a = np.asarray(im.convert("RGBA"), np.float64) / 255.0
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such image — give the painted table as a PNG file") from None
-    except (UnidentifiedImageError, OSError) as e:
-        raise UserError(f"{path}: not an image Pillow can read ({e}) — save the painted table as PNG") from None
-    return a
-
-
 def bake(lib, args) -> int:
     from ...build.ktx2 import encode
     from ...io import atomic_write
@@ -84,11 +71,14 @@ def bake(lib, args) -> int:
         raise UsageError(f"no brick declares table '{args.bake}': give --size WxH and --texel-format")
     if args.image and not d.painted:
         raise UsageError(f"table '{args.bake}' is baked from its reference, not painted: drop --image")
-    image = _image(args.image) if args.image else None
-    try:
-        stored = baked(args.bake, size, fmt, image)
-    except ValueError as e:  # the painted image does not fit the table (checked by its baker)
-        raise UserError(f"{args.image or args.bake}: {e}") from None
+    if args.image:  # the painted baker validates the file (readable, channels, shape) and names it in errors
+        from ...reference.tables_painted import bake_painted
+        stored = bake_painted(args.bake, args.image, size, fmt)
+    else:
+        try:
+            stored = baked(args.bake, size, fmt)
+        except ValueError as e:
+            raise UserError(f"{args.bake}: {e}") from None
     atomic_write(Path(args.out), encode(stored, fmt, cube=d.cube, writer=f"shadermatrix {__version__}"))
     print(f"{args.bake}: {size[0]}x{size[1]} {fmt}{' cube' if d.cube else ''} → {args.out}")
     return 0
