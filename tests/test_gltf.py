@@ -199,13 +199,19 @@ def test_permutations_change_exactly_where_the_shader_does(tmp_path, lib):
     def tangents_in_file(g):  # rock with tangents in the file: generated ones give the same shader
         g.d["meshes"][3]["primitives"][0]["attributes"]["TANGENT"] = g.accessor([[1, 0, 0, 1]] * 4, "VEC4")
 
-    def no_colors(g):  # COLOR_0 is not applied (no brick reads it): no change
-        del g.d["meshes"][2]["primitives"][0]["attributes"]["COLOR_0"]
-
     def no_occlusion(g):  # occlusion is not read: no change
         del g.d["materials"][0]["occlusionTexture"]
 
-    for mutate in (factors, tangents_in_file, no_colors, no_occlusion):
+    def cutoff(g):  # alphaCutoff is a uniform: materials with other cutoffs share the shader
+        g.d["materials"][1]["alphaCutoff"] = 0.7
+
+    def opaque_alpha(g):  # baseColorFactor's alpha is not read by an OPAQUE material
+        g.d["materials"][2]["pbrMetallicRoughness"]["baseColorFactor"][3] = 0.3
+
+    def dark_emissive_texture(g):  # an emissiveTexture under emissiveFactor 0 emits nothing: not sampled
+        g.d["materials"][2]["emissiveTexture"] = {"index": 0}
+
+    for mutate in (factors, tangents_in_file, no_occlusion, cutoff, opaque_alpha, dark_emissive_texture):
         assert _key_of(tmp_path, lib, mutate, mutate.__name__) == ref, mutate.__name__
 
     def no_normal_map(g):
@@ -222,7 +228,38 @@ def test_permutations_change_exactly_where_the_shader_does(tmp_path, lib):
         {k: v for k, v in ref.items() if k != "statue"}
     assert _key_of(tmp_path, lib, no_orm, "no") == ref
     got = _key_of(tmp_path, lib, no_base_texture, "nb")
-    assert got["leaf"] != ref["leaf"] and got["leaf"] == got["cloth"]  # both constants(normal=vertex) now
+    assert got["leaf"] != ref["leaf"] and {k: v for k, v in got.items() if k != "leaf"} == \
+        {k: v for k, v in ref.items() if k != "leaf"}
+
+    # the surface state (matrix/surface.py): each of these changes the one object's shader, and nothing else
+    def no_colors(g):
+        del g.d["meshes"][2]["primitives"][0]["attributes"]["COLOR_0"]
+
+    def single_sided_cloth(g):
+        g.d["materials"][2]["doubleSided"] = False
+
+    def opaque_leaf(g):
+        g.d["materials"][1]["alphaMode"] = "OPAQUE"
+
+    def blended_leaf(g):
+        g.d["materials"][1]["alphaMode"] = "BLEND"
+
+    def glowing_cloth(g):
+        g.d["materials"][2]["emissiveFactor"] = [1.0, 0.5, 0.0]
+
+    def glowing_textured_cloth(g):
+        g.d["materials"][2]["emissiveFactor"] = [1.0, 0.5, 0.0]
+        g.d["materials"][2]["emissiveTexture"] = {"index": 0}
+
+    keys = {}
+    for mutate, obj in ((no_colors, "cloth"), (single_sided_cloth, "cloth"), (opaque_leaf, "leaf"),
+                        (blended_leaf, "leaf"), (glowing_cloth, "cloth"), (glowing_textured_cloth, "cloth")):
+        got = _key_of(tmp_path, lib, mutate, mutate.__name__)
+        assert got[obj] != ref[obj], mutate.__name__
+        assert {k: v for k, v in got.items() if k != obj} == {k: v for k, v in ref.items() if k != obj}, \
+            mutate.__name__
+        keys[mutate.__name__] = got[obj]
+    assert len(set(keys.values())) == len(keys)  # six different shaders
 
     def fewer_lights(g):
         g.d["scenes"][0]["nodes"] = g.d["scenes"][0]["nodes"][:-1]  # the spot's node leaves the scene
@@ -380,7 +417,9 @@ def test_accepted_extensions_are_listed(tmp_path, lib):
     scene = load_scene(g.write_gltf(tmp_path / "model.gltf"), lib)
     assert scene.extra["extensions"] == ["KHR_lights_punctual", "KHR_materials_emissive_strength"]
     assert any("EXT_texture_webp ignored" in n for n in scene.notes)
-    assert any("'cloth': emission is not shaded" in n for n in scene.notes)
+    cloth = next(o for o in scene.objects if o["name"] == "cloth")
+    assert scene.materials[cloth["material"]].params["emissive"] == [2.0, 1.0, 0.0]  # factor · emissiveStrength
+    assert scene.permutations[cloth["permutation"]].surface.emissive == "factor"
 
 
 def _glb_bytes():
@@ -447,7 +486,7 @@ def test_matrix_explain_and_accuracy_take_a_gltf_scene(tmp_path):
     path = g.write_gltf(tmp_path / "model.gltf")
     r = run("matrix", path, "--explain", "--no-compile")
     assert r.returncode == 0, r.stderr
-    assert "## Accepted, not applied" in r.stdout and "emission is not shaded" in r.stdout
+    assert "## Accepted, not applied" in r.stdout and "emissiveStrength scales the emissive parameter" in r.stdout
     r = run("accuracy", path, "--targets", "numpy", "--dtypes", "float32", "--samples", "2", "--format", "json")
     assert r.returncode == 0, r.stderr
     specs = json.loads(r.stdout)["specs"]

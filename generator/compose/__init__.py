@@ -221,7 +221,7 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES, di
             ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, used),
                    "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
                    "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
-                   "textures": iface.textures, "call_args": call_args, "shade": shade,
+                   "textures": iface.textures, "call_args": call_args, "shade": shade, "surface": perm.surface,
                    "iface": iface, "spell": lambda name, _t=get_target(lang): _t.type_name(BUILTIN_TYPES[name])}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
@@ -247,7 +247,8 @@ def _dialect_sources(perm, lp, dialects, call_args, mat, lights, bricks, templat
             ctx = {"provenance": _provenance(f"permutation ({d})", perm.canonical(), h, bricks, used),
                    "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
                    "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
-                   "textures": iface.textures, "call_args": call_args, "shade": shade, "iface": iface, "spell": spell}
+                   "textures": iface.textures, "call_args": call_args, "shade": shade, "iface": iface, "spell": spell,
+                   "surface": perm.surface}
             out.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{d}"))
     return out

@@ -140,6 +140,9 @@ def link_permutation(perm: Permutation, lib: Library, kernel: bool = False) -> L
         t0 = g.textures[0]
         raise SourceError("<key>", 1, 1, f"a shade kernel binds no textures, and {perm.canonical()} samples "
                           f"'{t0.param}'", "run texture-sampling permutations as fragment shaders")
+    if kernel and perm.surface.vertex_color:
+        raise SourceError("<key>", 1, 1, f"a shade kernel has no vertex colours, and {perm.canonical()} reads "
+                          "COLOR_0", "run vertex-colour permutations as fragment shaders")
     assign_bindings(g.textures, {"light": 2, "material": 1})
     mat_slots, mat_count = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.material])
     light_slots, light_count = layout([(n, p, e, t, s, i) for i, vals in enumerate(g.lights) for n, p, e, t, s in vals])

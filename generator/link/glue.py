@@ -20,7 +20,8 @@ from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, storage_buffe
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
 from ..library.params import ParamSpec, flat, spec_params
 from ..matrix.permutation import Node, Resolved
-from .interface import Texture
+from ..matrix.surface import EMISSIVE_MAP
+from .interface import Texture, texture_type
 from .irgen import Builder
 from .program import Program
 
@@ -194,6 +195,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             call = bind.call(prog, r.packing, f.name, "m_", "material", None, {})
             stmts.append(b.decl(f"p_{name}", call))
             provided[name] = b.var(f"p_{name}", call.ty)
+        stmts.extend(surface_inputs(b, bind, r, bg, provided))
         stmts.append(b.decl("N", bind.call(prog, normal, normal.brick.entries[0].name, "m_", "material", None, {})))
         stmts.extend(b.decl(n, e) for n, e in shading_tangent(prog, b, bind, normal, bg.tangent))
         stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
@@ -240,19 +242,27 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             else:
                 stmts.extend(body_i)
             lights.append(pre)
-        stmts.append(b.ret(bind.call(prog, out_node, "output", "o_", "material", None, {},
-                                     args={"color": b.var("Lo", VEC3)})))
+        stmts.extend(emission(b, bind, r.surface))
+        shaded = bind.call(prog, out_node, "output", "o_", "material", None, {}, args={"color": b.var("Lo", VEC3)})
+        stmts.extend(surface_output(b, bind, r, shaded))
         return stmts
 
     # The body is built first: it decides which parameters shade() takes.
     stmts = body()
     surface = ["P", "N"] + (["T", "B"] if bg.tangent or bind.surface & {"T", "B"} else []) \
-        + (["uv"] if "uv" in bind.surface else [])
-    sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")]
+        + (["uv"] if "uv" in bind.surface else []) + (["color"] if r.surface.vertex_color else [])
+    sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")] \
+        + ([(VERTEX_COLOR, VEC4)] if r.surface.vertex_color else [])
     material = [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in flat(bg.params)
                 if k not in provided or f"m_{n}" in bind.params]
     material += [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in flat(packing_params)]
     material += [(f"o_{n}", k, e, ty, p) for n, k, e, ty, p in flat(output_params)]
+    state = r.surface.params()
+    clash = [n for n in state if n in {k for _, k, _, _, _ in material}]
+    if clash:
+        raise SourceError("<key>", 1, 1, f"parameter '{clash[0]}' of the surface state ({r.surface.canonical()[1:]}) "
+                          "is also a brick parameter of this material", "rename the brick's parameter")
+    material += [(f"m_{n}", n, None, sp.ty, sp) for n, sp in state.items()]
     light_values = []
     for i, (lb, sh) in enumerate(r.lights):
         lp = spec_params([Node(lb, ()), sh])
@@ -268,6 +278,76 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     prog.add(b.function("shade", sig, VEC4, shade_body))
     prog.globals.extend(dynamic_lights)
     return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights)
+
+
+VERTEX_COLOR = "vertex_color"  # shade()'s parameter: COLOR_0, interpolated (the templates' local of that name)
+
+
+def surface_inputs(b: Builder, bind: _Binder, r: Resolved, bg: BrdfGlue, provided: dict) -> list[ir.Stmt]:
+    """With vertex colours (matrix/surface.py): rho_d · COLOR_0.rgb, declared as `vc_rho_d` and given to the BRDF
+    in place of the packing's (or the material's) rho_d. Nothing otherwise."""
+    if not r.surface.vertex_color:
+        return []
+    if "rho_d" not in bg.params:
+        raise SourceError("<key>", 1, 1, "vertex_color multiplies rho_d, and this BRDF has no rho_d",
+                          "use a BRDF with a diffuse term (lambert, …) or drop vertex_color")
+    rho = b.copy(provided["rho_d"]) if "rho_d" in provided else b.var("m_rho_d", VEC3, "param")
+    if "rho_d" not in provided:
+        bind.params["m_rho_d"] = VEC3
+    rgb = ir.Swizzle(VEC3, b.here(), b.var(VERTEX_COLOR, VEC4, "param"), "xyz")
+    provided["rho_d"] = b.var("vc_rho_d", VEC3)
+    return [b.decl("vc_rho_d", b.arith("*", rho, rgb))]
+
+
+def coverage_texture(packing: Node) -> str:
+    """The packing's texture whose A is the base colour's coverage: the sRGB 2D texture its get_rho_d samples
+    (glTF's baseColorTexture: albedo_map, base_color_map), or '' when rho_d is not textured."""
+    f = packing.brick.module.functions.get("get_rho_d")
+    for p in (f.params if f is not None else []):
+        if p.ty.kind == "texture" and p.ty.dim == "2d" and not p.ty.compare \
+                and _texture_decl([packing], p.name).get("srgb"):
+            return p.name
+    return ""
+
+
+def _sample(b: Builder, bind: _Binder, tname: str, param: str, srgb: bool) -> ir.Expr:
+    """sample(t_<param>, uv) in shade(), binding the material texture if nothing bound it yet."""
+    if tname not in {t.name for t in bind.textures}:
+        bind.textures.append(Texture(tname, param, "material", srgb, "2d"))
+    bind.surface.add("uv")
+    tex = bind.b.var(tname, texture_type("2d"), "param")
+    return b.intrinsic("sample", VEC4, tex, b.var("uv", SURFACE["uv"], "param"))
+
+
+def emission(b: Builder, bind: _Binder, sf) -> list[ir.Stmt]:
+    """Lo += m_emissive [· sample(t_emissive_map, uv).rgb] (glTF emissiveFactor · emissiveTexture)."""
+    if sf.emissive == "none":
+        return []
+    e = b.var("m_emissive", VEC3, "param")
+    if sf.emissive == "texture":
+        e = b.arith("*", e, ir.Swizzle(VEC3, b.here(), _sample(b, bind, f"t_{EMISSIVE_MAP}", EMISSIVE_MAP, True), "xyz"))
+    return [b.assign(b.var("Lo", VEC3), e, "+")]
+
+
+def surface_output(b: Builder, bind: _Binder, r: Resolved, shaded: ir.Expr) -> list[ir.Stmt]:
+    """The return of shade(): the output brick's colour, its alpha replaced by the coverage for MASK (1 kept, 0
+    discarded by the template) and BLEND (the coverage itself); OPAQUE returns the output brick's value as is."""
+    sf = r.surface
+    if sf.alpha == "opaque":
+        return [b.ret(shaded)]
+    cov = b.var("m_base_alpha", FLOAT, "param")
+    tex = coverage_texture(r.packing)
+    if tex:
+        cov = b.arith("*", cov, ir.Swizzle(FLOAT, b.here(), _sample(b, bind, f"t_{tex}", tex, True), "w"))
+    if sf.vertex_color:
+        cov = b.arith("*", cov, ir.Swizzle(FLOAT, b.here(), b.var(VERTEX_COLOR, VEC4, "param"), "w"))
+    stmts = [b.decl("shaded", shaded), b.decl("coverage", cov)]
+    a = b.var("coverage", FLOAT)
+    if sf.alpha == "mask":  # glTF 3.9.4: fully opaque where coverage ≥ alphaCutoff, else not drawn
+        a = ir.Select(FLOAT, b.here(), b.compare(">=", a, b.var("m_alpha_cutoff", FLOAT, "param")),
+                      b.const(1.0), b.const(0.0))
+    rgb = ir.Swizzle(VEC3, b.here(), b.var("shaded", VEC4), "xyz")
+    return stmts + [b.ret(b.construct(VEC4, rgb, a))]
 
 
 def has_tangent(normal: Node) -> bool:

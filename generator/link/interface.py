@@ -194,9 +194,11 @@ class Location:
 VERTEX_INPUTS = {"P": Location(0, "a_position", "vec3", "R32G32B32_SFLOAT"),
                  "N": Location(1, "a_normal", "vec3", "R32G32B32_SFLOAT"),
                  "T": Location(2, "a_tangent", "vec4", "R32G32B32A32_SFLOAT"),
-                 "uv": Location(3, "a_uv", "vec2", "R32G32_SFLOAT")}
+                 "uv": Location(3, "a_uv", "vec2", "R32G32_SFLOAT"),
+                 "color": Location(4, "a_color", "vec4", "R32G32B32A32_SFLOAT")}  # COLOR_0 (matrix/surface.py)
 INTERPOLANTS = {"P": Location(0, "v_position", "vec3"), "N": Location(1, "v_normal", "vec3"),
-                "T": Location(2, "v_tangent", "vec4"), "uv": Location(3, "v_uv", "vec2")}
+                "T": Location(2, "v_tangent", "vec4"), "uv": Location(3, "v_uv", "vec2"),
+                "color": Location(4, "v_color", "vec4")}
 
 
 @dataclass
@@ -205,7 +207,7 @@ class Interface:
 
     stage_entries: dict[str, str]  # stage -> entry point name
     shading_inputs: list[str]  # rows of the inputs table the BRDF reads (frame rows included)
-    surface: list[str]  # P, N, then T, B, uv where read
+    surface: list[str]  # P, N, then T, B, uv, color where read
     blocks: list[Block]
     textures: list[Texture]
     outputs: list[Location]
@@ -217,11 +219,13 @@ class Interface:
 
     @property
     def vertex_inputs(self) -> list[Location]:
-        return [VERTEX_INPUTS[k] for k in ("P", "N", "T", "uv") if k in self.surface or (k == "T" and self.tangent)]
+        return [VERTEX_INPUTS[k] for k in ("P", "N", "T", "uv", "color")
+                if k in self.surface or (k == "T" and self.tangent)]
 
     @property
     def interpolants(self) -> list[Location]:
-        return [INTERPOLANTS[k] for k in ("P", "N", "T", "uv") if k in self.surface or (k == "T" and self.tangent)]
+        return [INTERPOLANTS[k] for k in ("P", "N", "T", "uv", "color")
+                if k in self.surface or (k == "T" and self.tangent)]
 
     def block(self, name: str) -> Block | None:
         for b in self.blocks:

@@ -21,12 +21,16 @@ Its packing follows the textures present (each changes the shader, so each chang
     an absent texture: the factor alone), recorded as "white" in GltfMaterial.textures.
   - normalTexture → the packing's normal slot `normal_map`, else `vertex`. normalTexture.scale ≠ 1 is
     not applied (normal_map has no scale): a note.
-  - occlusionTexture is not read (it scales indirect light; the light loop has direct lights only),
-    emissiveFactor / emissiveTexture are not shaded (there is no emissive brick): a note each, and
-    neither changes the key.
-  - alphaMode / alphaCutoff / doubleSided are recorded on the material (GltfMaterial) and on every
-    object; the permutation key (matrix/permutation.py) has no field for them yet, so materials that
-    differ only there share a permutation (the alpha test / back-face normal flip is left for the key).
+  - occlusionTexture is not read (it scales indirect light; the light loop has direct lights only): a
+    note, and it does not change the key.
+  - the surface state (matrix/surface.py) is part of the key where it changes the shader: alphaMode →
+    alpha opaque | mask | blend (base_alpha = baseColorFactor[3] and alpha_cutoff are material uniforms,
+    so other cutoffs share the shader); doubleSided → double_sided (the back-face flip; the renderer culls
+    back faces otherwise); emissiveFactor · KHR_materials_emissive_strength ≠ 0 → emissive "factor", with
+    an emissiveTexture "texture" (emissive_map); an emissiveTexture under a zero factor is not sampled (a
+    note). A primitive with COLOR_0 draws with vertex_color: its material is mapped a second time, as
+    `<name>+COLOR_0`, since the shader differs. alphaMode, alphaCutoff and doubleSided stay recorded on
+    GltfMaterial and on every object too.
   - texCoord ≠ 0 in a textureInfo is an error (the bricks read one UV set, TEXCOORD_0).
   - every material is mapped and checked, used or not (as a TOML scene's materials); only the ones
     objects use make permutations. Texture images are not read (their presence is what the key needs).
@@ -34,9 +38,9 @@ Tangents. A primitive whose material has a normal map and whose mesh has no TANG
 tangents generated on import from the UV gradients (Lengyel 2001: per-triangle ∂P/∂u, ∂P/∂v summed
 per vertex, Gram-Schmidt against N, w = handedness) — NOT MikkTSpace-exact (MikkTSpace splits vertices
 at tangent-space seams and weights by angle). The shader is the same with file or generated tangents,
-so the key is too; the object records `tangents` = "file" | "generated". COLOR_0 is recorded on the
-object (`vertex_colors`) but not applied (no vertex-color packing brick): a note; it does not change
-the key. A primitive without NORMAL gets flat normals (its triangles unwelded), as glTF requires.
+so the key is too; the object records `tangents` = "file" | "generated". COLOR_0 (VEC3 or VEC4; RGB
+gets alpha 1) is read into the mesh (Mesh.colors) and recorded on the object (`vertex_colors`).
+A primitive without NORMAL gets flat normals (its triangles unwelded), as glTF requires.
 Lights. KHR_lights_punctual lights instanced by nodes become the scene's lights (one Light per node
 instance, shadow "none"): directional → `directional` (direction = the node's +Z, towards the light),
 point → `point_range` (radius = range) or `point` (no range), spot → `spot` (position, direction = the
@@ -77,7 +81,8 @@ from ..lang import SourceError
 from ..library.bricks import Library
 from ..library.params import spec_params
 from .permutation import LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf, parse_spec, resolve
-from .scene import Light, Material, Scene
+from .scene import Light, Material, Scene, surface_specs
+from .surface import EMISSIVE_MAP, Surface
 
 BRDF = "lambert+microfacet(ndf=ggx,fresnel=schlick,vis=smith_ggx_height_correlated)"
 MAX_GLTF_BYTES = 256 << 20  # a .gltf, .glb or .bin larger than this is refused
@@ -93,7 +98,7 @@ SHADING_EXTENSIONS = {  # change what the shader computes; no brick implements t
 ACCEPTED_EXTENSIONS = {  # do not change the shader (or are mapped here): accepted, listed in scene.notes
     "KHR_lights_punctual": "mapped to the scene's lights",
     "KHR_mesh_quantization": "quantized attributes are decoded on import",
-    "KHR_materials_emissive_strength": "emission is not shaded (no emissive brick)",
+    "KHR_materials_emissive_strength": "emissiveStrength scales the emissive parameter",
     "KHR_texture_basisu": "an image encoding: the sampled values, not the shader, change",
     "KHR_xmp_json_ld": "metadata",
     "KHR_animation_pointer": "animation, not shading",
@@ -122,7 +127,7 @@ class GltfError(SourceError):
 
 @dataclass
 class GltfMaterial(Material):
-    """A Material with what the permutation key cannot hold yet (see the module docstring)."""
+    """A Material with glTF's own alpha, sidedness and texture bindings (see the module docstring)."""
 
     alpha_mode: str = "OPAQUE"
     alpha_cutoff: float = 0.5
@@ -471,14 +476,16 @@ def load_gltf(path, lib: Library) -> Scene:
     for name in ("textures", "images", "samplers", "meshes", "nodes", "accessors", "bufferViews", "buffers", "scenes"):
         rd.array(name)
     mat_names = _unique_names([m.get("name") if isinstance(m.get("name"), str) else "" for m in materials], "material")
-    mapped: dict[int, GltfMaterial] = {}
+    mapped: dict[tuple, GltfMaterial] = {}
 
-    def material(i):  # i None: the glTF default material
-        if i not in mapped:
-            mapped[i] = _material(rd, lib, i, materials[i] if i is not None else {},
-                                  mat_names[i] if i is not None else _free_name("default", mat_names), notes)
-            scene.materials[mapped[i].name] = mapped[i]
-        return mapped[i]
+    def material(i, colors=False):  # i None: the glTF default material; colors: drawn on primitives with COLOR_0
+        if (i, colors) not in mapped:
+            name = mat_names[i] if i is not None else _free_name("default", mat_names)
+            if colors:  # another shader (vertex_color), so another material: "<name>+COLOR_0"
+                name = _free_name(f"{name}+COLOR_0", set(mat_names) | set(scene.materials))
+            mapped[(i, colors)] = _material(rd, lib, i, materials[i] if i is not None else {}, name, notes, colors)
+            scene.materials[name] = mapped[(i, colors)]
+        return mapped[(i, colors)]
 
     for i in range(len(materials)):  # every material is checked, used or not; unused ones build nothing
         material(i)
@@ -563,7 +570,8 @@ def load_gltf(path, lib: Library) -> Scene:
                 if mode not in _MODES:
                     raise rd.err(f"{pptr}/mode", f"{mode} is not a primitive mode", "use 0 … 6 (4: TRIANGLES)")
                 mat_i = rd.ref(prim, "material", pptr, "materials", None)
-                m = material(mat_i)
+                attrs = prim.get("attributes")
+                m = material(mat_i, isinstance(attrs, dict) and "COLOR_0" in attrs)
                 if mode < 4:
                     skipped_modes.add(_MODES[mode])
                     continue
@@ -573,7 +581,7 @@ def load_gltf(path, lib: Library) -> Scene:
                 mesh_obj, tangents, colors = mesh_cache[key]
                 oname = _free_name(_clean(nname + (f"#{pi}" if len(prims) > 1 else "")), obj_names)
                 obj_names.add(oname)
-                perm = Permutation(m.brdf, keys, m.packing, scene.output, scene.precision)
+                perm = Permutation(m.brdf, keys, m.packing, scene.output, scene.precision, m.surface)
                 h = hashes.get(perm)
                 if h is None:
                     h = hashes[perm] = perm.hash
@@ -587,9 +595,6 @@ def load_gltf(path, lib: Library) -> Scene:
                                       "double_sided": m.double_sided, "tangents": tangents, "vertex_colors": colors})
     if skipped_modes:
         notes.append(f"primitives drawn as {', '.join(sorted(skipped_modes))} are not shaded: skipped")
-    if any(o["vertex_colors"] for o in scene.objects):
-        notes.append("COLOR_0 (vertex colors) is recorded per object but not applied: there is no vertex-color "
-                     "packing brick")
     gen = sorted({o["name"] for o in scene.objects if o["tangents"] == "generated"})
     if gen:
         notes.append(f"tangents generated from UV gradients (Lengyel; not MikkTSpace-exact) for: {', '.join(gen)}")
@@ -722,7 +727,9 @@ def _texture_info(rd: _Reader, d: dict, key: str, ptr: str) -> dict | None:
     return out
 
 
-def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list) -> GltfMaterial:
+def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list, colors: bool = False) -> GltfMaterial:
+    """Material i (None: glTF's default material) mapped to a GltfMaterial; colors: the primitives drawn with it
+    carry COLOR_0 (the vertex_color part of the surface state)."""
     ptr = _ptr("materials", i) if i is not None else "/materials (default material)"
     pbr = rd.get(m, "pbrMetallicRoughness", ptr, "obj", {})
     pptr = f"{ptr}/pbrMetallicRoughness"
@@ -735,6 +742,7 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list) -> 
     tex_o = _texture_info(rd, m, "occlusionTexture", ptr)
     tex_e = _texture_info(rd, m, "emissiveTexture", ptr)
     emissive = rd.nums(m, "emissiveFactor", ptr, 3, [0.0, 0.0, 0.0], 0.0, 1.0)
+    strength = _emissive_strength(rd, m, ptr)
     alpha_mode = rd.get(m, "alphaMode", ptr, "str", "OPAQUE")
     if alpha_mode not in ("OPAQUE", "MASK", "BLEND"):
         raise rd.err(f"{ptr}/alphaMode", f"'{alpha_mode}' is not an alpha mode", "use OPAQUE, MASK or BLEND")
@@ -747,8 +755,6 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list) -> 
     if tex_o is not None:
         notes.append(f"material '{name}': occlusionTexture is not read (it scales indirect light; "
                      "the light loop has direct lights only)")
-    if tex_e is not None or any(emissive):
-        notes.append(f"material '{name}': emission is not shaded (there is no emissive brick)")
     normal = "normal_map" if tex_n is not None else "vertex"
     r2 = roughness * roughness
     textures: dict = {}
@@ -767,12 +773,27 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list) -> 
         params = {"base_color": base[:3], "metallic": metallic, "roughness": roughness}
         textures["base_color_map"] = tex_base or "white"
         textures["orm_map"] = tex_mr or "white"
+    # the surface state (matrix/surface.py): each part only where it changes what the shader computes
+    lit = [c * strength for c in emissive]
+    surface = Surface(alpha=alpha_mode.lower(), double_sided=double, vertex_color=colors,
+                      emissive="texture" if tex_e is not None and any(lit) else "factor" if any(lit) else "none")
+    if alpha_mode != "OPAQUE":
+        params["base_alpha"] = base[3]
+    if alpha_mode == "MASK":
+        params["alpha_cutoff"] = cutoff
+    if surface.emissive != "none":
+        params["emissive"] = lit
+    if surface.emissive == "texture":
+        textures[EMISSIVE_MAP] = tex_e
+    elif tex_e is not None:
+        notes.append(f"material '{name}': emissiveTexture is not sampled (emissiveFactor is 0)")
     try:
         brdf = canonical(parse_brdf(BRDF, lib))
         nodes = parse_brdf(brdf, lib)
         pnodes = parse_spec(packing, lib, ("packing",))
         packing = canonical(pnodes)
         specs = spec_params(list(nodes) + pnodes + [lib.get("output", "linear")])
+        specs = surface_specs(specs, surface, lambda key, msg, todo: rd.err(ptr, msg, todo))
     except (SpecError, SourceError) as e:
         raise rd.err(ptr, f"the bricks this material maps to are missing: {e}",
                      "use the standard brick library (or --bricks with lambert, microfacet, ggx, …)") from None
@@ -783,8 +804,18 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list) -> 
     problem, todo = check_packing(resolve(Permutation(brdf, (), packing, "linear"), lib))
     if problem:
         raise rd.err(ptr, problem, todo)
-    return GltfMaterial(name, brdf, packing, params, alpha_mode=alpha_mode, alpha_cutoff=cutoff,
+    return GltfMaterial(name, brdf, packing, params, surface, alpha_mode=alpha_mode, alpha_cutoff=cutoff,
                         double_sided=double, base_alpha=base[3], textures=textures, source=ptr)
+
+
+def _emissive_strength(rd: _Reader, m: dict, ptr: str) -> float:
+    """KHR_materials_emissive_strength's emissiveStrength (1 without it): it scales emissiveFactor."""
+    ext = m.get("extensions")
+    if not isinstance(ext, dict) or "KHR_materials_emissive_strength" not in ext:
+        return 1.0
+    eptr = f"{ptr}/extensions/KHR_materials_emissive_strength"
+    e = rd.get(ext, "KHR_materials_emissive_strength", f"{ptr}/extensions", "obj")
+    return rd.num(e, "emissiveStrength", eptr, 1.0, 0.0, None)
 
 
 def _light(rd: _Reader, lib: Library, L, ptr: str, name: str, world: np.ndarray) -> Light:
@@ -859,9 +890,9 @@ def _mesh(rd: _Reader, prim: dict, pptr: str, mode: int, m: GltfMaterial):
         return a
 
     nrm, tan, uv = attr("NORMAL", ("VEC3",)), attr("TANGENT", ("VEC4",)), attr("TEXCOORD_0", ("VEC2",))
-    colors = "COLOR_0" in attrs
-    if colors:
-        attr("COLOR_0", ("VEC3", "VEC4"))
+    colors = attr("COLOR_0", ("VEC3", "VEC4"))
+    if colors is not None and colors.shape[1] == 3:  # RGB: alpha 1 (glTF 3.7.2.1)
+        colors = np.concatenate([colors, np.ones((len(colors), 1), np.float32)], axis=1)
     if "indices" in prim:
         ii = rd.ref(prim, "indices", pptr, "accessors")
         a = rd.array("accessors")[ii]
@@ -889,6 +920,7 @@ def _mesh(rd: _Reader, prim: dict, pptr: str, mode: int, m: GltfMaterial):
     if nrm is None:  # flat normals: unweld the triangles (glTF 2.0 §3.7.2.1)
         pos, idx_old = pos[idx], idx
         uv = uv[idx_old] if uv is not None else None
+        colors = colors[idx_old] if colors is not None else None
         tan = None
         idx = np.arange(len(pos), dtype=np.int64)
         tri = pos.reshape(-1, 3, 3).astype(np.float64)
@@ -902,7 +934,9 @@ def _mesh(rd: _Reader, prim: dict, pptr: str, mode: int, m: GltfMaterial):
         tan = generate_tangents(pos, nrm, uv, idx) if idx.size else np.zeros((len(pos), 4), np.float32)
         source = "generated" if "normal_map" in m.textures else "none"
     f = lambda x: np.ascontiguousarray(x, dtype=np.float32)  # noqa: E731
-    return Mesh(f(pos), f(nrm), f(tan), f(uv), np.ascontiguousarray(idx, dtype=np.uint32)), source, colors
+    mesh = Mesh(f(pos), f(nrm), f(tan), f(uv), np.ascontiguousarray(idx, dtype=np.uint32),
+                f(colors) if colors is not None else None)
+    return mesh, source, colors is not None
 
 
 def textures_need_uv(m: GltfMaterial) -> bool:

@@ -22,6 +22,7 @@ class Mesh:
     tangents: np.ndarray   # (n, 4), w = bitangent sign
     uvs: np.ndarray        # (n, 2)
     indices: np.ndarray    # (3 t,) uint32
+    colors: np.ndarray | None = None  # (n, 4) COLOR_0 (RGBA); None: white, as a mesh without COLOR_0 reads it
 
     @property
     def vertex_count(self) -> int:
@@ -32,8 +33,10 @@ class Mesh:
         return len(self.indices)
 
     def attributes(self) -> dict[str, np.ndarray]:
-        """The arrays by vertex-input name (a_position, a_normal, a_tangent, a_uv)."""
-        return {"a_position": self.positions, "a_normal": self.normals, "a_tangent": self.tangents, "a_uv": self.uvs}
+        """The arrays by vertex-input name (a_position, a_normal, a_tangent, a_uv, a_color)."""
+        colors = self.colors if self.colors is not None else np.ones((self.vertex_count, 4), np.float32)
+        return {"a_position": self.positions, "a_normal": self.normals, "a_tangent": self.tangents, "a_uv": self.uvs,
+                "a_color": colors}
 
     def interleaved(self, names=ATTRIBUTES) -> np.ndarray:
         """The chosen attributes interleaved per vertex, (n, floats per vertex) float32, in `names` order."""

@@ -17,6 +17,7 @@ from ..library.bricks import Brick, Library
 from ..library.kinds import BRDF_KINDS
 from ..lang import SourceError
 from ..lang.errors import UserError
+from .surface import DEFAULT as DEFAULT_SURFACE, Surface
 
 _TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[0-9]+|[()+=,])")
 PRECISIONS = ("fp32", "fp16")  # fp16: the BRDF and glue arithmetic in half (targets/*Half*), the interface 32-bit
@@ -199,11 +200,13 @@ class Permutation:
     packing: str  # canonical packing spec
     output: str = "linear"
     precision: str = "fp32"
+    surface: Surface = DEFAULT_SURFACE  # alpha mode, double-sided, vertex colours, emission (matrix/surface.py)
 
     def canonical(self) -> str:
+        """The key as text; the surface state at its defaults writes nothing (earlier keys and hashes unchanged)."""
         lights = ",".join(k.canonical() for k in self.lights) or "-"
         return (f"brdf={self.brdf};lights={lights};packing={self.packing};"
-                f"output={self.output};precision={self.precision}")
+                f"output={self.output};precision={self.precision}{self.surface.canonical()}")
 
     @property
     def hash(self) -> str:
@@ -220,6 +223,7 @@ class Resolved:
     lights: list[tuple[Brick, Node]]  # (light brick, shadow spec) per light, in order
     output: Brick
     dynamic: tuple[bool, ...] = ()  # per light: a loop over a storage buffer of such lights
+    surface: Surface = DEFAULT_SURFACE
 
 
 def resolve(perm: Permutation, lib: Library) -> Resolved:
@@ -239,7 +243,7 @@ def resolve(perm: Permutation, lib: Library) -> Resolved:
     if out is None:
         raise SourceError("<key>", 1, 1, f"unknown output brick '{perm.output}'",
                           f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
-    return Resolved(brdf, packing[0], lights, out, tuple(lk.dynamic for lk in perm.lights))
+    return Resolved(brdf, packing[0], lights, out, tuple(lk.dynamic for lk in perm.lights), perm.surface)
 
 
 def check_packing(r: Resolved) -> tuple[str, str]:

@@ -2,7 +2,9 @@
 
 Schema (README "Scene files"):
     [scene]            name, output (default "linear"), precision (default "fp32")
-    [materials.NAME]   brdf = spec, packing = spec (default "constants"), params = {...}
+    [materials.NAME]   brdf = spec, packing = spec (default "constants"), params = {...},
+                       alpha = "opaque"|"mask"|"blend", double_sided, vertex_color = true|false,
+                       emissive = "none"|"factor"|"texture" (the surface state: matrix/surface.py)
     [lights.NAME]      type = light brick, shadow = spec (default "none"), params = {...}
     [light_sets]       NAME = [light names, in order]
     [[objects]]        name, material = NAME, lights = light set NAME
@@ -22,6 +24,7 @@ from ..lang import SourceError
 from ..lang.errors import read_text
 from .permutation import (PRECISIONS, LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf,
                           parse_spec, resolve)
+from .surface import DEFAULT as DEFAULT_SURFACE, Surface
 
 
 class Locator:
@@ -101,6 +104,7 @@ class Material:
     brdf: str
     packing: str
     params: dict
+    surface: Surface = DEFAULT_SURFACE  # what of alpha, sidedness, vertex colours and emission the shader does
 
 
 @dataclass
@@ -189,12 +193,16 @@ def load_scene(path, lib: Library) -> Scene:
             specs = spec_params(list(nodes) + parse_spec(packing, lib, ("packing",)) + [lib.get("output", output)])
         except SourceError as e:
             raise loc.error(where, e.message, e.hint) from None
+        surface = Surface(m.get("alpha", "opaque"), m.get("double_sided", False), m.get("vertex_color", False),
+                          m.get("emissive", "none"))
+        specs = surface_specs(specs, surface, lambda key, msg, todo: loc.error(
+            loc.find(f"materials.{name}", key), f"material '{name}': {msg}", todo))
         params = m.get("params", {})
         _check_params(loc, f"materials.{name}", params, specs, f"BRDF '{brdf}'")
         problem, todo = check_packing(resolve(Permutation(brdf, (), packing, output), lib))
         if problem:
             raise loc.error(loc.find(f"materials.{name}", "packing"), f"material '{name}': {problem}", todo)
-        scene.materials[name] = Material(name, brdf, packing, params)
+        scene.materials[name] = Material(name, brdf, packing, params, surface)
 
     for name, li in _table(loc, data, "lights").items():
         where = loc.find(f"lights.{name}")
@@ -256,7 +264,7 @@ def load_scene(path, lib: Library) -> Scene:
                             f"object '{oname}' needs lights = a light set name", 'write lights = "outdoor"')
         m = scene.materials[mat]
         keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in names)
-        perm = Permutation(m.brdf, keys, m.packing, output, precision)
+        perm = Permutation(m.brdf, keys, m.packing, output, precision, m.surface)
         h = hashes.get(perm)
         if h is None:  # the first object of a permutation: where messages about it will point
             h = hashes[perm] = perm.hash
@@ -265,6 +273,20 @@ def load_scene(path, lib: Library) -> Scene:
         scene.users.setdefault(h, []).append(oname)
         scene.objects.append({"name": oname, "material": mat, "light_set": lset, "lights": names, "permutation": h})
     return scene
+
+
+def surface_specs(specs: dict, surface: Surface, error) -> dict:
+    """The material's parameter specs with those its surface state reads (matrix/surface.py); error(key, what,
+    todo) makes the exception for a state the material's bricks cannot take."""
+    if surface.vertex_color and "rho_d" not in specs:
+        raise error("vertex_color", "vertex_color multiplies rho_d, and the BRDF and packing have no rho_d",
+                    "use a BRDF with a diffuse term (lambert, …) or drop vertex_color")
+    extra = surface.params()
+    clash = [k for k in extra if k in specs]
+    if clash:
+        raise error("alpha" if clash[0] != "emissive" else "emissive", f"the surface state's parameter "
+                    f"'{clash[0]}' is also a parameter of the material's bricks", "rename the brick's parameter")
+    return {**specs, **extra}
 
 
 def _table(loc: Locator, data: dict, key: str) -> dict:

@@ -14,6 +14,8 @@ import difflib
 import itertools
 import re
 
+from .surface import ALPHA_MODES, EMISSIVE
+
 NAME = {"type": "string", "minLength": 1, "maxLength": 256,
         "pattern": r"^[^\x00-\x1f\x7f\u0085\u2028\u2029]*(?!\n)$"}  # (?!\n): Python's $ also matches before a final \n
 SPEC = {"type": "string", "minLength": 1, "maxLength": 4096}
@@ -32,7 +34,11 @@ SCENE_SCHEMA = {
                   "properties": {"name": NAME, "output": SPEC, "precision": NAME}},
         "materials": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["brdf"],
-            "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS}}},
+            "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS,
+                           # the surface state (matrix/surface.py); absent = the default, the key unchanged
+                           "alpha": {"type": "string", "enum": list(ALPHA_MODES)},
+                           "double_sided": {"type": "boolean"}, "vertex_color": {"type": "boolean"},
+                           "emissive": {"type": "string", "enum": list(EMISSIVE)}}}},
         "lights": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type"],
             "properties": {"type": NAME, "shadow": SPEC, "params": PARAMS}}},
@@ -44,7 +50,8 @@ SCENE_SCHEMA = {
     },
 }
 
-_TYPES = {"object": "a table", "array": "an array", "string": "a string", "number": "a number"}
+_TYPES = {"object": "a table", "array": "an array", "string": "a string", "number": "a number",
+          "boolean": "true or false"}
 _EXAMPLES = {"scene": "[scene] name = \"courtyard\"", "materials": "[materials.NAME] brdf = \"lambert\"",
              "lights": "[lights.NAME] type = \"point\"", "light_sets": "[light_sets] NAME = [\"sun\"]",
              "objects": "[[objects]] material = \"NAME\" lights = \"SET\""}
@@ -139,6 +146,9 @@ def _located(e, loc):
         example = _EXAMPLES.get(str(path[0]) if path else "", "see README, \"Scene files\"")
         return loc.error(pos, f"'{key}' must be {want}, not {_what(e.instance)}", f"write {example}"
                          if len(path) <= 1 else f"give {want}")
+    if e.validator == "enum":
+        return loc.error(pos, f"'{key}' is {e.instance!r}, not one of {', '.join(map(str, e.validator_value))}",
+                         f"write {key.split('.')[-1]} = \"{e.validator_value[0]}\"")
     if e.validator == "anyOf":
         return loc.error(pos, f"'{key}' must be a number or an array of numbers, not {_what(e.instance)}",
                          "write e.g. 0.5 or [0.8, 0.1, 0.1]")

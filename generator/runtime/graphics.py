@@ -10,8 +10,9 @@
   vertex buffer binding per vertex input (the Interface's ``vertex_inputs``: location, name, Vulkan
   format), descriptor sets described by ``set_layouts`` ({set: {binding: kind}}, kinds of
   :mod:`.compute`: UNIFORM, STORAGE, SAMPLED_IMAGE, SAMPLER), as :func:`layouts_from_interface`
-  reads them off an Interface. Triangle lists, cull mode none, depth test LESS with writes,
-  viewport and scissor = the target, no blending.
+  reads them off an Interface. Triangle lists, cull mode none (back with ``cull_back``: a single-sided
+  material, matrix/surface.py), front faces counter-clockwise, depth test LESS with writes, viewport and
+  scissor = the target, no blending (source-over with ``blend``: glTF's BLEND, src·a + dst·(1 − a)).
 - :class:`GpuMesh`: a :class:`~.meshes.Mesh` uploaded, one vertex buffer per attribute, and its
   uint32 index buffer.
 - :class:`DepthTarget`: a D32_SFLOAT image drawn by a depth-only render pass (vertex-only pipelines), then
@@ -117,8 +118,10 @@ class GraphicsPipeline:
     def __init__(self, device: Device, target: "OffscreenTarget | DepthTarget", vert_spirv: bytes,
                  frag_spirv: bytes | None,
                  vertex_inputs, set_layouts: dict[int, dict[int, str]], specialization: dict[int, int] | None = None,
-                 vert_entry: str = "main", frag_entry: str = "main", cache=None, flags: int = 0):
+                 vert_entry: str = "main", frag_entry: str = "main", cache=None, flags: int = 0,
+                 cull_back: bool = False, blend: bool = False):
         vk = self.vk = device.vk
+        self.cull_back, self.blend = cull_back, blend  # render state of the surface (matrix/surface.py)
         self.flags = flags  # VkPipelineCreateFlags (e.g. capture statistics: runtime/gpu_stats.py)
         self.cache = cache  # a runtime.pipeline_cache.PipelineCacheFile, or None
         self.device, self.target = device, target
@@ -195,7 +198,7 @@ class GraphicsPipeline:
         viewport_state = vk.VkPipelineViewportStateCreateInfo(pViewports=[viewport], pScissors=[scissor])
         raster = vk.VkPipelineRasterizationStateCreateInfo(
             depthClampEnable=vk.VK_FALSE, rasterizerDiscardEnable=vk.VK_FALSE, polygonMode=vk.VK_POLYGON_MODE_FILL,
-            cullMode=vk.VK_CULL_MODE_NONE, frontFace=vk.VK_FRONT_FACE_COUNTER_CLOCKWISE, depthBiasEnable=vk.VK_FALSE,
+            cullMode=vk.VK_CULL_MODE_BACK_BIT if self.cull_back else vk.VK_CULL_MODE_NONE, frontFace=vk.VK_FRONT_FACE_COUNTER_CLOCKWISE, depthBiasEnable=vk.VK_FALSE,
             depthBiasConstantFactor=0.0, depthBiasClamp=0.0, depthBiasSlopeFactor=0.0, lineWidth=1.0)
         multisample = vk.VkPipelineMultisampleStateCreateInfo(
             rasterizationSamples=vk.VK_SAMPLE_COUNT_1_BIT, sampleShadingEnable=vk.VK_FALSE, minSampleShading=0.0,
@@ -209,10 +212,14 @@ class GraphicsPipeline:
             minDepthBounds=0.0, maxDepthBounds=1.0)
         mask = (vk.VK_COLOR_COMPONENT_R_BIT | vk.VK_COLOR_COMPONENT_G_BIT | vk.VK_COLOR_COMPONENT_B_BIT
                 | vk.VK_COLOR_COMPONENT_A_BIT)
+        over = self.blend  # source-over for colour; alpha keeps the destination's coverage summed (a + d(1 − a))
         blend_attachment = vk.VkPipelineColorBlendAttachmentState(
-            blendEnable=vk.VK_FALSE, srcColorBlendFactor=vk.VK_BLEND_FACTOR_ONE,
-            dstColorBlendFactor=vk.VK_BLEND_FACTOR_ZERO, colorBlendOp=vk.VK_BLEND_OP_ADD,
-            srcAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE, dstAlphaBlendFactor=vk.VK_BLEND_FACTOR_ZERO,
+            blendEnable=vk.VK_TRUE if over else vk.VK_FALSE,
+            srcColorBlendFactor=vk.VK_BLEND_FACTOR_SRC_ALPHA if over else vk.VK_BLEND_FACTOR_ONE,
+            dstColorBlendFactor=vk.VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA if over else vk.VK_BLEND_FACTOR_ZERO,
+            colorBlendOp=vk.VK_BLEND_OP_ADD,
+            srcAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE,
+            dstAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA if over else vk.VK_BLEND_FACTOR_ZERO,
             alphaBlendOp=vk.VK_BLEND_OP_ADD, colorWriteMask=mask)
         blend = vk.VkPipelineColorBlendStateCreateInfo(logicOpEnable=vk.VK_FALSE, logicOp=vk.VK_LOGIC_OP_COPY,
                                                        pAttachments=[blend_attachment],

@@ -31,25 +31,33 @@ def placement(i: int, n: int) -> np.ndarray:
     return model
 
 
-def make_mesh(kind: str):
-    """The mesh a placement names: a unit UV sphere (24 × 48), a plane of side 2 in y = 0, or a box [−1, 1]³."""
+def make_mesh(kind):
+    """The mesh a placement names: a unit UV sphere (24 × 48), a plane of side 2 in y = 0, or a box [−1, 1]³;
+    a glTF primitive's mesh is itself."""
     from .meshes import box, plane, uv_sphere
+
+    if not isinstance(kind, str):
+        return kind
 
     return {"sphere": lambda: uv_sphere(24, 48), "plane": lambda: plane(2.0), "box": lambda: box(2.0)}[kind]()
 
 
 @dataclass(frozen=True)
 class Placed:
-    """One object's placement: its mesh and model = translate · rotate_y · scale (scale: half-extents)."""
+    """One object's placement: its mesh and model = translate · rotate_y · scale (scale: half-extents), or a
+    glTF primitive: its own mesh (matrix.mesh.Mesh) and its node's world matrix."""
 
     name: str
-    mesh: str = "sphere"
+    mesh: object = "sphere"  # a MESHES name, or a Mesh read from a glTF file
     translate: tuple = (0.0, 0.0, 0.0)
     scale: tuple = (1.0, 1.0, 1.0)
     rotate_y: float = 0.0  # degrees, counter-clockwise seen from +y
+    matrix: tuple | None = None  # the model matrix given whole (16 numbers, row-major): a glTF node's world
 
     @property
     def model(self) -> np.ndarray:
+        if self.matrix is not None:
+            return np.array(self.matrix, np.float64).reshape(4, 4)
         c, s = np.cos(np.radians(self.rotate_y)), np.sin(np.radians(self.rotate_y))
         m = np.eye(4)
         m[:3, :3] = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]) @ np.diag(self.scale)
@@ -58,6 +66,11 @@ class Placed:
 
     def corners(self) -> np.ndarray:
         """The world positions of the corners of the mesh's bounds, (8, 3) (a plane's are 4, given twice)."""
+        if not isinstance(self.mesh, str):  # a glTF primitive: the box of its positions
+            p = np.asarray(self.mesh.positions, np.float64).reshape(-1, 3)
+            lo, hi = (p.min(0), p.max(0)) if len(p) else (np.zeros(3), np.zeros(3))
+            local = np.array([(x, y, z, 1.0) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+            return (self.model @ local.T).T[:, :3]
         y = (0.0,) if self.mesh == "plane" else (-1.0, 1.0)
         local = np.array([(x, yy, z, 1.0) for x in (-1.0, 1.0) for yy in y for z in (-1.0, 1.0)])
         local = np.concatenate([local] * (8 // len(local)))
@@ -122,7 +135,8 @@ _CAMERA_KEYS = ("eye", "target", "fov_y")
 
 def load_placement(scene, path=None) -> Placement:
     """The placement of `scene`'s objects: from `path` (default :func:`placement_path` of the scene), or the
-    fallback row when that file does not exist (an explicit `path` must exist).
+    fallback row when that file does not exist (an explicit `path` must exist). A glTF scene without an
+    explicit `path` draws its own meshes at their nodes' world matrices.
 
     Schema (TOML)::
 
@@ -144,6 +158,12 @@ def load_placement(scene, path=None) -> Placement:
 
     names = [o["name"] for o in scene.objects]
     explicit = path is not None
+    if not explicit and scene.objects and all(o.get("mesh") is not None and not isinstance(o.get("mesh"), str)
+                                              and o.get("model") is not None for o in scene.objects):
+        # a glTF scene: every object is a primitive with its mesh and its node's world matrix; the camera
+        # frames their bounds
+        return Placement([Placed(o["name"], o["mesh"], matrix=tuple(np.asarray(o["model"], np.float64).ravel()))
+                          for o in scene.objects], source=Path(scene.path))
     path = Path(path) if explicit else placement_path(scene.path)
     if not path.exists():
         if explicit:

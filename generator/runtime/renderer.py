@@ -29,7 +29,11 @@ box-filtered on the host (:func:`moments_map`) and uploaded as an RGBA32F image.
 (pcf_hardware) reads the depth pass's D32_SFLOAT image itself through a comparison sampler
 (runtime/depth_images.py: linear, compareOp LESS_OR_EQUAL), where no map is drawn a lit 1×1 depth image
 (depth 1.0); a device that cannot linearly filter D32_SFLOAT is refused for it. Other textures
-are generated: an sRGB albedo checker, a normal map of known bumps. Pipelines are created through
+are generated: an sRGB albedo checker, a normal map of known bumps. The surface state of a permutation
+(matrix/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
+pipelines blend source-over and are drawn after the opaque ones (not sorted by depth), the back faces of
+what a glTF file calls single-sided are culled (TOML objects keep cull mode none); the ubershader implements
+none of it (it stands in for the BRDF, packing and output only), and the depth pass ignores coverage. Pipelines are created through
 a persisted pipeline cache (runtime/pipeline_cache.py), and when the render opens its own device,
 Mesa's shader disk cache lives in out/shader_cache and the driver's hit and miss counts go into the
 report (runtime/shader_cache.py).
@@ -278,11 +282,13 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         report.cache_problem = cache.problem
         target = gx.OffscreenTarget(device, W, H)
         owned += [target, cache]
-        meshes = {}
-        for kind in dict.fromkeys(o.mesh for o in placed.objects):
-            meshes[kind] = gx.GpuMesh(device, make_mesh(kind))
-            owned.append(meshes[kind])
-        mesh_of = [meshes[o.mesh] for o in placed.objects]
+        meshes = {}  # by name (sphere, plane, box) or by object (a glTF primitive's mesh, maybe instanced)
+        key_of = [o.mesh if isinstance(o.mesh, str) else id(o.mesh) for o in placed.objects]
+        for o, key in zip(placed.objects, key_of):
+            if key not in meshes:
+                meshes[key] = gx.GpuMesh(device, make_mesh(o.mesh))
+                owned.append(meshes[key])
+        mesh_of = [meshes[k] for k in key_of]
         # One bilinear sampler for every texture, shadow maps included: the one tap of the shadow brick then
         # compares against depth averaged over 2×2 texels, which with one bias is what keeps a point
         # light's perspective map free of acne here (a nearest sampler acnes: NOTES.md, "Renderer").
@@ -306,8 +312,10 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     frag = spv[(f"{tag}{variant}", "frag")]
                 else:
                     spec = {SPEC_VARIANT: variant}
+            sf = perms[tag].surface if tag in perms else None  # the ubershader: no surface state (NOTES.md)
             p = gx.GraphicsPipeline(device, target, spv[(tag, "vert")], frag, iface.vertex_inputs,
-                                    gx.layouts_from_interface(iface), cache=cache, specialization=spec)
+                                    gx.layouts_from_interface(iface), cache=cache, specialization=spec,
+                                    cull_back=tag in single_sided, blend=sf is not None and sf.alpha == "blend")
             owned.append(p)  # released whatever happens next (list.append is atomic: the worker may call this)
             report.pipeline_create_ms.append((time.perf_counter() - t0) * 1e3)
             report.pipelines_created += 1
@@ -315,6 +323,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             return p
 
         object_bufs = [buf(gx.object_bytes(o.model), U) for o in placed.objects]
+        # Back faces are culled for what a glTF file says is single-sided (its objects carry double_sided
+        # False); a TOML scene's objects keep cull mode none, as they were always drawn (matrix/surface.py).
+        single_sided = {o["permutation"] for o in scene.objects if o.get("double_sided") is False}
 
         # Depth passes: one DepthTarget per shadowed light, every object drawn by a vertex-only pipeline.
         shadow_maps, moments = {}, {}
@@ -357,7 +368,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                       if x["material"] == name)
             data = np.zeros((u.material_vec4s, 4), np.float32)
             block = np.frombuffer(bytes.fromhex(up.get("Material", "")), np.float32).reshape(-1, 4)
-            data[:len(block)] = block
+            n = min(len(block), len(data))  # the surface state's values come last, and the ubershader has none
+            data[:n] = block[:n]
             k = variant[(p.brdf, p.packing, p.output)]
             mat_ids.append((k, 0, 0, 0))
             mat_rows.append(data)
@@ -451,6 +463,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, sampler_of(t)
             draws.append((h, spec, ub, mesh_of[i]))
 
+        # blended surfaces after the opaque ones, in scene order otherwise (no sorting by depth: NOTES.md)
+        draws.sort(key=lambda d: perms[d[0]].surface.alpha == "blend")
         specialized: dict[str, object] = {}
         order = list(dict.fromkeys(h for h, _, _, _ in draws))  # first use
         start = time.perf_counter()

@@ -12,10 +12,10 @@
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template glsl/fragment.glsl.j2 sha256:32d05b26605c
+// template glsl/fragment.glsl.j2 sha256:37bd50385640
 // template glsl/macros.glsl.j2 sha256:0712fef74734
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
@@ -90,6 +90,12 @@ vec3 normal_map_normal(vec3 N, vec3 T, vec3 B, vec2 uv, texture2D normal_map, sa
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
 }
 
+vec3 normal_map_tangent(vec3 Np, vec3 T) {
+#line 22 "bricks/packing/normal/normal_map.py"
+    vec3 t = (T - (dot(T, Np) * Np));
+    return (t * inversesqrt(max(dot(t, t), 1e-06)));
+}
+
 #line 15 "bricks/packing/albedo_texture.py"
 vec3 albedo_texture_512f91_get_rho_d(vec2 uv, texture2D albedo_map, sampler _smp_albedo_map, vec3 rho_d) {
     return (rho_d * texture(sampler2D(albedo_map, _smp_albedo_map), uv).xyz);
@@ -160,7 +166,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, vec3 m_rho_d, float
 }
 
 
-#line 164 "ec099fb79c17.frag.glsl"
+#line 170 "ec099fb79c17.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

@@ -20,7 +20,7 @@
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
@@ -212,6 +212,12 @@ vec3 brdf_lit_3(vec3 L, vec3 V, vec3 N, vec3 rho_d, float alpha, vec3 f0) {
 vec3 normal_map_normal(vec3 N, vec3 T, vec3 B, vec2 uv, texture2D normal_map, sampler _smp_normal_map) {
     vec3 t = ((texture(sampler2D(normal_map, _smp_normal_map), uv).xyz * 2.0) - vec3(1.0));
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
+}
+
+vec3 normal_map_tangent(vec3 Np, vec3 T) {
+#line 22 "bricks/packing/normal/normal_map.py"
+    vec3 t = (T - (dot(T, Np) * Np));
+    return (t * inversesqrt(max(dot(t, t), 1e-06)));
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
@@ -425,7 +431,7 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, int material, textu
 }
 
 
-#line 429 "ubershader.frag.glsl"
+#line 435 "ubershader.frag.glsl"
 void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);

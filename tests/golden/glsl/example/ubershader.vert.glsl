@@ -19,12 +19,12 @@
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template glsl/macros.glsl.j2 sha256:0712fef74734
-// template glsl/vertex.glsl.j2 sha256:f82bfd289b63
+// template glsl/vertex.glsl.j2 sha256:416c66bbdad2
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 

@@ -11,7 +11,7 @@
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
-// template hlsl/fragment.hlsl.j2 sha256:1f6cb2a72a74
+// template hlsl/fragment.hlsl.j2 sha256:7b706c539c1e
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };

@@ -12,7 +12,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
-// template hlsl/vertex.hlsl.j2 sha256:ad4a8af5dca3
+// template hlsl/vertex.hlsl.j2 sha256:0e528599ae7b
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 

@@ -10,10 +10,10 @@
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template hlsl/fragment.hlsl.j2 sha256:1f6cb2a72a74
+// template hlsl/fragment.hlsl.j2 sha256:7b706c539c1e
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
@@ -90,6 +90,12 @@ float3 normal_map_normal(float3 N, float3 T, float3 B, float2 uv, Texture2D norm
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
 }
 
+float3 normal_map_tangent(float3 Np, float3 T) {
+#line 22 "bricks/packing/normal/normal_map.py"
+    float3 t = (T - (dot(T, Np) * Np));
+    return (t * rsqrt(max(dot(t, t), 1e-06)));
+}
+
 #line 15 "bricks/packing/albedo_texture.py"
 float3 albedo_texture_512f91_get_rho_d(float2 uv, Texture2D albedo_map, SamplerState _smp_albedo_map, float3 rho_d) {
     return (rho_d * albedo_map.Sample(_smp_albedo_map, uv).xyz);
@@ -160,7 +166,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, float
 }
 
 
-#line 164 "ec099fb79c17.frag.hlsl"
+#line 170 "ec099fb79c17.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

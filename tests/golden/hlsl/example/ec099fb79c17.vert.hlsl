@@ -10,11 +10,11 @@
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
-// template hlsl/vertex.hlsl.j2 sha256:ad4a8af5dca3
+// template hlsl/vertex.hlsl.j2 sha256:0e528599ae7b
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 

@@ -18,7 +18,7 @@
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
@@ -226,6 +226,12 @@ float3 brdf_lit_3(float3 L, float3 V, float3 N, float3 rho_d, float alpha, float
 float3 normal_map_normal(float3 N, float3 T, float3 B, float2 uv, Texture2D normal_map, SamplerState _smp_normal_map) {
     float3 t = ((normal_map.Sample(_smp_normal_map, uv).xyz * 2.0) - ((float3)(1.0)));
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
+}
+
+float3 normal_map_tangent(float3 Np, float3 T) {
+#line 22 "bricks/packing/normal/normal_map.py"
+    float3 t = (T - (dot(T, Np) * Np));
+    return (t * rsqrt(max(dot(t, t), 1e-06)));
 }
 
 #line 15 "bricks/packing/albedo_texture.py"
@@ -439,7 +445,7 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, int m
 }
 
 
-#line 443 "ubershader.frag.hlsl"
+#line 449 "ubershader.frag.hlsl"
 float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);

@@ -11,7 +11,7 @@
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
 // template hlsl/macros.hlsl.j2 sha256:88a641fa5070
-// template hlsl/vertex.hlsl.j2 sha256:ad4a8af5dca3
+// template hlsl/vertex.hlsl.j2 sha256:0e528599ae7b
 
 cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 

@@ -12,7 +12,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template wgsl/fragment.wgsl.j2 sha256:a29ee6bbc5f9
+// template wgsl/fragment.wgsl.j2 sha256:2251700a77bb
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }

@@ -10,10 +10,10 @@
 // brick bricks/light/point.py sha256:44797f65469c
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template wgsl/fragment.wgsl.j2 sha256:a29ee6bbc5f9
+// template wgsl/fragment.wgsl.j2 sha256:2251700a77bb
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
 
 struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
@@ -74,6 +74,11 @@ fn brdf_lit(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, alpha: f
 fn normal_map_normal(N: vec3<f32>, T: vec3<f32>, B: vec3<f32>, uv: vec2<f32>, normal_map: texture_2d<f32>, _smp_normal_map: sampler) -> vec3<f32> {
     var t: vec3<f32> = ((textureSample(normal_map, _smp_normal_map, uv).xyz * 2.0f) - vec3<f32>(1.0f));
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
+}
+
+fn normal_map_tangent(Np: vec3<f32>, T: vec3<f32>) -> vec3<f32> {
+    var t: vec3<f32> = (T - (dot(T, Np) * Np));
+    return (t * inverseSqrt(max(dot(t, t), 1e-06f)));
 }
 
 fn albedo_texture_512f91_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, rho_d: vec3<f32>) -> vec3<f32> {

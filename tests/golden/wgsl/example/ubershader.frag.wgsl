@@ -18,7 +18,7 @@
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
@@ -181,6 +181,11 @@ fn brdf_lit_3(L: vec3<f32>, V: vec3<f32>, N: vec3<f32>, rho_d: vec3<f32>, alpha:
 fn normal_map_normal(N: vec3<f32>, T: vec3<f32>, B: vec3<f32>, uv: vec2<f32>, normal_map: texture_2d<f32>, _smp_normal_map: sampler) -> vec3<f32> {
     var t: vec3<f32> = ((textureSample(normal_map, _smp_normal_map, uv).xyz * 2.0f) - vec3<f32>(1.0f));
     return normalize((((t.x * T) + (t.y * B)) + (t.z * N)));
+}
+
+fn normal_map_tangent(Np: vec3<f32>, T: vec3<f32>) -> vec3<f32> {
+    var t: vec3<f32> = (T - (dot(T, Np) * Np));
+    return (t * inverseSqrt(max(dot(t, t), 1e-06f)));
 }
 
 fn albedo_texture_512f91_get_rho_d(uv: vec2<f32>, albedo_map: texture_2d<f32>, _smp_albedo_map: sampler, rho_d: vec3<f32>) -> vec3<f32> {

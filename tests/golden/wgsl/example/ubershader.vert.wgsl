@@ -18,12 +18,12 @@
 // brick bricks/output/linear.py sha256:cd21e9aab58c
 // brick bricks/packing/albedo_texture.py sha256:577a026d2848
 // brick bricks/packing/constants.py sha256:df1740cdcbbf
-// brick bricks/packing/normal/normal_map.py sha256:c3aa4530af41
+// brick bricks/packing/normal/normal_map.py sha256:c88281c4cc6b
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
-// template wgsl/vertex.wgsl.j2 sha256:9c77a8d527bb
+// template wgsl/vertex.wgsl.j2 sha256:41c5d31a11a2
 
 struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;

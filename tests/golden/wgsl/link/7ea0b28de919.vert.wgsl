@@ -9,7 +9,7 @@
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
 // template wgsl/macros.wgsl.j2 sha256:da1d910c1d17
-// template wgsl/vertex.wgsl.j2 sha256:9c77a8d527bb
+// template wgsl/vertex.wgsl.j2 sha256:41c5d31a11a2
 
 struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;
