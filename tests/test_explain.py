@@ -142,6 +142,24 @@ def test_matrix_counts_every_stage_and_explains_every_value(tmp_path):
     assert "## Axis values" in md.stdout and "dropped: light set(s) night" in md.stdout
 
 
+def test_surface_states_are_an_axis_of_the_matrix(tmp_path):
+    scene = tmp_path / "s.toml"
+    scene.write_text(SCENE.replace('[lights.lamp]', '[materials.c]\nbrdf = "lambert"\nalpha = "mask"\n'
+                                   'double_sided = true\n\n[lights.lamp]'))
+    bricks = tmp_path / "bricks"
+    bricks.mkdir()
+    (bricks / "lam_a.py").write_text(LAMBERT_COPY)
+    (bricks / "lam_b.py").write_text(LAMBERT_COPY)
+    r = _cli(scene, "--bricks", bricks, "--explain", "--format", "json", "--no-compile")
+    assert r.returncode == 0, r.stderr
+    rep = json.loads(r.stdout)
+    surface = {v["value"]: v for v in rep["axes"] if v["axis"] == "surface"}
+    assert set(surface) == {"default", "alpha=mask;double_sided=true"}
+    assert surface["default"]["kept"] and not surface["alpha=mask;double_sided=true"]["kept"]
+    assert "c" in surface["alpha=mask;double_sided=true"]["why"]
+    assert {s["stage"]: s["count"] for s in rep["stages"]}["full product"] == 3 * 2 * 2 * 2
+
+
 def test_matrix_of_the_example_lists_the_forbidden_pairs():
     r = _cli(REPO / "scenes" / "example.toml", "--explain", "--no-compile")
     assert r.returncode == 0, r.stderr

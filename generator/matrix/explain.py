@@ -1,7 +1,7 @@
 """How a scene's matrix is pruned, stage by stage, and why each axis value is kept or dropped.
 
-The axes of a scene's matrix are the values its declarations name: the BRDFs and
-packings of its materials, the light configurations of its light sets (light
+The axes of a scene's matrix are the values its declarations name: the BRDFs,
+packings and surface states (alpha, sidedness, vertex colours, emission) of its materials, the light configurations of its light sets (light
 brick and shadow filter per light, in order), its output transform and its
 precision. Four counts:
 
@@ -49,7 +49,13 @@ def axes(scene: Scene) -> dict[str, list]:
                           for members in scene.light_sets.values())
     return {"brdf": _first_seen(m.brdf for m in scene.materials.values()),
             "packing": _first_seen(m.packing for m in scene.materials.values()),
+            "surface": _first_seen(m.surface for m in scene.materials.values()),
             "lights": configs, "output": [scene.output], "precision": [scene.precision]}
+
+
+def _surface_text(surface) -> str:
+    """A surface state as the key writes it, without the leading ';' ('default' at the defaults)."""
+    return surface.canonical().lstrip(";") or "default"
 
 
 def _lights_text(config) -> str:
@@ -69,7 +75,7 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
     for brdf, packing in product(ax["brdf"], ax["packing"]):
         pairs[(brdf, packing)] = violations(Permutation(brdf, (), packing, scene.output, scene.precision), lib)
     valid_pairs = [k for k, v in pairs.items() if not v]
-    valid = len(valid_pairs) * len(ax["lights"]) * len(ax["output"]) * len(ax["precision"])
+    valid = len(valid_pairs) * len(ax["surface"]) * len(ax["lights"]) * len(ax["output"]) * len(ax["precision"])
 
     materials_of: dict[str, list[str]] = {}
     for o in scene.objects:
@@ -82,7 +88,7 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
                "of": " × ".join(f"{len(v)} {k}" for k, v in ax.items())},
               {"stage": "valid", "count": valid,
                "of": f"{len(valid_pairs)} of {len(pairs)} BRDF × packing pairs pass the constraints, "
-                     f"× {len(ax['lights'])} light configurations"},
+                     f"× {len(ax['surface'])} surface states × {len(ax['lights'])} light configurations"},
               {"stage": "used", "count": used, "of": f"{len(scene.objects)} objects draw {used} distinct permutations; "
                                                      f"{valid - used:,} valid combinations are drawn by no object"}]
     merged_into: dict[str, str] = {}
@@ -106,6 +112,9 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
             elif axis == "packing":
                 mats = [m.name for m in scene.materials.values() if m.packing == v]
                 hs = [h for h, p in scene.permutations.items() if p.packing == v]
+            elif axis == "surface":
+                mats = [m.name for m in scene.materials.values() if m.surface == v]
+                hs = [h for h, p in scene.permutations.items() if p.surface == v]
             elif axis == "lights":
                 sets = [n for n, members in scene.light_sets.items()
                         if tuple((scene.lights[x].type, scene.lights[x].shadow) for x in members) == v]
@@ -123,7 +132,8 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
                 why = f"dropped: light set(s) {_names(mats)} are lit on no object"
             else:
                 why = f"dropped: material(s) {_names(mats)} are drawn by no object"
-            values.append({"axis": axis, "value": _lights_text(v) if axis == "lights" else v,
+            text = _lights_text(v) if axis == "lights" else _surface_text(v) if axis == "surface" else v
+            values.append({"axis": axis, "value": text,
                            "kept": bool(objs), "why": why, "declared_by": mats, "permutations": hs})
     invalid = [{"brdf": b, "packing": p, "why": [f"{n}: {w}" for n, w in pairs[(b, p)]]}
                for (b, p) in pairs if pairs[(b, p)]]
