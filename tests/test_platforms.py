@@ -156,7 +156,7 @@ def test_gl_validation_errors_name_the_brick_line():
     errors = validate_dialects(jobs)
     assert errors["a.frag.gl"] == []
     assert errors["b.frag.gl"] and errors["b.frag.gl"][0].startswith("bricks/x.py:7:0: error:")
-    assert "nope" in errors["b.frag.gl"][0]
+    assert "nope" in errors["b.frag.gl"][0] and not any("compilation terminated" in e for e in errors["b.frag.gl"])
     assert errors["c.frag.essl"] and "precision" in errors["c.frag.essl"][0]
 
 
@@ -175,3 +175,22 @@ def test_platform_option_builds_only_those_trees_and_packs(tmp_path):
     bad = subprocess.run([*cli, "--platform", "metal"], capture_output=True, text=True, cwd=REPO)
     assert bad.returncode == 2 and "--platform: 'metal' is not a comma-separated list of vulkan, d3d12, gl, webgpu" \
         in bad.stderr
+
+
+def test_essl_at_fp16_is_mediump_in_the_fragment_stage_only(lib, tmp_path):
+    """fp16: the ES vertex transform stays highp (as the other languages' vertex shaders stay 32-bit), and
+    Frame, declared by both stages, is highp in both (an ES program's uniforms match across stages)."""
+    from generator.compose import compose_permutation
+    from generator.matrix.scene import load_scene
+    from generator.toolchain import CompileJob
+    from generator.toolchain.platforms import validate_dialects
+    scene_file = tmp_path / "fp16.toml"
+    scene_file.write_text(re.sub(r'(?m)^precision = "fp32"$', 'precision = "fp16"', EXAMPLE.read_text()))
+    scene = load_scene(scene_file, lib)
+    h = sorted(scene.permutations)[0]
+    es = {s.stage: s for s in compose_permutation(scene.permutations[h], lib, ("glsl",), ("essl",)).dialects}
+    assert "precision highp float;" in es["vert"].text and "precision mediump float;" in es["frag"].text
+    for s in es.values():
+        assert "uniform Frame { highp mat4 view_proj; highp vec4 camera_pos; }" in s.text
+    jobs = [CompileJob(f"{h}.{s.stage}.essl", "essl", s.stage, s.text, line_map=tuple(s.line_map)) for s in es.values()]
+    assert validate_dialects(jobs) == {j.key: [] for j in jobs}

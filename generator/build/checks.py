@@ -17,8 +17,10 @@ All checks asked for at once are composed once per permutation and compiled in o
 shaders once, through the compile cache); a failure reads as the brick line that caused it (the
 compilers' diagnostics are mapped back through #line, or the GL sources' line map). Golden sources are
 named by permutation, not by content, so a drift is a diff of one file. `languages` narrows what is
-checked as `build_scene(languages=...)` narrows what is built: a platform is checked when the language it
-is made from (platforms.PLATFORM_LANGUAGE) is one of them, and vulkan compiles only those languages.
+checked as `build_scene(languages=...)` narrows what is built: a platform is checked when one of the
+languages it is made from (MADE_FROM; vulkan: any) is given, and vulkan compiles only those
+given. (`build` is narrower: it writes a platform only when its platforms.PLATFORM_LANGUAGE is built,
+so vulkan needs GLSL there.)
 """
 from __future__ import annotations
 

@@ -77,7 +77,7 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
     stages = sorted({s.stage for s in composed.sources}, key=("vert", "frag", "comp").index)
     out, errs = {}, []
 
-    def put(tree: str, lang: str, stage: str, data: bytes, kind: str) -> dict:
+    def put(tree: str, stage: str, data: bytes, kind: str) -> dict:
         digest = sha256(data)
         rel = f"{tree}/{name}.{stage}.{digest[:12]}.{EXT[kind]}"
         write(rel, data)
@@ -98,12 +98,12 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
         elif p == "d3d12":
             for stage in stages:
                 src = sources[("hlsl", stage)]
-                item = {"hlsl": put("d3d12", "hlsl", stage, src.text.encode(), "hlsl")}
+                item = {"hlsl": put("d3d12", stage, src.text.encode(), "hlsl")}
                 if dxil is not None:
                     blob, e = dxil(name, src, precision)
                     errs += e
                     if blob is not None:
-                        item["dxil"] = put("d3d12", "hlsl", stage, blob, "dxil")
+                        item["dxil"] = put("d3d12", stage, blob, "dxil")
                 d["stages"][stage] = item
             from ..toolchain.platforms import DX_PROFILES
             d.update(profiles={s: DX_PROFILES[(s, precision)] for s in stages},
@@ -114,15 +114,15 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
             for stage in stages:
                 core = dialect_errors.get(f"{name}.{stage}.gl", [])
                 errs += core
-                item = {"glsl": put("gl", "gl", stage, sources[("gl", stage)].text.encode(), "gl")}
+                item = {"glsl": put("gl", stage, sources[("gl", stage)].text.encode(), "gl")}
                 if not es_errors:
-                    item["essl"] = put("gl", "essl", stage, sources[("essl", stage)].text.encode(), "essl")
+                    item["essl"] = put("gl", stage, sources[("essl", stage)].text.encode(), "essl")
                 d["stages"][stage] = item
             d.update(versions={"glsl": "450 core", "essl": "310 es"},
                      essl="ok" if not es_errors else {"unsupported": es_errors})
         elif p == "webgpu":
             for stage in stages:
-                d["stages"][stage] = {"wgsl": put("webgpu", "wgsl", stage, sources[("wgsl", stage)].text.encode(),
+                d["stages"][stage] = {"wgsl": put("webgpu", stage, sources[("wgsl", stage)].text.encode(),
                                                   "wgsl")}
             d.update(cost={s: langs["wgsl"][s]["cost"] for s in stages}, cost_from="wgsl SPIR-V (naga)")
         d["reflection"] = platform_reflection(composed.interface, p)

@@ -15,8 +15,8 @@ OpenGL's binding model (GLSL 4.50 spec §4.4.5 "Uniform and Shader Storage Block
   all: glslangValidator's messages are mapped back through the line map instead), no
   `constant_id` specialization constants (GLSL for OpenGL has none without GL_ARB_gl_spirv).
 - **ES 3.10** (`EsslTarget`): `#version 310 es` and default precision qualifiers — `highp`, or
-  `mediump` for a permutation whose key says fp16 (ESSL's way of allowing half precision;
-  ESSL 3.10 §4.7.2: mediump has at least 16-bit float range and 10-bit mantissa).
+  `mediump` in the fragment stage of a permutation whose key says fp16 (ESSL's way of allowing half
+  precision; ESSL 3.10 §4.7.2: mediump has at least 16-bit float range and 10-bit mantissa).
 
 Desktop GL at fp16 is emitted at 32-bit floats: GL has no portable half arithmetic (the float16
 extension is the Vulkan path's).
@@ -88,7 +88,7 @@ class GlTarget(GlslTarget):
 
     def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
         raise ValueError(f"specialization constant '{name}': GLSL for OpenGL has none (GL_ARB_gl_spirv only) — "
-                         "the ubershader is built for the Vulkan and WebGPU platforms")
+                         "the ubershader is built for the vulkan platform only")
 
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
         """sampler2D (samplerCube, sampler2DShadow) NAME on the texture unit of Vulkan (set, binding)."""
@@ -112,8 +112,12 @@ class EsslTarget(GlTarget):
 
     def precision_lines(self, stage: str) -> list[str]:
         """ESSL has no default float precision in fragment shaders (§4.7.4), and samplers default to lowp:
-        every type the shaders use gets one. fp16 keys ask for mediump (half where the GPU has it)."""
-        p = "mediump" if self.key_precision == "fp16" else "highp"
+        every type the shaders use gets one. fp16 keys ask for mediump (half where the GPU has it) in the
+        fragment stage only: the vertex transform stays highp, as the other languages' vertex shaders stay
+        32-bit at fp16 (mediump world positions would lose about a unit in 2^11), and the Frame block both
+        stages declare spells its members highp (macros.gl.j2: a uniform's precision must match across
+        the stages of an ES program)."""
+        p = "mediump" if self.key_precision == "fp16" and stage == "frag" else "highp"
         types = ["float", "int"] + (["sampler2D", "samplerCube", "sampler2DShadow"] if stage == "frag" else [])
         return [f"precision {p if t == 'float' else 'highp'} {t};" for t in types]
 

@@ -18,6 +18,7 @@
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import re
@@ -85,7 +86,7 @@ def _batch(tool: str, tmp: str, items: list[tuple[int, CompileJob]]) -> dict[str
         m = _MESSAGE.match(line)
         if current is None or not m or _SUMMARY.match(line) or m["sev"] != "ERROR":
             continue
-        if m["line"] is None and "compilation terminated" in m["msg"]:
+        if "compilation terminated" in m["msg"]:  # glslang's trailer after the real error, with or without a line
             continue
         path, lineno = _map_line(current, int(m["line"])) if m["line"] else (current.key, 0)
         msg = re.sub(r"^'' :\s+", "", m["msg"].strip())
@@ -100,8 +101,12 @@ def _batch(tool: str, tmp: str, items: list[tuple[int, CompileJob]]) -> dict[str
 def dxc_version() -> str:
     """dxc's version line, or "missing" (the d3d12 platform then ships HLSL without DXIL)."""
     path = _tc.find_tool("dxc")
-    if path is None:
-        return "missing"
+    return "missing" if path is None else _dxc_version_at(path)
+
+
+@functools.lru_cache(maxsize=4)
+def _dxc_version_at(path: str) -> str:
+    """Once per process and dxc path (a build asks for every permutation's d3d12 tools, as tool_versions is)."""
     try:
         _, out = _run([path, "--version"])
     except OSError as exc:
