@@ -158,3 +158,41 @@ def test_the_tables_command_lists_and_bakes(tmp_path):
     r = cli("--bake", "ndf_map", "--image", "bricks/brdf/painted/ndf_map_anisotropic.png", "--out", str(tmp_path / "m.ktx2"))
     assert r.returncode == 1 and r.stderr.startswith("error: bricks/brdf/painted/ndf_map_anisotropic.png:1:1: ")
     assert not (tmp_path / "m.ktx2").exists()
+
+
+def test_two_bricks_may_not_declare_different_tables_under_one_texture_name(tmp_path):
+    from generator.library.bricks import load_library
+
+    a = TABLE_BRICK.replace("TEX", '{"table": "oren_nayar_sin_sin", "size": [8, 8], "format": "fp16"}')
+    (tmp_path / "ta.py").write_text(a)
+    (tmp_path / "tb.py").write_text(a.replace('[8, 8]', '[16, 16]'))
+    with pytest.raises(SourceError, match=r"texture 't' of diffuse brick 'tb' is table 'oren_nayar_sin_sin' 16x16 fp16, "
+                                          r"but diffuse brick 'ta'"):
+        load_library([tmp_path])
+    (tmp_path / "tb.py").write_text(a)  # the same table at the same size and format: one texture, fine
+    assert set(load_library([tmp_path]).tables()) >= {"t"}
+
+
+def test_table_error_checks_between_the_centres_of_a_fine_table():
+    """A fixed 257-point grid lands on the texel centres of a 256-texel axis and saw none of the filter's error
+    (1.7e-4 reported for sin θ_i sin θ_r at 256², 2.2e-2 in truth: its square-root edge)."""
+    coarse = tables.table_error("oren_nayar_sin_sin", (128, 128), "fp32")["max_rel"]
+    fine = tables.table_error("oren_nayar_sin_sin", (256, 256), "fp32")["max_rel"]
+    assert 0.5 * coarse < fine < coarse, (coarse, fine)  # O(√h) at the edge: a factor √2 per doubling
+
+
+def test_bakers_refuse_what_they_cannot_bake_with_a_message(tmp_path):
+    from PIL import Image
+
+    from generator.reference import tables_painted as tp
+
+    with pytest.raises(ValueError, match="beyond the dense solve"):  # refused before a 19 GB matrix is made
+        tables.lookup("homomorphic_p").bake(64, 64)
+    with pytest.raises(ValueError, match="faces are square"):
+        tables.lookup("homomorphic_q").bake(16, 8)
+    spike = np.zeros((1, 2048, 3), np.uint8)
+    spike[0, 0] = 255  # one painted pixel: K_N p overflows half's 65504
+    Image.fromarray(spike, "RGB").save(tmp_path / "spike.png")
+    with pytest.raises(SourceError, match="does not fit fp16") as e:
+        tp.bake_painted("ndf_map", tmp_path / "spike.png", (2048, 1))
+    assert str(e.value).startswith(f"{tmp_path / 'spike.png'}:1:1: ")

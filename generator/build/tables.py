@@ -16,18 +16,9 @@ from pathlib import Path
 
 from .. import __version__
 from ..io import atomic_write
+from ..lang.errors import UserError
 
 TABLES_DIR = "tables"
-
-
-def declared(lib) -> dict[str, dict]:
-    """{texture name: its declaration} of every texture a brick of `lib` declares as a baked table."""
-    out = {}
-    for b in lib.bricks.values():
-        for name, d in b.textures.items():
-            if d.get("table"):
-                out[name] = {**d, "brick": b.id}
-    return out
 
 
 def _users(manifest: dict, names) -> dict[str, list[str]]:
@@ -48,13 +39,17 @@ def write_tables(out: Path, lib, manifest: dict, count=None) -> list[dict]:
     from ..reference.tables import baked, lookup, sha256, table_error
     from .ktx2 import encode
 
-    decl = declared(lib)
+    decl = lib.tables()
     users = _users(manifest, decl)
     rows = []
     for name in sorted(users):
         d = decl[name]
         w, h = d["size"]
-        stored = baked(d["table"], d["size"], d["format"])
+        try:
+            stored = baked(d["table"], d["size"], d["format"])
+        except (LookupError, ValueError) as e:  # an unknown table, a size or format its baker refuses
+            raise UserError(f"brick '{d['brick']}', texture '{name}': table '{d['table']}' at {w}x{h} "
+                            f"{d['format']}: {e}") from None
         cube = lookup(d["table"]).cube
         data = encode(stored, d["format"], cube=cube, writer=f"shadermatrix {__version__}")
         import hashlib

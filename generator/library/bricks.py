@@ -94,6 +94,12 @@ class Library:
     def of_kind(self, kind: str) -> list[Brick]:
         return sorted((b for (k, _), b in self.bricks.items() if k == kind), key=lambda b: b.id)
 
+    def tables(self) -> dict[str, dict]:
+        """{texture name: its declaration and "brick"} of every texture a brick declares as a baked table
+        (one per name: load_library refuses two different tables under one name)."""
+        return {name: {**d, "brick": b.id} for b in sorted(self.bricks.values(), key=lambda b: (b.kind, b.id))
+                for name, d in b.textures.items() if d.get("table")}
+
     def find(self, brick_id: str, kinds) -> list[Brick]:
         return [self.bricks[(k, brick_id)] for k in kinds if (k, brick_id) in self.bricks]
 
@@ -136,7 +142,28 @@ def load_library(extra_dirs=(), strict: bool = True) -> Library:
                 raise SourceError(b.display_path, 1, 1, f"{b.kind} brick '{b.id}' is also defined in {other.display_path}",
                                   "rename one of the files (the file stem is the brick id)")
             lib.bricks[(b.kind, b.id)] = b
+    _check_table_names(lib)
     return lib
+
+
+def _table_key(d: dict):
+    return (d.get("table"), tuple(d.get("size") or ()), d.get("format")) if d.get("table") else None
+
+
+def _check_table_names(lib: Library) -> None:
+    """Textures are bound by name (glue, ubershader, renderer, build): two bricks may share a texture name only
+    when both mean the same thing — no table, or the same table at the same size and format."""
+    seen: dict[str, Brick] = {}
+    for b in sorted(lib.bricks.values(), key=lambda b: (b.kind, b.id)):
+        for name, d in b.textures.items():
+            other = seen.setdefault(name, b)
+            if other is not b and _table_key(other.textures[name]) != _table_key(d):
+                what = lambda t: f"table '{t['table']}' {t['size'][0]}x{t['size'][1]} {t['format']}" \
+                    if t.get("table") else "a texture the scene supplies"  # noqa: E731
+                raise SourceError(b.display_path, 1, 1, f"texture '{name}' of {b.kind} brick '{b.id}' is "
+                                  f"{what(d)}, but {other.kind} brick '{other.id}' ({other.display_path}) declares "
+                                  f"it as {what(other.textures[name])}",
+                                  "rename one of the textures: textures are bound by name")
 
 
 _BUILTIN: Library | None = None

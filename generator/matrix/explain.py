@@ -162,7 +162,7 @@ def markdown(rep: dict, explain: bool) -> str:
     out += ["", "Constraints (generator/matrix/constraints.py): "
             + "; ".join(f"`{c['name']}` — {c['doc']}" for c in rep["constraints"]) + "."]
     if rep.get("notes"):  # what an importer (glTF) accepted without shading it, or left out
-        out += ["", "## Accepted, not applied", ""] + [f"- {n}" for n in rep["notes"]]
+        out += ["", "## Importer notes: what was mapped, accepted or left out", ""] + [f"- {n}" for n in rep["notes"]]
     out += ["", "## Permutations and their objects", "", "| permutation | materials | objects | merged into | key |",
             "|---|---|---|---|---|"]
     out += [f"| `{p['hash']}` | {', '.join(p['materials'])} | {', '.join(p['objects'])} | "

@@ -793,10 +793,11 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list, col
         pnodes = parse_spec(packing, lib, ("packing",))
         packing = canonical(pnodes)
         specs = spec_params(list(nodes) + pnodes + [lib.get("output", "linear")])
-        specs = surface_specs(specs, surface, lambda key, msg, todo: rd.err(ptr, msg, todo))
     except (SpecError, SourceError) as e:
         raise rd.err(ptr, f"the bricks this material maps to are missing: {e}",
                      "use the standard brick library (or --bricks with lambert, microfacet, ggx, …)") from None
+    # outside the try: its own located error (a GltfError is a SourceError) is not "missing bricks"
+    specs = surface_specs(specs, surface, lambda key, msg, todo: rd.err(ptr, msg, todo))
     for k, v in params.items():
         problem = specs[k].check(v) if k in specs else f"no parameter '{k}'"
         if problem:

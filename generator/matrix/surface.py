@@ -14,7 +14,8 @@ defaults writes nothing more and keeps its canonical string and hash (goldens, c
 - `double_sided`: false (default) | true. The fragment main reverses N, T and B on back faces
   (gl_FrontFacing / SV_IsFrontFace / @builtin(front_facing)) before shading: glTF 3.9.5, "the back-face must
   have its normals reversed before the lighting equation is evaluated". The pipeline's cull mode (none vs
-  back) is render state, not shader code: the renderer reads it from here too.
+  back) is render state, not shader code: the renderer culls the back faces of a glTF object whose material
+  is single-sided (the object's `double_sided`, runtime/renderer.py); TOML objects keep cull mode none.
 - `vertex_color`: false (default) | true. COLOR_0 (RGBA; a mesh without one reads white) is a vertex input
   and interpolant; rho_d is multiplied by its RGB before the BRDF (glTF: base colour · COLOR_0; exact for
   rho_d = base (1 − metallic); f0 = mix(0.04, base, metallic) of a metal is not tinted) and its A scales
@@ -78,11 +79,6 @@ class Surface:
         names = (["base_alpha"] if self.alpha != "opaque" else []) + (["alpha_cutoff"] if self.alpha == "mask" else []) \
             + (["emissive"] if self.emissive != "none" else [])
         return {n: SURFACE_PARAMS[n] for n in names}
-
-    @property
-    def cull_back(self) -> bool:
-        """The pipeline culls back faces (glTF: a single-sided material's back faces are not drawn)."""
-        return not self.double_sided
 
 
 DEFAULT = Surface()

@@ -262,7 +262,7 @@ class GraphicsPipeline:
 
 class GpuMesh:
     """A :class:`~.meshes.Mesh` on the device: one vertex buffer per attribute (:attr:`buffers`, by vertex-input
-    name: a_position, a_normal, a_tangent, a_uv) and a uint32 index buffer."""
+    name: a_position, a_normal, a_tangent, a_uv, a_color) and a uint32 index buffer."""
 
     def __init__(self, device: Device, mesh: "Mesh"):
         vk = device.vk

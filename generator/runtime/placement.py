@@ -8,7 +8,7 @@ row along x, SPACING apart, and camera() looks at them from above and in front.
 from __future__ import annotations
 
 import difflib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -31,15 +31,18 @@ def placement(i: int, n: int) -> np.ndarray:
     return model
 
 
-def make_mesh(kind):
+def make_mesh(kind, mirrored: bool = False):
     """The mesh a placement names: a unit UV sphere (24 × 48), a plane of side 2 in y = 0, or a box [−1, 1]³;
-    a glTF primitive's mesh is itself."""
+    a glTF primitive's mesh is itself. mirrored (Placed.mirrored): each triangle's winding reversed, so that
+    under a model matrix of negative determinant its front face stays counter-clockwise (glTF 2.0: "the
+    determinant of the node's global transform defines the winding order of that primitive")."""
     from .meshes import box, plane, uv_sphere
 
-    if not isinstance(kind, str):
-        return kind
-
-    return {"sphere": lambda: uv_sphere(24, 48), "plane": lambda: plane(2.0), "box": lambda: box(2.0)}[kind]()
+    if isinstance(kind, str):
+        kind = {"sphere": lambda: uv_sphere(24, 48), "plane": lambda: plane(2.0), "box": lambda: box(2.0)}[kind]()
+    if mirrored:
+        kind = replace(kind, indices=np.ascontiguousarray(np.asarray(kind.indices).reshape(-1, 3)[:, ::-1].ravel()))
+    return kind
 
 
 @dataclass(frozen=True)
@@ -63,6 +66,11 @@ class Placed:
         m[:3, :3] = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]) @ np.diag(self.scale)
         m[:3, 3] = self.translate
         return m
+
+    @property
+    def mirrored(self) -> bool:
+        """The model matrix reverses orientation (negative determinant: a glTF node scaled by −1 on an axis)."""
+        return bool(np.linalg.det(self.model[:3, :3]) < 0.0)
 
     def corners(self) -> np.ndarray:
         """The world positions of the corners of the mesh's bounds, (8, 3) (a plane's are 4, given twice)."""

@@ -108,12 +108,8 @@ def _textures(device, lib=None):
 def _table_images(device, lib) -> dict:
     """{texture name: a function making its image} for every texture a brick of `lib` declares as a table."""
     from ..reference.tables import baked
-    out = {}
-    for b in (lib.bricks.values() if lib is not None else ()):
-        for name, d in b.textures.items():
-            if d.get("table"):
-                out[name] = (lambda d=d: device.image(baked(d["table"], d["size"], d["format"])))
-    return out
+    tables = lib.tables() if lib is not None else {}
+    return {name: (lambda d=d: device.image(baked(d["table"], d["size"], d["format"]))) for name, d in tables.items()}
 
 
 class _TestTextures(dict):
@@ -282,11 +278,14 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         report.cache_problem = cache.problem
         target = gx.OffscreenTarget(device, W, H)
         owned += [target, cache]
-        meshes = {}  # by name (sphere, plane, box) or by object (a glTF primitive's mesh, maybe instanced)
-        key_of = [o.mesh if isinstance(o.mesh, str) else id(o.mesh) for o in placed.objects]
+        # by name (sphere, plane, box) or by object (a glTF primitive's mesh, maybe instanced), and whether the
+        # model matrix mirrors it (then uploaded with its winding reversed: front faces stay counter-clockwise
+        # for the back-face culling of single-sided materials and for gl_FrontFacing)
+        meshes = {}
+        key_of = [(o.mesh if isinstance(o.mesh, str) else id(o.mesh), o.mirrored) for o in placed.objects]
         for o, key in zip(placed.objects, key_of):
             if key not in meshes:
-                meshes[key] = gx.GpuMesh(device, make_mesh(o.mesh))
+                meshes[key] = gx.GpuMesh(device, make_mesh(o.mesh, o.mirrored))
                 owned.append(meshes[key])
         mesh_of = [meshes[k] for k in key_of]
         # One bilinear sampler for every texture, shadow maps included: the one tap of the shadow brick then

@@ -24,15 +24,15 @@ BRICK = {
         "f0": {"type": "vec3", "range": [0.0, 1.0], "default": [0.04, 0.04, 0.04],
                "doc": "R_F(0), Fresnel reflectance at normal incidence"},
     },
-    "textures": {"ndf_tex": {"table": "ndf_map_anisotropic", "size": [64, 64], "format": "fp16",
+    "textures": {"ndf_aniso_tex": {"table": "ndf_map_anisotropic", "size": [64, 64], "format": "fp16",
                              "doc": "K_N p = D/4 over (h·t, h·b) ∈ [−1, 1]²"}},
     "tolerance": 0.002,
     "needs": ["HdotT", "HdotB"],
 }
 
 
-def specular(HdotT: float, HdotB: float, f0: vec3, ndf_tex: texture2d) -> vec3:
+def specular(HdotT: float, HdotB: float, f0: vec3, ndf_aniso_tex: texture2d) -> vec3:
     # (h.t, h.b) in [-1, 1] to [0, 1], then to texel centres: x (W - 1)/W + 0.5/W for W = H = 64
     uv = vec2(HdotT, HdotB) * 0.4921875 + vec2(0.5)
-    k = sample_level(ndf_tex, uv, 0.0).xyz
+    k = sample_level(ndf_aniso_tex, uv, 0.0).xyz
     return f0 * k
