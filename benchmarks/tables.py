@@ -99,12 +99,13 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=folder, default=str(REPO / "benchmarks" / "results"),
                     help="folder for tables.md and tables.json (default: benchmarks/results)")
     args = ap.parse_args(argv)
+    from generator.io import atomic_write
     from generator.library.bricks import load_library
     results = [{"entry": e, "sweep": sweep(e)} for e in declared(load_library())]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    (out / "tables.json").write_text(json.dumps(results, indent=1) + "\n")
-    (out / "tables.md").write_text(markdown(results) + "\n")
+    atomic_write(out / "tables.json", (json.dumps(results, indent=1) + "\n").encode())
+    atomic_write(out / "tables.md", (markdown(results) + "\n").encode())
     print(f"{len(results)} tables → {out / 'tables.md'}")
     return 0
 

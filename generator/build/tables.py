@@ -6,8 +6,8 @@ A permutation (or the ubershader) that samples a texture a brick declares as a t
 name carries the texels' sha256, so a changed baker writes a new file and never overwrites one a
 manifest names; the manifest's ``tables`` list says, per table: the texture name the shaders bind, the
 table, path, sha256 of the file, format, size, bytes, the reference it is baked from, its filtered error
-against that reference (`table_error`; None for a painted or fitted table, whose error is on the BRDF:
-`shadermatrix accuracy`), and which permutations (and whether the ubershader) sample it. Files of
+against that reference (`table_error`; for a painted or fitted table, which has no exact function, the
+tolerance its brick declares, judged on the BRDF by `shadermatrix accuracy`), and which permutations (and whether the ubershader) sample it. Files of
 ``tables/`` that the new manifest no longer names are removed after it is in place.
 """
 from __future__ import annotations
@@ -62,7 +62,10 @@ def write_tables(out: Path, lib, manifest: dict, count=None) -> list[dict]:
             atomic_write(path, data)
         if count is not None:
             count(changed)
-        err = table_error(d["table"], d["size"], d["format"])
+        # the filtered table against its exact function; a painted or fitted table has none: its error is the
+        # BRDF's (`shadermatrix accuracy`), judged at the tolerance its brick declares
+        err = table_error(d["table"], d["size"], d["format"]) or {
+            "measured_on": "the BRDF (shadermatrix accuracy)", "brick_tolerance": d["tolerance"]}
         rows.append({"texture": name, "table": d["table"], "brick": d["brick"], "path": rel, "sha256": digest,
                      "texels_sha256": sha256(stored), "format": d["format"], "size": [w, h],
                      "dimension": "cube" if cube else "2d", "bytes": len(data), "reference": lookup(d["table"]).reference,

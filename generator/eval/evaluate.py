@@ -189,6 +189,9 @@ def baked_table(decl: dict) -> np.ndarray:
         return baked(decl["table"], decl["size"], decl["format"])
     except TableError as e:
         raise EvalError(str(e), "name a table of generator/reference/tables_*.py in the brick's texture") from None
+    except ValueError as e:  # a size or format the baker refuses (a non-square cube, fp16 overflow, …)
+        raise EvalError(f"table '{decl['table']}' at {decl['size']} {decl['format']}: {e}",
+                        "change the texture's size or format in the brick") from None
 
 
 def _numpy_texels(data, srgb: bool):

@@ -95,9 +95,10 @@ class Library:
         return sorted((b for (k, _), b in self.bricks.items() if k == kind), key=lambda b: b.id)
 
     def tables(self) -> dict[str, dict]:
-        """{texture name: its declaration and "brick"} of every texture a brick declares as a baked table
+        """{texture name: its declaration, "brick" and the brick's "tolerance"} of every texture a brick declares as a baked table
         (one per name: load_library refuses two different tables under one name)."""
-        return {name: {**d, "brick": b.id} for b in sorted(self.bricks.values(), key=lambda b: (b.kind, b.id))
+        return {name: {**d, "brick": b.id, "tolerance": b.tolerance}
+                for b in sorted(self.bricks.values(), key=lambda b: (b.kind, b.id))
                 for name, d in b.textures.items() if d.get("table")}
 
     def find(self, brick_id: str, kinds) -> list[Brick]:

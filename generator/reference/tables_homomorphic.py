@@ -204,10 +204,17 @@ def target_brdf(L, V) -> np.ndarray:
 
 
 _SOLVED: dict[int, dict] = {}
+# The largest cube side the dense solve takes: its normal matrix is (2 · 6 S²)² float64, 184 MB at S = 20
+# (about four such arrays at the peak); S = 32 would need 1.2 GB each and S = 64 19 GB (an iterative
+# solver then, module docstring). Refused with a ValueError before anything is allocated.
+MAX_CUBE = 20
 
 
 def solved(size: int) -> dict:
     """The factorization of the target BRDF at cube size S (one solve per size, shared by P and Q)."""
+    if not 1 <= size <= MAX_CUBE:
+        raise ValueError(f"a homomorphic factorization cube of {size} × {size} texels per face is beyond the dense "
+                         f"solve's {MAX_CUBE} (its normal matrix grows as S⁴): declare a size of at most {MAX_CUBE}")
     if size not in _SOLVED:
         L, V = sample_pairs()
         _SOLVED[size] = factorize(L, V, target_brdf(L, V), size)
@@ -224,6 +231,8 @@ def _rgba_cube(t: np.ndarray) -> np.ndarray:
        "of the reference of `homomorphic_factorization`", cube=True)
 def homomorphic_p(w: int, h: int) -> np.ndarray:
     """P: the direction factor (RGB, dimensionless, p(n) = 1), indexed by l or v in the (t, b, n) frame."""
+    if w != h:
+        raise ValueError(f"a cube map's faces are square, not {w} × {h}: declare [S, S]")
     return _rgba_cube(solved(w)["P"])
 
 
@@ -231,4 +240,6 @@ def homomorphic_p(w: int, h: int) -> np.ndarray:
        "of the reference of `homomorphic_factorization`", cube=True)
 def homomorphic_q(w: int, h: int) -> np.ndarray:
     """Q: the half-vector factor (RGB, 1/sr), indexed by h in the (t, b, n) frame."""
+    if w != h:
+        raise ValueError(f"a cube map's faces are square, not {w} × {h}: declare [S, S]")
     return _rgba_cube(solved(w)["Q"])

@@ -355,7 +355,11 @@ def bake_painted(name: str, image_path, size=None, fmt: str | None = None) -> np
     src = Painted(name, img, str(image_path))
     bake = {"ndf_map": ndf_map, "ndf_map_anisotropic": ndf_map_anisotropic, "ndf_fresnel_map": ndf_fresnel_map,
             "fresnel_ramp": fresnel_ramp}[name]
-    return quantize(bake(int(w), int(h), src), fmt or d_fmt)
+    try:
+        return quantize(bake(int(w), int(h), src), fmt or d_fmt)
+    except ValueError as e:  # fp16's 65504 (a narrow painted lobe normalizes to large K_N p): name the file
+        raise SourceError(str(image_path), 1, 1, f"the normalized table does not fit {fmt or d_fmt}: {e}",
+                          "paint a wider lobe, or bake it as fp32 (--texel-format fp32)") from None
 
 
 # ------------------------------------------------------------------ references of the painted bricks
