@@ -199,11 +199,8 @@ def studies(lib) -> tuple[list[Study], list[str]]:
         _factored("factored_oren_nayar", "Oren-Nayar", "oren_nayar_factored", "oren_nayar",
                   {"rho_d": [0.5] * 3, "sigma": 0.3}),
     ]
-    try:
-        measured = _homomorphic_params()
-    except ImportError:  # a checkout before the homomorphic factorization
-        measured = None
-    if measured is not None:
+    measured = _homomorphic_params()
+    if measured:
         # Measured: the cube-map factorization against the BRDF it was fitted to, beside the analytic
         # factored form of the same model at the same parameters (one exact model for both).
         s.append(Study("measured", "Measured: homomorphic factorization of Ashikhmin-Shirley",

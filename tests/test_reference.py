@@ -31,6 +31,10 @@ SPECS = accuracy.default_specs(LIB)  # every slot filler at least once
 # The whole filler product, the combinations beyond SPECS under the `slow` marker.
 ALL_SPECS = SPECS + [pytest.param(s, marks=pytest.mark.slow)
                      for s in accuracy.default_specs(LIB, full=True) if s not in SPECS]
+# Bricks whose approximation error is of order 1 (a 3-factor fit: homomorphic_factorization, tolerance 36): an
+# emission-vs-reference bound widened by it would pass anything finite, so the two emission tests leave them to
+# their own tests (tests/test_homomorphic.py) and to accuracy's verdict.
+EMISSION_SPECS = [s for s in ALL_SPECS if accuracy.spec_tolerance(getattr(s, "values", (s,))[0], LIB, 0.0) < 1.0]
 EPS32 = float(np.finfo(np.float32).eps)
 EPS64 = float(np.finfo(np.float64).eps)
 PARAMS = [{}, {"alpha": 0.02, "f0": [1.0, 0.5, 0.0]}, {"alpha": 1.0}, {"n": 1000.0}, {"n": 1.0, "rho_d": [0.2, 0.9, 0.0]}]
@@ -65,7 +69,7 @@ def _kappa(spec: str, p: dict) -> float:
     return 2.0 / q["alpha"] ** 2 if "alpha" in q else 0.0
 
 
-@pytest.mark.parametrize("spec", ALL_SPECS)
+@pytest.mark.parametrize("spec", EMISSION_SPECS)
 def test_reference_equals_the_float64_emission_of_the_brick(spec, hemi):
     # |f64 - ref| <= max(1e-12, 8 ulp kappa) |ref| + 1e-15 max|ref|: the absolute term covers
     # values 1e-15 below the peak, where cancelling differences (1 - v·h in Schlick's
@@ -91,7 +95,7 @@ def test_reference_equals_the_float64_emission_of_the_brick(spec, hemi):
 OVER_COS_L = {"phong"}
 
 
-@pytest.mark.parametrize("spec", ALL_SPECS)
+@pytest.mark.parametrize("spec", EMISSION_SPECS)
 def test_float32_emission_is_within_a_stated_tolerance_of_the_reference(spec, hemi):
     # |f32 - ref| <= 64 ulp (1 + kappa/16) |ref| + 2^-20 max|ref|: a ~30-operation chain
     # amplified by the lobe (see the module docstring); the absolute term covers dot

@@ -12,6 +12,7 @@ tolerance its brick declares, judged on the BRDF by `shadermatrix accuracy`), an
 """
 from __future__ import annotations
 
+import hashlib
 from pathlib import Path
 
 from .. import __version__
@@ -52,7 +53,6 @@ def write_tables(out: Path, lib, manifest: dict, count=None) -> list[dict]:
                             f"{d['format']}: {e}") from None
         cube = lookup(d["table"]).cube
         data = encode(stored, d["format"], cube=cube, writer=f"shadermatrix {__version__}")
-        import hashlib
         digest = hashlib.sha256(data).hexdigest()
         rel = f"{TABLES_DIR}/{d['table']}.{w}x{h}.{d['format']}.{digest[:12]}.ktx2"
         path = out / rel

@@ -428,12 +428,13 @@ def declared_params(spec: str, lib) -> dict:
 def spec_tolerance(spec: str, lib, tol: float) -> float:
     """The hemisphere tolerance a spec is judged at: tol, or the largest `tolerance` its bricks declare for
     their approximation (a baked table, a fit), whichever is larger."""
-    from ..matrix.permutation import parse_brdf
+    from ..lang import SourceError
+    from ..matrix.permutation import SpecError, parse_brdf
     if lib is None:
         return tol
     try:
         nodes = parse_brdf(spec, lib)
-    except Exception:
+    except (SpecError, SourceError):  # not a spec of this library: judged at tol (its own errors come elsewhere)
         return tol
     return max([tol] + [n.brick.tolerance for top in nodes for n in top.walk()])
 
