@@ -44,6 +44,18 @@ pytestmark = pytest.mark.lavapipe
 
 REPO = Path(__file__).resolve().parent.parent
 SPECS = tomllib.loads((REPO / "tests/golden/cases.toml").read_text())["eval"]
+
+
+def _samples_a_table(spec: str) -> bool:
+    from generator.eval.evaluate import program
+    return any(d.get("table") for _n, _ty, d in program(spec).textures)
+
+
+# The ulp-level agreement below is for arithmetic; a baked table is filtered by the sampler (lavapipe weighs
+# texels with 8 subtexel bits, filters across cube faces) and by NumPy exactly, so the table bricks' own tests
+# compare the GPU with NumPy at the sampler's precision (tests/test_factored.py, test_painted.py,
+# test_homomorphic.py, test_tables.py).
+ALU_SPECS = [s for s in SPECS if not _samples_a_table(s)]
 LANGS = ("glsl", "hlsl", "wgsl")
 EPS32 = float(np.finfo(np.float32).eps)
 ATOL_SCALE = 2.0 ** -20
@@ -118,7 +130,7 @@ def assert_close(got, want, kappa, what):
 
 
 @pytest.mark.parametrize("params", list(PARAM_SETS), ids=list(PARAM_SETS))
-@pytest.mark.parametrize("spec", SPECS)
+@pytest.mark.parametrize("spec", ALU_SPECS)
 @pytest.mark.toolchain  # compiles eval kernels
 def test_gpu_kernels_agree_with_numpy(device, samples, spec, params):
     from generator.eval.evaluate import evaluate, program, resolve_params
