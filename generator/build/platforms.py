@@ -52,7 +52,8 @@ def platform_tools(platform: str) -> dict[str, str]:
     """The exact versions of the tools that made and checked a platform's artifacts."""
     from ..toolchain.platforms import dxc_version
     t = tool_versions()
-    return {"vulkan": lambda: {"glslc": t["glslc"], "spirv-tools": t["spirv-tools"], "naga": t["naga"]},
+    return {"vulkan": lambda: {"glslc": t["glslc"], "glslang": t["glslang"], "spirv-tools": t["spirv-tools"],
+                               "naga": t["naga"]},  # glslang: the HLSL's SPIR-V in the vulkan tree
             "d3d12": lambda: {"glslang": t["glslang"], "dxc": dxc_version()},
             "gl": lambda: {"glslang": t["glslang"]},
             "webgpu": lambda: {"naga": t["naga"]}}[platform]()
