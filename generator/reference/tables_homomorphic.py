@@ -31,7 +31,9 @@ sparse system with a smoothness (Laplacian) regularization; so do we, with these
   P is dimensionless, Q carries 1/sr.
 
 The target by default is the reference of the brick `homomorphic_factorization` (the BRDF it
-approximates, generator/reference/specular.py). A measured BRDF (MERL binary) is not read yet.
+approximates, generator/reference/specular.py), sampled on the grid above; or a measured BRDF, a file
+of the MERL database (Matusik et al. 2003) read and sampled trilinearly by measured.py, whose
+unmeasured samples are skipped (`shadermatrix tables --bake homomorphic_p --measured FILE`).
 """
 from __future__ import annotations
 
@@ -162,9 +164,14 @@ def _rows_transpose(idx: np.ndarray, w: np.ndarray, r: np.ndarray, n: int) -> np
 def factorize(L, V, f, size: int, smooth: float = SMOOTH) -> dict:
     """Log-space least-squares factorization f ≈ P(l) Q(h) P(v) of samples f (M, C) at local directions
     L, V (M, 3): {"P", "Q": (6, S, S, C) texels, "residual": RMS log residual per channel, "baseline":
-    the RMS log residual of the best constant (P = 1, Q = the geometric mean of f)}."""
+    the RMS log residual of the best constant (P = 1, Q = the geometric mean of f), "samples": M, "used":
+    the rows fitted}. A row with a NaN (a measured BRDF's unmeasured sample, measured.py) is skipped."""
     f = np.asarray(f, np.float64)
     f = f[:, None] if f.ndim == 1 else f
+    samples = len(f)
+    keep = np.all(np.isfinite(f), 1)
+    if not keep.all():
+        L, V, f = np.asarray(L)[keep], np.asarray(V)[keep], f[keep]
     b = np.maximum(np.log(np.maximum(f, 1e-300)), LOG_FLOOR)  # 1e-300: log(0) is -inf before the floor
     n_tex = 6 * size * size
     il, wl = cube_footprint(L, size)
@@ -189,7 +196,7 @@ def factorize(L, V, f, size: int, smooth: float = SMOOTH) -> dict:
     centre = sample_cube(P, np.array([0.0, 0.0, 1.0]))  # p(n) as the brick samples it
     return {"P": P / centre, "Q": Q * centre * centre,  # gauge: p(n) = 1 (the product is unchanged)
             "residual": np.sqrt(np.mean(resid ** 2, 0)),
-            "baseline": np.sqrt(np.mean((b - b.mean(0)) ** 2, 0))}
+            "baseline": np.sqrt(np.mean((b - b.mean(0)) ** 2, 0)), "samples": samples, "used": len(f)}
 
 
 # ------------------------------------------------------------------ the tables the brick samples
@@ -203,22 +210,27 @@ def target_brdf(L, V) -> np.ndarray:
     return np.asarray(lookup("specular", "homomorphic_factorization")(g, {}, {}), np.float64)
 
 
-_SOLVED: dict[int, dict] = {}
+_SOLVED: dict[tuple, dict] = {}
 # The largest cube side the dense solve takes: its normal matrix is (2 · 6 S²)² float64, 184 MB at S = 20
 # (about four such arrays at the peak); S = 32 would need 1.2 GB each and S = 64 19 GB (an iterative
 # solver then, module docstring). Refused with a ValueError before anything is allocated.
 MAX_CUBE = 20
 
 
-def solved(size: int) -> dict:
-    """The factorization of the target BRDF at cube size S (one solve per size, shared by P and Q)."""
+def solved(size: int, target=None, key=None) -> dict:
+    """The factorization of the target BRDF at cube size S (one solve per size, shared by P and Q). target:
+    another tabulated BRDF f(L, V) -> (M, 3), NaN where it has no data (a measured file, measured.py),
+    cached under `key` (its file's sha256); None: the brick's reference."""
     if not 1 <= size <= MAX_CUBE:
         raise ValueError(f"a homomorphic factorization cube of {size} × {size} texels per face is beyond the dense "
                          f"solve's {MAX_CUBE} (its normal matrix grows as S⁴): declare a size of at most {MAX_CUBE}")
-    if size not in _SOLVED:
+    if target is not None and key is None:
+        raise ValueError("a tabulated target needs a cache key (its file's sha256)")
+    ck = (size,) if target is None else (size, key)
+    if ck not in _SOLVED:
         L, V = sample_pairs()
-        _SOLVED[size] = factorize(L, V, target_brdf(L, V), size)
-    return _SOLVED[size]
+        _SOLVED[ck] = factorize(L, V, (target_brdf if target is None else target)(L, V), size)
+    return _SOLVED[ck]
 
 
 def _rgba_cube(t: np.ndarray) -> np.ndarray:

@@ -5,7 +5,9 @@ table, size, format, bytes, what it is baked from and its filtered error (`table
 --bake TABLE --out FILE.ktx2: the table's texels in KTX2 (build/ktx2.py) at the declaring brick's size
 and format (or --size/--format); a painted table (ndf_map, fresnel_ramp, …) takes the artist's image
 with --image FILE.png and normalizes it as the brick needs (the shader stays the same: an engine binds
-the file in place of the build's default table).
+the file in place of the build's default table). The factors of `homomorphic_factorization`
+(homomorphic_p, homomorphic_q) are factored from a measured BRDF with --measured FILE.binary (MERL
+format, reference/measured.py) instead of the brick's reference; the shader is the same.
 """
 from __future__ import annotations
 
@@ -25,6 +27,8 @@ def add_arguments(p) -> None:
     p.add_argument("--bake", metavar="TABLE", help="write this table (a name from the listing) as KTX2 to --out")
     p.add_argument("--out", metavar="FILE.ktx2", help="with --bake: the file to write")
     p.add_argument("--image", metavar="FILE", help="with --bake of a painted table: the painted image (PNG)")
+    p.add_argument("--measured", metavar="FILE.binary",
+                   help="with --bake homomorphic_p or homomorphic_q: factor this MERL measured BRDF instead")
     p.add_argument("--size", metavar="WxH", help="with --bake: the size (default: the declaring brick's)")
     p.add_argument("--texel-format", choices=("unorm8", "fp16", "fp32"),
                    help="with --bake: the stored format (default: the declaring brick's)")
@@ -71,7 +75,18 @@ def bake(lib, args) -> int:
         raise UsageError(f"no brick declares table '{args.bake}': give --size WxH and --texel-format")
     if args.image and not d.painted:
         raise UsageError(f"table '{args.bake}' is baked from its reference, not painted: drop --image")
-    if args.image:  # the painted baker validates the file (readable, channels, shape) and names it in errors
+    if args.measured:
+        from ...reference.measured import MEASURED_TABLES, bake_measured
+        if args.bake not in MEASURED_TABLES:
+            raise UsageError(f"--measured goes with --bake {' or '.join(MEASURED_TABLES)}, not '{args.bake}'")
+        try:
+            stored, info = bake_measured(args.bake, args.measured, size, fmt)
+        except ValueError as e:
+            raise UserError(f"{args.bake}: {e}") from None
+        print(f"{args.measured}: {info['used']} of {info['samples']} sample pairs measured; RMS log residual "
+              + " ".join(f"{r:.3f}" for r in info["residual"]) + " (a constant: "
+              + " ".join(f"{r:.3f}" for r in info["baseline"]) + ")")
+    elif args.image:  # the painted baker validates the file (readable, channels, shape) and names it in errors
         from ...reference.tables_painted import bake_painted
         stored = bake_painted(args.bake, args.image, size, fmt)
     else:
@@ -88,7 +103,7 @@ def run(args) -> int:
     from ...library.bricks import load_library
     lib = load_library(args.bricks)
     if args.bake is None:
-        for flag in ("out", "image", "size", "texel_format"):
+        for flag in ("out", "image", "measured", "size", "texel_format"):
             if getattr(args, flag):
                 raise UsageError(f"--{flag.replace('_', '-')} goes with --bake TABLE")
     elif not args.out:
