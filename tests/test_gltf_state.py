@@ -37,6 +37,16 @@ def test_the_default_state_keeps_every_earlier_key(lib):
     assert leaf.hash != p.hash
 
 
+def _body(text: str) -> str:
+    """A generated source without its provenance header (hash, bricks, templates: it differs per permutation):
+    from the first line that is not a comment, blank, or the GLSL #version/#extension lines above the header."""
+    lines = text.split("\n")
+    head = ("//", "#version", "#extension")
+    first = next((i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith(head)),
+                 len(lines))
+    return "\n".join(lines[first:])
+
+
 def test_each_axis_changes_the_shader_and_its_values_do_not(lib):
     from generator.compose import compose_permutation
     texts = {}
@@ -45,14 +55,14 @@ def test_each_axis_changes_the_shader_and_its_values_do_not(lib):
              "glow_tex": {"emissive": "texture"}}
     for name, state in cases.items():
         c = compose_permutation(_perm(lib, "albedo_texture(normal=normal_map)", **state), lib)
-        texts[name] = "\n".join(s.text.split("\n", 20)[-1] for s in c.sources)  # past the provenance header
+        texts[name] = "\n".join(_body(s.text) for s in c.sources)
     assert len(set(texts.values())) == len(cases)
-    frag = {n: c for n, c in texts.items()}
-    assert "discard" in frag["mask"] and "discard" not in frag["blend"] + frag["opaque"]
-    assert "gl_FrontFacing" in frag["double"] and "SV_IsFrontFace" in frag["double"] and \
-        "@builtin(front_facing)" in frag["double"]
-    assert "a_color" in frag["colors"] and "a_color" not in frag["opaque"]
-    assert "t_emissive_map" in frag["glow_tex"] and "t_emissive_map" not in frag["glow"]
+    assert not any("sha256:" in t for t in texts.values())  # the provenance headers are cut
+    assert "discard" in texts["mask"] and "discard" not in texts["blend"] + texts["opaque"]
+    assert "gl_FrontFacing" in texts["double"] and "SV_IsFrontFace" in texts["double"] and \
+        "@builtin(front_facing)" in texts["double"]
+    assert "a_color" in texts["colors"] and "a_color" not in texts["opaque"]
+    assert "t_emissive_map" in texts["glow_tex"] and "t_emissive_map" not in texts["glow"]
     c = compose_permutation(_perm(lib, "albedo_texture(normal=normal_map)", alpha="mask", emissive="factor"), lib)
     params = [s.param for s in c.material]
     assert params[-3:] == ["base_alpha", "alpha_cutoff", "emissive"]  # uniforms: a cutoff is no key value
@@ -189,6 +199,34 @@ def test_toml_scenes_take_the_same_keys(tmp_path, lib):
         load_scene(path, lib)
     line = text.splitlines().index("vertex_color = true") + 1
     assert "vertex_color multiplies rho_d" in e.value.message and e.value.line == line
+
+
+TINTED = '''"""A packing with its own rho_d parameter and no get_rho_d (test)."""
+BRICK = {
+    "kind": "packing",
+    "cite": "test",
+    "params": {"rho_d": {"type": "vec3", "range": [0.0, 1.0], "default": [0.5, 0.5, 0.5], "doc": "unused tint"}},
+    "slots": {"normal": {"kind": "normal", "default": "vertex"}},
+}
+'''
+
+
+def test_vertex_colours_need_the_brdfs_rho_d_not_a_packings(tmp_path):
+    """The scene check is the glue's (link/glue.py surface_inputs: the BRDF's parameters): a rho_d that only the
+    packing declares is refused at the material's vertex_color key, not at link time."""
+    from generator.library.bricks import load_library
+    from generator.matrix.scene import load_scene
+    (tmp_path / "bricks").mkdir()
+    (tmp_path / "bricks" / "tinted.py").write_text(TINTED)
+    lib = load_library([tmp_path / "bricks"])
+    text = TOML.replace('[materials.lamp]\nbrdf = "lambert"', '[materials.lamp]\nbrdf = "phong"\npacking = "tinted"')
+    path = tmp_path / "state.toml"
+    path.write_text(text.replace("rho_d = [0.8, 0.8, 0.8], emissive", "emissive"))
+    with pytest.raises(SourceError) as e:
+        load_scene(path, lib)
+    line = text.splitlines().index("vertex_color = true") + 1
+    assert (e.value.path, e.value.line) == (str(path), line) and e.value.hint.startswith("use a BRDF with a diffuse")
+    assert e.value.message == "material 'lamp': vertex_color multiplies rho_d, and this BRDF has no rho_d"
 
 
 @pytest.mark.lavapipe

@@ -155,6 +155,28 @@ def test_a_bad_image_is_an_error_naming_the_file(content, words, tmp_path):
         tp.bake_painted("oren_nayar_sin_sin", path)
 
 
+def test_a_16_bit_grey_png_loads_to_0_1_and_a_32_bit_image_is_refused(tmp_path):
+    """16-bit grey ("I;16" here; older Pillow opens such a PNG as "I", read as the same 0 … 65535) is scaled by
+    1/65535, not 1/(2^32 − 1) (which loaded it almost black); 32-bit integer grey is an error naming the file."""
+    from PIL import Image
+
+    words = np.array([[0, 1, 257, 32768, 65535]], np.uint16)
+    path = tmp_path / "grey16.png"
+    Image.fromarray(words).save(path)  # mode "I;16": a 16-bit grey PNG
+    want = np.repeat((words / 65535.0)[..., None], 3, -1)
+    got = tp.load_image(path)
+    np.testing.assert_array_equal(got[..., :3], want)
+    np.testing.assert_array_equal(got[..., 3], 1.0)
+    with Image.open(path) as im:
+        assert im.mode in ("I;16", "I") and im.format == "PNG"
+        np.testing.assert_array_equal(tp._rgba(im.convert("I"), "PNG", str(path)), got)  # older Pillow's mode
+    tif = tmp_path / "grey32.tif"
+    Image.fromarray(words.astype(np.int32) * 256).save(tif)  # mode "I": 32-bit signed (up to 2^24 here)
+    with pytest.raises(SourceError, match="32-bit integer grey") as e:
+        tp.load_image(tif)
+    assert str(e.value).startswith(f"{tif}:1:1: ")
+
+
 def test_the_painted_bricks_pass_accuracy_in_numpy():
     from generator.eval import accuracy
     from generator.library.bricks import load_library

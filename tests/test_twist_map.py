@@ -10,7 +10,7 @@ Gram-Schmidt-orthogonalized against the perturbed normal N' (link/glue.py shadin
   Ashikhmin-Shirley, Banks and anisotropic GGX;
 - a twist of 90° swaps the roles of the two roughnesses (Ward: m_u ↔ m_v), a twist of 0 is the
   vertex tangent Gram-Schmidt-orthogonalized against N';
-- guards: an unpainted (mid-grey) twist texel keeps the vertex tangent, d ∥ N' stays finite;
+- guards: an unpainted (mid-grey) twist texel keeps the vertex tangent, d ∥ N' stays finite (in float16 too);
 - isotropic BRDFs ignore the twist (channels not read, texture and tangent interpolant not declared);
 - a scene of twist materials builds in GLSL, HLSL and WGSL (and its ubershader), and on lavapipe the
   specialized and ubershader renders agree while the twist changes the image.
@@ -195,6 +195,34 @@ def test_guards_an_unpainted_texel_keeps_the_vertex_tangent_and_a_twist_along_th
     assert np.all(np.isfinite(got))
     Np = normal_from_xy(edge[j, i, :2], local["Ng"], local["T"], local["B"])
     np.testing.assert_allclose(Np, _unit(local["T"]), atol=1e-15)
+
+
+@pytest.mark.parametrize("normal", ["normal_twist_map", "twist_map"])
+def test_the_parallel_twist_guard_holds_in_float16(lib, normal):
+    """d exactly ∥ N' (t = d − (d·N') N' = 0 exactly, in half as in double): the floor 1e-6 is a half, so
+    shade() in NumPy float16 gives T' = 0 and the colour float64 gives (1e-30 was 0 in half: 0 · rsqrt(0) is
+    NaN, and the pixel came out black). An
+    axis-aligned frame makes the cancellation exact: normal_twist_map tilts N' 90° onto T (normal xy (1, 0))
+    with the twist along T; twist_map keeps N' = N and takes a degenerate interpolated T = N."""
+    from generator.targets.numpy import NumpyTarget
+
+    _, names, lp = _shade_fn(lib, _perm("ward_anisotropic", normal))
+    t = NumpyTarget()
+    emitted = t.emit(lp.program.structs, lp.program.functions, lp.program.globals)
+    n = 16
+    rng = np.random.default_rng(6)
+    X, Z = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+    Np = X if normal == "normal_twist_map" else Z
+    V = _unit(Np + 0.5 * LIGHT_DIR + rng.uniform(-0.3, 0.3, (n, 3)))  # n·v ≥ 0.3: no half overflow in Ward
+    local = {"P": np.zeros((n, 3)), "Ng": np.tile(Z, (n, 1)), "V": V, "uv": np.full((n, 2), 0.5 / SIZE),
+             "T": np.tile(X if normal == "normal_twist_map" else Z, (n, 1)), "B": np.tile([0.0, 1.0, 0.0], (n, 1))}
+    params = {"m_u": 0.08, "m_v": 0.35, "f0": [0.9] * 3}
+    texel = np.full((SIZE, SIZE, 4), [1.0, 0.5, 1.0, 0.5])  # normal xy (1, 0), twist w = (1, 0)
+    tex = {"t_normal_map": texel} if normal == "normal_twist_map" else {"t_twist_map": texel[..., 2:]}
+    got = {dt: _run(t.load(emitted, dt)["shade"], names, local, _values(params, **tex))
+           for dt in (np.float64, np.float16)}
+    assert np.all(np.isfinite(got[np.float16])) and got[np.float64][:, :3].max() > 0.1
+    np.testing.assert_allclose(got[np.float16], got[np.float64], rtol=2e-2, atol=1e-2)
 
 
 # ------------------------------------------------------------------ isotropic BRDFs: the twist is ignored

@@ -797,7 +797,7 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list, col
         raise rd.err(ptr, f"the bricks this material maps to are missing: {e}",
                      "use the standard brick library (or --bricks with lambert, microfacet, ggx, …)") from None
     # outside the try: its own located error (a GltfError is a SourceError) is not "missing bricks"
-    specs = surface_specs(specs, surface, lambda key, msg, todo: rd.err(ptr, msg, todo))
+    specs = surface_specs(specs, spec_params(nodes), surface, lambda key, msg, todo: rd.err(ptr, msg, todo))
     for k, v in params.items():
         problem = specs[k].check(v) if k in specs else f"no parameter '{k}'"
         if problem:

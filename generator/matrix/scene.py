@@ -195,7 +195,7 @@ def load_scene(path, lib: Library) -> Scene:
             raise loc.error(where, e.message, e.hint) from None
         surface = Surface(m.get("alpha", "opaque"), m.get("double_sided", False), m.get("vertex_color", False),
                           m.get("emissive", "none"))
-        specs = surface_specs(specs, surface, lambda key, msg, todo: loc.error(
+        specs = surface_specs(specs, spec_params(nodes), surface, lambda key, msg, todo: loc.error(
             loc.find(f"materials.{name}", key), f"material '{name}': {msg}", todo))
         params = m.get("params", {})
         _check_params(loc, f"materials.{name}", params, specs, f"BRDF '{brdf}'")
@@ -275,11 +275,14 @@ def load_scene(path, lib: Library) -> Scene:
     return scene
 
 
-def surface_specs(specs: dict, surface: Surface, error) -> dict:
-    """The material's parameter specs with those its surface state reads (matrix/surface.py); error(key, what,
-    todo) makes the exception for a state the material's bricks cannot take."""
-    if surface.vertex_color and "rho_d" not in specs:
-        raise error("vertex_color", "vertex_color multiplies rho_d, and the BRDF and packing have no rho_d",
+def surface_specs(specs: dict, brdf: dict, surface: Surface, error) -> dict:
+    """The material's parameter specs with those its surface state reads (matrix/surface.py); `brdf` the BRDF's
+    own specs (spec_params of its nodes); error(key, what, todo) makes the exception for a state the material's
+    bricks cannot take. Vertex colours scale the rho_d the BRDF shades with, so the BRDF must have one: the
+    rule of link/glue.py surface_inputs, checked here to point at the material's key (a packing's or output's
+    parameter named rho_d is not what the BRDF reads)."""
+    if surface.vertex_color and "rho_d" not in brdf:
+        raise error("vertex_color", "vertex_color multiplies rho_d, and this BRDF has no rho_d",
                     "use a BRDF with a diffuse term (lambert, …) or drop vertex_color")
     extra = surface.params()
     clash = [k for k in extra if k in specs]

@@ -98,16 +98,7 @@ def load_image(path) -> np.ndarray:
     try:
         with Image.open(path) as im:
             im.load()
-            mode = im.mode
-            if mode in ("I;16", "I;16B", "I;16L", "I"):  # 16-bit (or 32-bit integer) grey
-                a = np.asarray(im, dtype=np.float64) / (65535.0 if mode.startswith("I;16") else 4294967295.0)
-                a = np.repeat(a[..., None], 3, axis=-1)
-                a = np.concatenate([a, np.ones(a.shape[:2] + (1,))], axis=-1)
-            elif mode in ("1", "L", "LA", "P", "PA", "RGB", "RGBA"):
-                a = np.asarray(im.convert("RGBA"), dtype=np.float64) / 255.0
-            else:
-                raise SourceError(shown, 1, 1, f"the image's pixel mode {mode!r} is not read",
-                                  "save it as 8-bit (or 16-bit grey) PNG: grey, RGB or RGBA")
+            a = _rgba(im, im.format, shown)
     except FileNotFoundError:
         raise SourceError(shown, 1, 1, "no such image file", "check the path") from None
     except UnidentifiedImageError:
@@ -117,6 +108,31 @@ def load_image(path) -> np.ndarray:
     if a.ndim != 3 or a.shape[2] != 4:
         raise SourceError(shown, 1, 1, f"unexpected image shape {a.shape}", "give a 2D grey, RGB or RGBA image")
     return a
+
+
+GREY16 = ("I;16", "I;16B", "I;16L")  # Pillow's 16-bit grey modes (native, big- and little-endian words)
+
+
+def _rgba(im, fmt: str | None, shown: str) -> np.ndarray:
+    """An opened image's pixels as float64 RGBA in [0, 1]; `fmt` the file's format (Pillow's im.format).
+
+    16-bit grey is scaled by 1/65535: modes "I;16", "I;16B", "I;16L" and mode "I" read from a PNG, the mode in
+    which older Pillow versions open 16-bit grey PNGs (PNG stores at most 16 bits a channel, so "I" from a PNG
+    holds 0 … 65535). Mode "I" from any other file is 32-bit signed: no scale to [0, 1] is known, so it is refused
+    (dividing by 2^32 − 1 made a 16-bit painting almost black)."""
+    mode = im.mode
+    if mode in GREY16 or (mode == "I" and fmt == "PNG"):
+        a = np.asarray(im, dtype=np.float64) / 65535.0
+        a = np.repeat(a[..., None], 3, axis=-1)
+        return np.concatenate([a, np.ones(a.shape[:2] + (1,))], axis=-1)
+    if mode in ("1", "L", "LA", "P", "PA", "RGB", "RGBA"):
+        return np.asarray(im.convert("RGBA"), dtype=np.float64) / 255.0
+    if mode in ("I", "F"):
+        raise SourceError(shown, 1, 1, f"the image is {'32-bit integer' if mode == 'I' else '32-bit float'} "
+                          f"grey (Pillow mode {mode!r}), which has no fixed [0, 1] scale",
+                          "save it as an 8-bit or 16-bit grey PNG (or 8-bit RGB/RGBA)")
+    raise SourceError(shown, 1, 1, f"the image's pixel mode {mode!r} is not read",
+                      "save it as 8-bit (or 16-bit grey) PNG: grey, RGB or RGBA")
 
 
 def example_image(name: str) -> np.ndarray:

@@ -30,9 +30,12 @@ Guards (`tangent`):
   code 128 gives |w| = 0.0039), or filtering across opposite directions — and the vertex tangent T
   is used, so such texels shade as without a twist instead of with an arbitrary tangent. A painted
   8-bit unit direction has |w| ≥ 0.99, far above the threshold.
-- The length of d − (d·N') N' is floored at 1e-30 before rsqrt: it is 0 only when d is parallel to
-  N' (a normal tilted 90° toward the twist); T' is then 0 instead of NaN, the anisotropic terms see
-  H·T' = H·B' = 0 and stay finite.
+- The squared length of t = d − (d·N') N' is floored at 1e-6 before rsqrt, as `normal_map` and
+  `normal_map_xy` floor theirs: 1e-6 is representable in half (the subnormal 17 · 2^-24 ≈ 1.01e-6;
+  1e-30 was 0 there), so the guard holds in fp16 too. The floor changes T' only where |t| < 1e-3,
+  i.e. where d lies within 0.06° of N' for a painted unit twist (|w| ≥ 0.99); T' is there t · 1000,
+  shorter than unit, and 0 when d is parallel to N' (a normal tilted 90° toward the twist) instead
+  of NaN: the anisotropic terms see H·T' = H·B' = 0 and stay finite.
 Normal guard: 1 − |t.xy|² floored at 0, as `normal_map_xy` (filtering gives |t.xy| slightly > 1).
 
 Cost (`shadermatrix costs`, spirv-opt -O, Ward with one point light, the same in GLSL, HLSL and WGSL):
@@ -42,7 +45,6 @@ spirv-opt does not merge the two samples (one texture, one binding, two sample i
 """
 BRICK = {
     "kind": "normal",
-    "fp16": "unsafe: the 1e-30 floor is 0 in float16, so a twist parallel to N' (T' = 0 in float32) is 0 · inf (NaN)",
     "cite": "Hoffman & Baker 2006, Anisotropic BRDF with Normal and Twist Maps (Gram-Schmidt T against the "
             "perturbed N); ATI 2005 3Dc (xy normals); Peercy et al. 1997 tangent-space normal maps",
     "textures": {"normal_map": {"srgb": False, "doc": "linear RGBA; RG: normal xy as (t + 1) / 2, z reconstructed; "
@@ -62,6 +64,7 @@ def tangent(Np: vec3, T: vec3, B: vec3, uv: vec2, normal_map: texture2d) -> vec3
     d = w.x * T + w.y * B
     if dot(d, d) < 0.0001:  # |w| < 0.01: no twist painted (mid-grey), keep the vertex tangent
         d = T
-    # Gram-Schmidt against the perturbed normal; the floor keeps d ∥ N' finite (T' = 0)
+    # Gram-Schmidt against the perturbed normal; the floor 1e-6 (representable in half) keeps d ∥ N' finite
+    # (T' = 0) and changes T' only where |t| < 1e-3 (d within 0.06 degrees of N' for a unit twist)
     t = d - dot(d, Np) * Np
-    return t * rsqrt(max(dot(t, t), 1e-30))
+    return t * rsqrt(max(dot(t, t), 0.000001))
