@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..targets.numpy_resources import cube_face, cube_texel_direction
 from .tables import table
 
 # log f is floored at log(1e-6) (accuracy.REL_FLOOR: 1e-3 of an 8-bit step at unit light): f → 0
@@ -55,35 +56,22 @@ GRID = (12, 24)
 
 # ------------------------------------------------------------------ cube maps (Vulkan face selection)
 
+def _texel_grid(size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(face, i, j) of every texel of an S × S cube, broadcasting to (6, S, S) in [face, j, i] order."""
+    k = np.arange(size)
+    return np.arange(6)[:, None, None], k[None, None, :], k[None, :, None]
+
+
 def cube_directions(size: int) -> np.ndarray:
     """(6, S, S, 3) unit directions of the texel centres, faces +X, −X, +Y, −Y, +Z, −Z (Vulkan "Cube Map
-    Face Selection": the inverse of (s_c, t_c, m_a) per face)."""
-    c = (np.arange(size) + 0.5) / size * 2.0 - 1.0
-    tc, sc = np.meshgrid(c, c, indexing="ij")  # row j is t, column i is s
-    one = np.ones_like(sc)
-    d = np.stack([np.stack(f, -1) for f in (
-        (one, -tc, -sc), (-one, -tc, sc), (sc, one, tc), (sc, -one, -tc), (sc, -tc, one), (-sc, -tc, -one))])
-    return d / np.linalg.norm(d, axis=-1, keepdims=True)
-
-
-def face_coordinates(d) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(face, s, t) of directions d (..., 3) under Vulkan's face selection (ties to x, then y)."""
-    r = np.asarray(d, np.float64)
-    rx, ry, rz = r[..., 0], r[..., 1], r[..., 2]
-    ax, ay, az = np.abs(rx), np.abs(ry), np.abs(rz)
-    use_x = (ax >= ay) & (ax >= az)
-    use_y = ~use_x & (ay >= az)
-    face = np.where(use_x, np.where(rx >= 0, 0, 1), np.where(use_y, np.where(ry >= 0, 2, 3), np.where(rz >= 0, 4, 5)))
-    sc = np.choose(face, [-rz, rz, rx, rx, rx, -rx])
-    tc = np.choose(face, [-ry, -ry, rz, -rz, -ry, -ry])
-    ma = np.choose(face, [ax, ax, ay, ay, az, az])
-    return face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)
+    Face Selection": the inverse of (s_c, t_c, m_a) per face), indexed [face, row j, column i]."""
+    return cube_texel_direction(*_texel_grid(size), size)
 
 
 def cube_footprint(d, size: int) -> tuple[np.ndarray, np.ndarray]:
     """Flat texel indices (…, 4) into a (6, S, S) cube and their bilinear weights (…, 4) at directions d:
     level 0, clamp-to-edge within the face (what the NumPy target samples)."""
-    face, s, t = face_coordinates(d)
+    face, s, t = cube_face(d)
     x, y = s * size - 0.5, t * size - 0.5
     x0, y0 = np.floor(x), np.floor(y)
     ax, ay = x - x0, y - y0
@@ -106,18 +94,13 @@ def sample_cube(texels: np.ndarray, d) -> np.ndarray:
 def _neighbour_pairs(size: int) -> np.ndarray:
     """(M, 2) flat texel index pairs of 4-neighbours on the sphere (each pair once): a step of one texel
     in s or t, past a face edge onto the adjacent face (the nearest texel there)."""
-    c = (np.arange(size) + 0.5) / size * 2.0 - 1.0
-    step = 2.0 / size
+    f, i, j = _texel_grid(size)
     pairs = []
-    for ds, dt in ((step, 0.0), (0.0, step)):
-        tc, sc = np.meshgrid(c + dt, c + ds, indexing="ij")
-        one = np.ones_like(sc)
-        d = np.stack([np.stack(f, -1) for f in (
-            (one, -tc, -sc), (-one, -tc, sc), (sc, one, tc), (sc, -one, -tc), (sc, -tc, one), (-sc, -tc, -one))])
-        face, s, t = face_coordinates(d)
-        i = np.clip(np.floor(s * size), 0, size - 1).astype(np.intp)
-        j = np.clip(np.floor(t * size), 0, size - 1).astype(np.intp)
-        pairs.append(np.stack([np.arange(6 * size * size), (face * size * size + j * size + i).ravel()], -1))
+    for di, dj in ((1, 0), (0, 1)):
+        face, s, t = cube_face(cube_texel_direction(f, i + di, j + dj, size))
+        ni = np.clip(np.floor(s * size), 0, size - 1).astype(np.intp)
+        nj = np.clip(np.floor(t * size), 0, size - 1).astype(np.intp)
+        pairs.append(np.stack([np.arange(6 * size * size), (face * size * size + nj * size + ni).ravel()], -1))
     p = np.concatenate(pairs)
     p = np.sort(p[p[:, 0] != p[:, 1]], axis=1)
     return np.unique(p, axis=0)
@@ -233,7 +216,11 @@ def solved(size: int, target=None, key=None) -> dict:
     return _SOLVED[ck]
 
 
-def _rgba_cube(t: np.ndarray) -> np.ndarray:
+def _factor_cube(factor: str, w: int, h: int) -> np.ndarray:
+    """The (6, S, S, 4) RGBA texels (alpha 1) of factor "P" or "Q" of the solve at S = w = h."""
+    if w != h:
+        raise ValueError(f"a cube map's faces are square, not {w} × {h}: declare [S, S]")
+    t = solved(w)[factor]
     out = np.ones(t.shape[:-1] + (4,))
     out[..., :3] = t[..., :3]
     return out
@@ -243,15 +230,11 @@ def _rgba_cube(t: np.ndarray) -> np.ndarray:
        "of the reference of `homomorphic_factorization`", cube=True)
 def homomorphic_p(w: int, h: int) -> np.ndarray:
     """P: the direction factor (RGB, dimensionless, p(n) = 1), indexed by l or v in the (t, b, n) frame."""
-    if w != h:
-        raise ValueError(f"a cube map's faces are square, not {w} × {h}: declare [S, S]")
-    return _rgba_cube(solved(w)["P"])
+    return _factor_cube("P", w, h)
 
 
 @table("homomorphic_q", "q(ω_h) of f ≈ p(ω_i) q(ω_h) p(ω_o), log-space least squares (McCool et al. 2001) "
        "of the reference of `homomorphic_factorization`", cube=True)
 def homomorphic_q(w: int, h: int) -> np.ndarray:
     """Q: the half-vector factor (RGB, 1/sr), indexed by h in the (t, b, n) frame."""
-    if w != h:
-        raise ValueError(f"a cube map's faces are square, not {w} × {h}: declare [S, S]")
-    return _rgba_cube(solved(w)["Q"])
+    return _factor_cube("Q", w, h)

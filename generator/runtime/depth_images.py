@@ -20,13 +20,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .device import VulkanUnavailable
-from .images import Image, Sampler
+from .images import FORMAT_FEATURE_TRANSFER_DST, Image, Sampler
 
 if TYPE_CHECKING:
     from .device import Device
 
 DEPTH_FORMAT = "VK_FORMAT_D32_SFLOAT"
-_FORMAT_FEATURE_TRANSFER_DST = 0x00008000  # core in Vulkan 1.1; the binding has only a _KHR alias
 
 
 def depth_compare_filterable(device: "Device") -> bool:
@@ -41,10 +40,13 @@ class DepthImage(Image):
     """A sampled D32_SFLOAT image of level 0 from (H, W) depths in [0, 1] (the depth aspect, SHADER_READ_ONLY).
 
     Depths outside [0, 1] are refused: a copy into a D32_SFLOAT depth aspect must stay in [0, 1] without
-    VK_EXT_depth_range_unrestricted. Owned by its device: released by Device.close unless destroyed earlier.
+    VK_EXT_depth_range_unrestricted. Created and uploaded as an :class:`~.images.Image` is (its _create and
+    _upload_staged, on the depth aspect). Owned by its device: released by Device.close unless destroyed earlier.
     """
 
-    def __init__(self, device: "Device", depth):  # no super().__init__: a depth upload, not a colour one
+    aspect = "VK_IMAGE_ASPECT_DEPTH_BIT"
+
+    def __init__(self, device: "Device", depth):  # no super().__init__: (H, W) depths, not colour texels
         vk = device.vk
         d = np.ascontiguousarray(np.asarray(depth, np.float32))
         if d.ndim != 2 or d.shape[0] < 1 or d.shape[1] < 1:
@@ -59,75 +61,17 @@ class DepthImage(Image):
         self.layout = vk.VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
         self.nbytes = d.nbytes
         feats = vk.vkGetPhysicalDeviceFormatProperties(device.physical, self.format).optimalTilingFeatures
-        if not depth_compare_filterable(device) or not feats & _FORMAT_FEATURE_TRANSFER_DST:
+        if not depth_compare_filterable(device) or not feats & FORMAT_FEATURE_TRANSFER_DST:
             raise VulkanUnavailable(f"{device.name} cannot upload and linearly filter {DEPTH_FORMAT}: no "
                                     "comparison sampling of a depth image")
-        self.handle = self.memory = self.view = None
-        dev = device.handle
-        try:
-            self.handle = vk.vkCreateImage(dev, vk.VkImageCreateInfo(
-                imageType=vk.VK_IMAGE_TYPE_2D, format=self.format,
-                extent=vk.VkExtent3D(width=self.width, height=self.height, depth=1), mipLevels=1, arrayLayers=1,
-                samples=vk.VK_SAMPLE_COUNT_1_BIT, tiling=vk.VK_IMAGE_TILING_OPTIMAL,
-                usage=vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED), None)
-            req = vk.vkGetImageMemoryRequirements(dev, self.handle)
-            self.memory = vk.vkAllocateMemory(dev, vk.VkMemoryAllocateInfo(
-                allocationSize=req.size, memoryTypeIndex=device.local_memory_type(req.memoryTypeBits)), None)
-            vk.vkBindImageMemory(dev, self.handle, self.memory, 0)
-            self.view = vk.vkCreateImageView(dev, vk.VkImageViewCreateInfo(
-                image=self.handle, format=self.format, viewType=vk.VK_IMAGE_VIEW_TYPE_2D,
-                components=vk.VkComponentMapping(**dict.fromkeys("rgba", vk.VK_COMPONENT_SWIZZLE_IDENTITY)),
-                subresourceRange=self._range()), None)
-            self.upload(d)
-        except BaseException:
-            self.destroy()
-            raise
-        device.own(self)
-
-    def _range(self):
-        vk = self.device.vk
-        return vk.VkImageSubresourceRange(aspectMask=vk.VK_IMAGE_ASPECT_DEPTH_BIT, baseMipLevel=0, levelCount=1,
-                                          baseArrayLayer=0, layerCount=1)
+        self._realize(d)
 
     def upload(self, depth) -> None:
         """Replace all depths ((H, W) float32 in [0, 1]) through a staging buffer; waits for the copy."""
-        vk, device = self.device.vk, self.device
         d = np.ascontiguousarray(np.asarray(depth, np.float32))
         if d.shape != (self.height, self.width):
             raise ValueError(f"upload of {d.shape} depths into a {self.height}x{self.width} depth image")
-        staging = device.buffer(d.nbytes, vk.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
-        ignored = vk.VK_QUEUE_FAMILY_IGNORED
-        try:
-            staging.write(d)
-            rng = self._range()
-            to_dst = vk.VkImageMemoryBarrier(
-                srcAccessMask=0, dstAccessMask=vk.VK_ACCESS_TRANSFER_WRITE_BIT,
-                oldLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED, newLayout=vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                srcQueueFamilyIndex=ignored, dstQueueFamilyIndex=ignored, image=self.handle, subresourceRange=rng)
-            to_read = vk.VkImageMemoryBarrier(
-                srcAccessMask=vk.VK_ACCESS_TRANSFER_WRITE_BIT, dstAccessMask=vk.VK_ACCESS_SHADER_READ_BIT,
-                oldLayout=vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=self.layout,
-                srcQueueFamilyIndex=ignored, dstQueueFamilyIndex=ignored, image=self.handle, subresourceRange=rng)
-            region = vk.VkBufferImageCopy(
-                bufferOffset=0, bufferRowLength=0, bufferImageHeight=0,
-                imageSubresource=vk.VkImageSubresourceLayers(aspectMask=vk.VK_IMAGE_ASPECT_DEPTH_BIT, mipLevel=0,
-                                                             baseArrayLayer=0, layerCount=1),
-                imageOffset=vk.VkOffset3D(x=0, y=0, z=0),
-                imageExtent=vk.VkExtent3D(width=self.width, height=self.height, depth=1))
-
-            def record(cmd):
-                vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, vk.VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                        0, 0, None, 0, None, 1, [to_dst])
-                vk.vkCmdCopyBufferToImage(cmd, staging.handle, self.handle, vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                          1, [region])
-                vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                        vk.VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | vk.VK_PIPELINE_STAGE_VERTEX_SHADER_BIT
-                                        | vk.VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, None, 0, None, 1, [to_read])
-
-            device.submit(record)
-        finally:
-            staging.destroy()
+        self._upload_staged(d)
 
 
 class ComparisonSampler(Sampler):
@@ -137,15 +81,5 @@ class ComparisonSampler(Sampler):
     Bound with a depth-format image only (a comparison on a colour format is undefined in Vulkan).
     """
 
-    def __init__(self, device: "Device"):  # no super().__init__: another VkSamplerCreateInfo
-        vk = device.vk
-        self.device = device
-        clamp = vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
-        self.handle = vk.vkCreateSampler(device.handle, vk.VkSamplerCreateInfo(
-            magFilter=vk.VK_FILTER_LINEAR, minFilter=vk.VK_FILTER_LINEAR,
-            mipmapMode=vk.VK_SAMPLER_MIPMAP_MODE_NEAREST,
-            addressModeU=clamp, addressModeV=clamp, addressModeW=clamp, mipLodBias=0.0,
-            anisotropyEnable=vk.VK_FALSE, maxAnisotropy=1.0, compareEnable=vk.VK_TRUE,
-            compareOp=vk.VK_COMPARE_OP_LESS_OR_EQUAL, minLod=0.0, maxLod=0.0,
-            borderColor=vk.VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE, unnormalizedCoordinates=vk.VK_FALSE), None)
-        device.own(self)
+    compare_op = "VK_COMPARE_OP_LESS_OR_EQUAL"
+    border_color = "VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE"

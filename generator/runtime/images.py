@@ -16,7 +16,7 @@ from .device import VulkanUnavailable
 if TYPE_CHECKING:
     from .device import Device
 
-_FORMAT_FEATURE_TRANSFER_DST = 0x00008000  # core in Vulkan 1.1; the binding has only a _KHR alias, = None
+FORMAT_FEATURE_TRANSFER_DST = 0x00008000  # core in Vulkan 1.1; the binding has only a _KHR alias, = None
 
 
 def _image_format(vk, dtype, srgb: bool):
@@ -82,6 +82,8 @@ class Image:
     Owned by its device: released by Device.close unless destroyed earlier.
     """
 
+    aspect = "VK_IMAGE_ASPECT_COLOR_BIT"  # the aspect that holds the texels (DepthImage: the depth aspect)
+
     def __init__(self, device: "Device", data, srgb: bool = False, cube: bool | None = None):
         vk = device.vk
         arr, self.cube = texels(data, cube)
@@ -93,48 +95,65 @@ class Image:
         self.nbytes = arr.nbytes
         feats = vk.vkGetPhysicalDeviceFormatProperties(device.physical, self.format).optimalTilingFeatures
         need = (vk.VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | vk.VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT
-                | _FORMAT_FEATURE_TRANSFER_DST)
+                | FORMAT_FEATURE_TRANSFER_DST)
         if feats & need != need:
             raise VulkanUnavailable(f"{device.name} cannot sample format {self.format} with linear filtering "
                                     "from optimal tiling")
+        self._realize(arr)
+
+    def _realize(self, arr: np.ndarray) -> None:
+        """Create the image, its memory and view from the attributes (format, width, height, layers, cube,
+        aspect, layout), upload `arr` (its texels already checked) and hand the image to its device; on
+        any failure release what was made (destroy) and re-raise."""
         self.handle = self.memory = self.view = None
-        dev = device.handle
         try:
-            self.handle = vk.vkCreateImage(dev, vk.VkImageCreateInfo(
-                flags=vk.VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT if self.cube else 0,
-                imageType=vk.VK_IMAGE_TYPE_2D, format=self.format,
-                extent=vk.VkExtent3D(width=self.width, height=self.height, depth=1),
-                mipLevels=1, arrayLayers=self.layers, samples=vk.VK_SAMPLE_COUNT_1_BIT,
-                tiling=vk.VK_IMAGE_TILING_OPTIMAL,
-                usage=vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED), None)
-            req = vk.vkGetImageMemoryRequirements(dev, self.handle)
-            self.memory = vk.vkAllocateMemory(dev, vk.VkMemoryAllocateInfo(
-                allocationSize=req.size, memoryTypeIndex=device.local_memory_type(req.memoryTypeBits)), None)
-            vk.vkBindImageMemory(dev, self.handle, self.memory, 0)
-            self.view = vk.vkCreateImageView(dev, vk.VkImageViewCreateInfo(
-                image=self.handle, format=self.format,
-                viewType=vk.VK_IMAGE_VIEW_TYPE_CUBE if self.cube else vk.VK_IMAGE_VIEW_TYPE_2D,
-                components=vk.VkComponentMapping(**dict.fromkeys("rgba", vk.VK_COMPONENT_SWIZZLE_IDENTITY)),
-                subresourceRange=self._range()), None)
-            self.upload(arr)
+            self._create()
+            self._upload_staged(arr)
         except BaseException:
             self.destroy()
             raise
-        device.own(self)
+        self.device.own(self)
+
+    def _create(self) -> None:
+        """vkCreateImage (level 0, optimal tiling, SAMPLED | TRANSFER_DST; CUBE_COMPATIBLE for a cube),
+        device-local memory and a 2D or CUBE view of the aspect; each handle is set as soon as it exists, so
+        that destroy releases a partial creation."""
+        vk, dev = self.device.vk, self.device.handle
+        self.handle = vk.vkCreateImage(dev, vk.VkImageCreateInfo(
+            flags=vk.VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT if self.cube else 0,
+            imageType=vk.VK_IMAGE_TYPE_2D, format=self.format,
+            extent=vk.VkExtent3D(width=self.width, height=self.height, depth=1),
+            mipLevels=1, arrayLayers=self.layers, samples=vk.VK_SAMPLE_COUNT_1_BIT,
+            tiling=vk.VK_IMAGE_TILING_OPTIMAL,
+            usage=vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+            sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED), None)
+        req = vk.vkGetImageMemoryRequirements(dev, self.handle)
+        self.memory = vk.vkAllocateMemory(dev, vk.VkMemoryAllocateInfo(
+            allocationSize=req.size, memoryTypeIndex=self.device.local_memory_type(req.memoryTypeBits)), None)
+        vk.vkBindImageMemory(dev, self.handle, self.memory, 0)
+        self.view = vk.vkCreateImageView(dev, vk.VkImageViewCreateInfo(
+            image=self.handle, format=self.format,
+            viewType=vk.VK_IMAGE_VIEW_TYPE_CUBE if self.cube else vk.VK_IMAGE_VIEW_TYPE_2D,
+            components=vk.VkComponentMapping(**dict.fromkeys("rgba", vk.VK_COMPONENT_SWIZZLE_IDENTITY)),
+            subresourceRange=self._range()), None)
 
     def _range(self):
         vk = self.device.vk
-        return vk.VkImageSubresourceRange(aspectMask=vk.VK_IMAGE_ASPECT_COLOR_BIT, baseMipLevel=0, levelCount=1,
+        return vk.VkImageSubresourceRange(aspectMask=getattr(vk, self.aspect), baseMipLevel=0, levelCount=1,
                                           baseArrayLayer=0, layerCount=self.layers)
 
     def upload(self, data) -> None:
         """Replace all texels (same shape and dtype) through a staging buffer; waits for the copy."""
-        vk, device = self.device.vk, self.device
         arr, _ = texels(data, self.cube)
         if arr.shape != (self.layers, self.height, self.width, 4) or arr.dtype != self.dtype:
             raise ValueError(f"upload of {arr.shape} {arr.dtype} into an image of "
                              f"{(self.layers, self.height, self.width, 4)} {self.dtype}")
+        self._upload_staged(arr)
+
+    def _upload_staged(self, arr: np.ndarray) -> None:
+        """Copy `arr` (the bytes of every layer, tightly packed, already checked) into the image's aspect
+        through a staging buffer, UNDEFINED → TRANSFER_DST_OPTIMAL → :attr:`layout`; waits for the copy."""
+        vk, device = self.device.vk, self.device
         staging = device.buffer(arr.nbytes, vk.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
         try:
             staging.write(arr)
@@ -154,7 +173,7 @@ class Image:
             # Tightly packed layers one after another: one region covers them all.
             region = vk.VkBufferImageCopy(
                 bufferOffset=0, bufferRowLength=0, bufferImageHeight=0,
-                imageSubresource=vk.VkImageSubresourceLayers(aspectMask=vk.VK_IMAGE_ASPECT_COLOR_BIT, mipLevel=0,
+                imageSubresource=vk.VkImageSubresourceLayers(aspectMask=getattr(vk, self.aspect), mipLevel=0,
                                                              baseArrayLayer=0, layerCount=self.layers),
                 imageOffset=vk.VkOffset3D(x=0, y=0, z=0),
                 imageExtent=vk.VkExtent3D(width=self.width, height=self.height, depth=1))
@@ -202,6 +221,10 @@ class Sampler:
     Owned by its device: released by Device.close unless destroyed earlier.
     """
 
+    # No depth comparison (ComparisonSampler sets one); the border colour is never read (clamp-to-edge).
+    compare_op: str | None = None
+    border_color = "VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK"
+
     def __init__(self, device: "Device"):
         vk = device.vk
         self.device = device
@@ -210,9 +233,10 @@ class Sampler:
             magFilter=vk.VK_FILTER_LINEAR, minFilter=vk.VK_FILTER_LINEAR,
             mipmapMode=vk.VK_SAMPLER_MIPMAP_MODE_NEAREST,
             addressModeU=clamp, addressModeV=clamp, addressModeW=clamp, mipLodBias=0.0,
-            anisotropyEnable=vk.VK_FALSE, maxAnisotropy=1.0, compareEnable=vk.VK_FALSE,
-            compareOp=vk.VK_COMPARE_OP_ALWAYS, minLod=0.0, maxLod=0.0,
-            borderColor=vk.VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK, unnormalizedCoordinates=vk.VK_FALSE), None)
+            anisotropyEnable=vk.VK_FALSE, maxAnisotropy=1.0,
+            compareEnable=vk.VK_FALSE if self.compare_op is None else vk.VK_TRUE,
+            compareOp=getattr(vk, self.compare_op or "VK_COMPARE_OP_ALWAYS"), minLod=0.0, maxLod=0.0,
+            borderColor=getattr(vk, self.border_color), unnormalizedCoordinates=vk.VK_FALSE), None)
         device.own(self)
 
     def destroy(self) -> None:

@@ -168,11 +168,12 @@ def _tex2d_compare(t, uv, ref):
     return out.astype(uv.dtype)
 
 
-def _texcube(t, d):
-    """sample / sample_level of a texturecube in direction d (Vulkan face selection, level 0)."""
-    d = np.asarray(d)
-    img = _image(t, cube=True)
-    r = d.astype(np.float64)
+def cube_face(d) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(face, s, t) of directions d (..., 3), float64: Vulkan "Cube Map Face Selection" (the major axis,
+    ties to X over Y over Z; faces +X, -X, +Y, -Y, +Z, -Z) and the face's normalized coordinates
+    s = (s_c / |m_a| + 1) / 2, t = (t_c / |m_a| + 1) / 2. Shared by _texcube and the homomorphic
+    factorization's cube maps (generator/reference/tables_homomorphic.py)."""
+    r = np.asarray(d, np.float64)
     rx, ry, rz = r[..., 0], r[..., 1], r[..., 2]
     ax, ay, az = np.abs(rx), np.abs(ry), np.abs(rz)
     use_x = (ax >= ay) & (ax >= az)
@@ -182,7 +183,29 @@ def _texcube(t, d):
     sc = np.choose(face, [-rz, rz, rx, rx, rx, -rx])
     tc = np.choose(face, [-ry, -ry, rz, -rz, -ry, -ry])
     ma = np.choose(face, [ax, ax, ay, ay, az, az])
-    s, tt = 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)
+    return face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)
+
+
+def cube_texel_direction(face, i, j, size: int) -> np.ndarray:
+    """Unit direction (..., 3) through the centre of texel (face, i, j) (column i, row j) of an S × S cube:
+    the inverse of cube_face there (s = (i + 0.5) / S, t = (j + 0.5) / S). i and j may be fractional or
+    past the face's edge (i = S is one texel step beyond it: a direction onto the adjacent face)."""
+    sc = (np.asarray(i, np.float64) + 0.5) / size * 2.0 - 1.0
+    tc = (np.asarray(j, np.float64) + 0.5) / size * 2.0 - 1.0
+    face, sc, tc = np.broadcast_arrays(np.asarray(face), sc, tc)
+    one = np.ones_like(sc)
+    # the (s_c, t_c, m_a) table of cube_face solved for (rx, ry, rz) at |m_a| = 1, per face
+    d = np.stack([np.choose(face, [one, -one, sc, sc, sc, -sc]),
+                  np.choose(face, [-tc, -tc, one, -one, -tc, -tc]),
+                  np.choose(face, [-sc, sc, tc, -tc, one, -one])], -1)
+    return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
+
+def _texcube(t, d):
+    """sample / sample_level of a texturecube in direction d (Vulkan face selection, level 0)."""
+    d = np.asarray(d)
+    img = _image(t, cube=True)
+    face, s, tt = cube_face(d)
     return _bilinear(img, face.astype(np.intp), s, tt).astype(d.dtype)
 
 
