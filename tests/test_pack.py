@@ -37,17 +37,15 @@ def minimal_read(data: bytes) -> dict:
     return {"key": key.hex(), "meta": meta, "entries": entries, "input_keys": {(r[0], r[1]): r[2] for r in rows}}
 
 
-PRIMARY = {"vulkan": "spirv", "d3d12": "hlsl", "gl": "glsl", "webgpu": "wgsl"}  # no dxc here: d3d12 packs HLSL
-
-
 def expected_entries(out: Path, manifest: dict, platform: str) -> dict:
     """{(permutation, stage): bytes} the pack of `platform` must hold: every ok entry's artifact (and the
     ubershader's GLSL SPIR-V in vulkan's)."""
+    from generator.build.platforms import PLATFORM_TABLE
     want = {}
     for e in manifest["permutations"]:
         if e.get("status") == "ok":
             for stage, item in e["platforms"][platform]["stages"].items():
-                kind = "dxil" if "dxil" in item else PRIMARY[platform]
+                kind = "dxil" if "dxil" in item else PLATFORM_TABLE[platform].blob  # no dxc: d3d12 packs HLSL
                 want[(e["hash"], stage)] = (out / item[kind]["path"]).read_bytes()
     if platform == "vulkan" and manifest["ubershader"].get("status") == "ok":
         for stage, item in manifest["ubershader"]["languages"]["glsl"].items():

@@ -194,3 +194,33 @@ def test_essl_at_fp16_is_mediump_in_the_fragment_stage_only(lib, tmp_path):
         assert "uniform Frame { highp mat4 view_proj; highp vec4 camera_pos; }" in s.text
     jobs = [CompileJob(f"{h}.{s.stage}.essl", "essl", s.stage, s.text, line_map=tuple(s.line_map)) for s in es.values()]
     assert validate_dialects(jobs) == {j.key: [] for j in jobs}
+
+
+def test_a_gl_core_failure_keeps_its_source_beside_like_a_compile_failure(lib, tmp_path):
+    """A GL core source that glslangValidator rejects fails the permutation and is written as
+    gl/<hash>.<stage>.failed.glsl, named in failed_sources (as vulkan/<lang>/….failed.<lang> for a compile
+    error). The failure: a Vulkan-only specialization constant, which GL core has not (targets/gl.py)."""
+    import dataclasses
+
+    from generator.build.platforms import write_platforms
+    from generator.compose import compose_permutation
+    from generator.io import atomic_write
+    from generator.matrix.scene import load_scene
+    from generator.toolchain import CompileJob
+    from generator.toolchain.platforms import validate_dialects
+    scene = load_scene(EXAMPLE, lib)
+    h = sorted(scene.permutations)[0]
+    c = compose_permutation(scene.permutations[h], lib, ("glsl",), ("gl", "essl"))
+    bad = "layout(constant_id = 0) const float vk_only = 1.0;\nvoid main() {"
+    c.dialects = [dataclasses.replace(s, text=s.text.replace("void main() {", bad))
+                  if (s.language, s.stage) == ("gl", "frag") else s for s in c.dialects]
+    checked = validate_dialects([CompileJob(f"{h}.{s.stage}.{s.language}", s.language, s.stage, s.text,
+                                            line_map=tuple(s.line_map)) for s in c.dialects])
+    assert checked[f"{h}.vert.gl"] == [] and "constant_id" in checked[f"{h}.frag.gl"][0]
+    entry = {"languages": {"glsl": {}}}
+    errs = write_platforms(lambda rel, data: atomic_write(tmp_path / rel, data), h, c, entry, ["gl"], checked, "fp32")
+    assert errs == checked[f"{h}.frag.gl"]
+    assert entry["failed_sources"] == {"gl.frag": f"gl/{h}.frag.failed.glsl"}
+    frag = next(s for s in c.dialects if (s.language, s.stage) == ("gl", "frag"))
+    assert (tmp_path / entry["failed_sources"]["gl.frag"]).read_text() == frag.text
+    assert not any(".frag." in p.name and ".failed." not in p.name for p in (tmp_path / "gl").iterdir())

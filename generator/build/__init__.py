@@ -177,7 +177,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
             if not errs:
                 errs = write_platforms(lambda rel, data: _count(res, atomic_write(out / rel, data)), h, c, entry,
                                        platforms, checked, scene.permutations[h].precision, dxil)
-                if errs:
+                if errs:  # failed_sources stays: a failing GL core source is written beside (write_platforms)
                     entry.pop("platforms", None)
                     entry["languages"] = {}
             built[h] = _settle(res, entry, errs, old.get(h), out, _failure_head(scene, h, users.get(h, [])))

@@ -19,7 +19,7 @@ compilers' diagnostics are mapped back through #line, or the GL sources' line ma
 named by permutation, not by content, so a drift is a diff of one file. `languages` narrows what is
 checked as `build_scene(languages=...)` narrows what is built: a platform is checked when one of the
 languages it is made from (MADE_FROM; vulkan: any) is given, and vulkan compiles only those
-given. (`build` is narrower: it writes a platform only when its platforms.PLATFORM_LANGUAGE is built,
+given. (`build` is narrower: it writes a platform only when its platforms.PLATFORM_TABLE made_from is built,
 so vulkan needs GLSL there.)
 """
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Shader packs (`build --pack`): one content-addressed file per platform, its artifacts by permutation.
 
-A pack holds what its platform loads (build/platforms.py PRIMARY): ``vulkan`` the optimized SPIR-V of
+A pack holds what its platform loads (build/platforms.py PLATFORM_TABLE ``blob``): ``vulkan`` the optimized SPIR-V of
 the GLSL, ``d3d12`` DXIL where dxc built it and the HLSL text otherwise, ``gl`` the GLSL 4.50 core text,
 ``webgpu`` the WGSL text; the metadata's ``blob`` says which (``spirv``, ``dxil``, ``hlsl``, ``glsl``,
 ``wgsl``). ``DIR/packs/<platform>.<key16>.smpack``, ``key16`` the first 16 hex digits of the pack key.
@@ -224,7 +224,7 @@ def pack_meta(platform: str, language: str, blob: str, generator: str, tools: di
 
 def _packed(entry: dict, name: str, platform: str):
     """(permutation name, stage, input key, blob kind, path, sha256) of an ok manifest entry on `platform`."""
-    from .platforms import PRIMARY
+    from .platforms import PLATFORM_TABLE
     if entry.get("status") != "ok":
         return
     if name == "ubershader":  # built for vulkan only: its GLSL's SPIR-V
@@ -234,14 +234,14 @@ def _packed(entry: dict, name: str, platform: str):
                     yield name, stage, entry["input_key"], "spirv", item["spirv"], item["spirv_sha256"]
         return
     for stage, item in entry.get("platforms", {}).get(platform, {}).get("stages", {}).items():
-        kind = "dxil" if "dxil" in item else PRIMARY[platform]
+        kind = "dxil" if "dxil" in item else PLATFORM_TABLE[platform].blob
         yield name, stage, entry["input_key"], kind, item[kind]["path"], item[kind]["sha256"]
 
 
 def write_packs(out: Path, manifest: dict, count=None) -> list[dict]:
     """Write one pack per platform of `manifest` (its ok permutations; the ubershader in vulkan's) into
     out/packs; returns the manifest's ``packs`` list. count(changed): the build's file counter."""
-    from .platforms import PRIMARY, SOURCE_LANGUAGE
+    from .platforms import PLATFORM_TABLE
     out = Path(out)
     listed = []
     for platform in manifest.get("platforms", []):
@@ -254,18 +254,18 @@ def write_packs(out: Path, manifest: dict, count=None) -> list[dict]:
                 raise PackError(f"{out / rel}: its sha256 is not the manifest's — rebuild without --pack first")
             entries.append((name, stage, input_key, data))
             kinds.add(kind)
-        blob_kind = "+".join(sorted(kinds)) or PRIMARY[platform]  # d3d12 without dxc for some: "dxil+hlsl"
+        blob_kind = "+".join(sorted(kinds)) or PLATFORM_TABLE[platform].blob  # d3d12 without dxc for some: "dxil+hlsl"
         own = next((e["platforms"][platform].get("tools", {}) for e in manifest["permutations"]
                     if platform in (e.get("platforms") or {})), {})  # as the build recorded them: no tool runs
         tools = {**own, **manifest["tools"]}
-        meta = pack_meta(platform, SOURCE_LANGUAGE[platform], blob_kind, manifest["generator"], tools)
+        meta = pack_meta(platform, PLATFORM_TABLE[platform].language, blob_kind, manifest["generator"], tools)
         blob, key = encode_pack(meta, entries)
         rel = f"{PACKS}/{platform}.{key[:16]}{SUFFIX}"
         changed = atomic_write(out / rel, blob)
         if count is not None:
             count(changed)
-        listed.append({"platform": platform, "language": SOURCE_LANGUAGE[platform], "blob": blob_kind, "path": rel,
-                       "sha256": hashlib.sha256(blob).hexdigest(), "key": key, "entries": len(entries),
+        listed.append({"platform": platform, "language": PLATFORM_TABLE[platform].language, "blob": blob_kind,
+                       "path": rel, "sha256": hashlib.sha256(blob).hexdigest(), "key": key, "entries": len(entries),
                        "size": len(blob)})
     return listed
 

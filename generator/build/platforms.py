@@ -20,17 +20,34 @@ Per permutation the manifest's ``platforms`` maps each built platform to ``{"sta
 "tools": {tool: version}, …}``; everything else about the entry (``languages``, ``interface``,
 ``uploads``) is what it was. GLSL ES is "where the bricks allow": a permutation whose ES source does not
 validate gets ``"essl": {"unsupported": [errors]}`` instead of an artifact, and still builds; a GL core
-error fails the permutation like a compile error.
+error fails the permutation like a compile error, its source written beside as
+``gl/<hash>.<stage>.failed.glsl`` and named in the entry's ``failed_sources`` (``"gl.<stage>"``).
 """
 from __future__ import annotations
+
+from typing import NamedTuple
 
 from ..io import sha256
 from ..toolchain import tool_versions
 
-PLATFORMS: tuple[str, ...] = ("vulkan", "d3d12", "gl", "webgpu")
-# the language whose SPIR-V (vulkan) or source (the others) is each platform's main artifact
-SOURCE_LANGUAGE = {"vulkan": "glsl", "d3d12": "hlsl", "gl": "gl", "webgpu": "wgsl"}
-PRIMARY = {"vulkan": "spirv", "d3d12": "hlsl", "gl": "glsl", "webgpu": "wgsl"}  # the pack's blob per platform
+
+class Platform(NamedTuple):
+    """What the build needs for a platform and what its pack holds (one row of PLATFORM_TABLE)."""
+
+    made_from: str  # the language `build` must build for the platform to be written (build_scene(languages=...))
+    language: str   # the dialect of its main artifact's source: the pack meta's and manifest ``packs``' "language"
+    blob: str       # the kind of its main artifact in the manifest's stages and the pack (d3d12: "dxil" where built)
+
+
+# The one table of the platforms, in build order. gl is made from the GLSL target (its `gl` dialect is a
+# GlslTarget subclass composed beside the languages: DIALECTS) and ships the 4.50 core text, kind "glsl".
+PLATFORM_TABLE: dict[str, Platform] = {
+    "vulkan": Platform(made_from="glsl", language="glsl", blob="spirv"),
+    "d3d12": Platform(made_from="hlsl", language="hlsl", blob="hlsl"),
+    "gl": Platform(made_from="glsl", language="gl", blob="glsl"),
+    "webgpu": Platform(made_from="wgsl", language="wgsl", blob="wgsl"),
+}
+PLATFORMS: tuple[str, ...] = tuple(PLATFORM_TABLE)
 DIALECTS = {"gl": ("gl", "essl")}  # platform -> dialects composed beside the languages (compose.Composed.dialects)
 EXT = {"gl": "glsl", "essl": "essl", "hlsl": "hlsl", "wgsl": "wgsl", "dxil": "dxil"}
 
@@ -59,9 +76,6 @@ def platform_tools(platform: str) -> dict[str, str]:
             "webgpu": lambda: {"naga": t["naga"]}}[platform]()
 
 
-PLATFORM_LANGUAGE = {"vulkan": "glsl", "d3d12": "hlsl", "gl": "glsl", "webgpu": "wgsl"}  # what each is made from
-
-
 def all_tools(platforms) -> dict:
     """Every platform's tools (for the build's key: a tool installed or upgraded rebuilds)."""
     return {p: platform_tools(p) for p in platforms}
@@ -70,7 +84,8 @@ def all_tools(platforms) -> dict:
 def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_errors: dict, precision: str,
                     dxil=None) -> list[str]:
     """Fill entry["platforms"] for one permutation whose languages compiled (entry["languages"] is written);
-    returns the errors that fail it. write(rel, data): the build's atomic writer. dialect_errors: job key ->
+    returns the errors that fail it (a GL core stage's among them, its source then written beside and named in
+    entry["failed_sources"]). write(rel, data): the build's atomic writer. dialect_errors: job key ->
     glslangValidator errors. dxil(source) -> (bytes | None, errors): the DXC step (None: no dxc)."""
     from .reflection import platform_reflection
     langs = entry["languages"]
@@ -85,7 +100,7 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
         return {"path": rel, "sha256": digest}
 
     for p in platforms:
-        if PLATFORM_LANGUAGE[p] not in langs or (p == "gl" and ("gl", stages[0]) not in sources):
+        if PLATFORM_TABLE[p].made_from not in langs or (p == "gl" and ("gl", stages[0]) not in sources):
             continue  # a build of fewer languages (build_scene(languages=...)): the platforms they make
         d: dict = {"stages": {}}
         if p == "vulkan":
@@ -114,8 +129,14 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
             es_errors = [e for s in stages for e in dialect_errors.get(f"{name}.{s}.essl", [])]
             for stage in stages:
                 core = dialect_errors.get(f"{name}.{stage}.gl", [])
-                errs += core
-                item = {"glsl": put("gl", stage, sources[("gl", stage)].text.encode(), "gl")}
+                text = sources[("gl", stage)].text.encode()
+                if core:  # it fails the permutation: the source beside, as a compile failure's (build._write_all)
+                    errs += core
+                    rel = f"gl/{name}.{stage}.failed.{EXT['gl']}"
+                    write(rel, text)
+                    entry.setdefault("failed_sources", {})[f"gl.{stage}"] = rel
+                    continue
+                item = {"glsl": put("gl", stage, text, "gl")}
                 if not es_errors:
                     item["essl"] = put("gl", stage, sources[("essl", stage)].text.encode(), "essl")
                 d["stages"][stage] = item

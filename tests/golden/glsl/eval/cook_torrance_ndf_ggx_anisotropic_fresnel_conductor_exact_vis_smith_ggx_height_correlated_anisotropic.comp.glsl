@@ -8,7 +8,7 @@
 // brick bricks/brdf/microfacet/visibility/smith_ggx_height_correlated_anisotropic.py sha256:bc459008c8c9
 // brick bricks/brdf/specular/cook_torrance.py sha256:9934eded63fa
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per
 // sample: L, V, N, T (xyz; w unused). params.info.x = sample count.

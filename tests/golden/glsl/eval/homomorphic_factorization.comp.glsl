@@ -5,7 +5,7 @@
 // hash: 99a6c359c89d
 // brick bricks/brdf/specular/homomorphic_factorization.py sha256:4f211c7071c5
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per
 // sample: L, V, N, T (xyz; w unused). params.info.x = sample count.

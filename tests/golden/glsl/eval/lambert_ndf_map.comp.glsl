@@ -6,7 +6,7 @@
 // brick bricks/brdf/diffuse/lambert.py sha256:571e572632b7
 // brick bricks/brdf/specular/ndf_map.py sha256:d47b8d2832c2
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

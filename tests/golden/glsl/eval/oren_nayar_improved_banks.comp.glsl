@@ -6,7 +6,7 @@
 // brick bricks/brdf/diffuse/oren_nayar_improved.py sha256:c3bc02210fd8
 // brick bricks/brdf/specular/banks.py sha256:4c7e94fa0027
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per
 // sample: L, V, N, T (xyz; w unused). params.info.x = sample count.

@@ -6,7 +6,7 @@
 // brick bricks/brdf/diffuse/oren_nayar_simplified_interreflection.py sha256:82cb5a5bc9da
 // brick bricks/brdf/specular/blinn_phong_normalized_fresnel.py sha256:a5cf5ed269db
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

@@ -11,8 +11,8 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick bricks/shadow/shadow_map.py sha256:ba9f6f186144
-// template glsl/macros.glsl.j2 sha256:0712fef74734
-// template glsl/vertex.glsl.j2 sha256:416c66bbdad2
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
+// template glsl/vertex.glsl.j2 sha256:58467b9ab3fd
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 

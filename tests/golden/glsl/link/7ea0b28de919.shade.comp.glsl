@@ -10,7 +10,7 @@
 // brick bricks/packing/normal/vertex.py sha256:e5656609551b
 // brick bricks/shadow/none.py sha256:11e2cea24e56
 // brick tests/link_bricks/output/exposure.py sha256:b50a4da31f80
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 // template glsl/shade.glsl.j2 sha256:9751a017d0ea
 
 // Shade kernel: the permutation's shade() for each sample, in a compute shader (the fragment

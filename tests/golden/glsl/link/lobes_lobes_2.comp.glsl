@@ -5,7 +5,7 @@
 // hash: ccf2080ae645
 // brick tests/link_bricks/specular/lobes.py sha256:889e667a483b
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

@@ -5,7 +5,7 @@
 // hash: 6dd2efd8fc3c
 // brick tests/link_bricks/diffuse/lut_diffuse.py sha256:b73105ae57a3
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.

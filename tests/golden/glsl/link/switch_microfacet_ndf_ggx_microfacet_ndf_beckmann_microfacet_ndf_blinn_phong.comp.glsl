@@ -10,7 +10,7 @@
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:df5916f2e496
 // brick bricks/brdf/specular/microfacet.py sha256:12ddb097075e
 // template glsl/eval.glsl.j2 sha256:2a6650fd24f0
-// template glsl/macros.glsl.j2 sha256:0712fef74734
+// template glsl/macros.glsl.j2 sha256:bc1b1167b5b0
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w the BRDF id, int). params.info.x = sample count.
