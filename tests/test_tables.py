@@ -103,9 +103,9 @@ def test_a_build_writes_the_tables_its_shaders_sample_as_ktx2_listed_in_the_mani
 
     from generator.build.ktx2 import decode
 
-    def build(brdf):
+    def build(brdf, extra=""):
         scene = tmp_path / "s.toml"
-        scene.write_text(SCENE.replace("BRDF", brdf))
+        scene.write_text(SCENE.replace("BRDF", brdf) + extra)
         r = subprocess.run([sys.executable, "-m", "generator.cli", "build", str(scene), "--out", str(tmp_path / "out"),
                             "--no-cache"], capture_output=True, text=True, timeout=300)
         assert r.returncode == 0, r.stderr
@@ -121,6 +121,20 @@ def test_a_build_writes_the_tables_its_shaders_sample_as_ktx2_listed_in_the_mani
     assert np.array_equal(texels, tables.baked("oren_nayar_sin_sin", (64, 64), "unorm8"))
     assert row["error"]["max_rel"] < 0.05 and "Oren & Nayar" in row["reference"]
     assert set(row["used_by"]) == {m["permutations"][0]["hash"], "ubershader"}
+    # a rebuild (another object, so not up to date) keeps the row whose input key and file are intact, and
+    # bakes again a table whose file was damaged
+    (tmp_path / "out" / row["path"]).write_bytes(b"damaged")
+    m2 = build("oren_nayar_factored", '[[objects]]\nname = "o2"\nmaterial = "m"\nlights = "all"\n')
+    (row2,) = m2["tables"]
+    assert row2["input_key"] == row["input_key"] and row2["sha256"] == row["sha256"]
+    assert hashlib.sha256((tmp_path / "out" / row2["path"]).read_bytes()).hexdigest() == row["sha256"]
+    # an intact row is kept, not baked and measured again: a mark put into it survives the next build
+    mf = tmp_path / "out" / "manifest.json"
+    marked = json.loads(mf.read_text())
+    marked["tables"][0]["error"] = {"kept": True}
+    mf.write_text(json.dumps(marked))
+    m3 = build("oren_nayar_factored", '[[objects]]\nname = "o3"\nmaterial = "m"\nlights = "all"\n')
+    assert m3["tables"][0]["error"] == {"kept": True}
     # a scene that no longer samples it: no table in the manifest, and the file is gone
     m = build("oren_nayar")
     assert "tables" not in m and not any((tmp_path / "out" / "tables").iterdir())

@@ -225,7 +225,7 @@ def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None
         res.manifest["removed"] = [{**e, "status": "removed"} for e in sorted({e["hash"]: e for e in gone}.values(),
                                                                              key=lambda e: e["hash"])]
     from .tables import write_tables  # baked lookup tables the shaders sample (content-named, like packs)
-    tables = write_tables(out, lib, res.manifest, lambda changed: _count(res, changed))
+    tables = write_tables(out, lib, res.manifest, lambda changed: _count(res, changed), previous, base)
     if tables:
         res.manifest["tables"] = tables
     if pack:  # written before the manifest that names them (content-named: the old ones stay until after it)

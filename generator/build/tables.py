@@ -16,7 +16,7 @@ import hashlib
 from pathlib import Path
 
 from .. import __version__
-from ..io import atomic_write
+from ..io import atomic_write, content_key
 from ..lang.errors import UserError
 
 TABLES_DIR = "tables"
@@ -34,18 +34,39 @@ def _users(manifest: dict, names) -> dict[str, list[str]]:
     return users
 
 
-def write_tables(out: Path, lib, manifest: dict, count=None) -> list[dict]:
+def _intact(out: Path, row: dict) -> bool:
+    try:
+        return hashlib.sha256((out / row["path"]).read_bytes()).hexdigest() == row["sha256"]
+    except (OSError, KeyError, TypeError):
+        return False
+
+
+def write_tables(out: Path, lib, manifest: dict, count=None, previous: dict | None = None, base: str = "") -> list[dict]:
     """Bake and write every table the manifest's shaders sample; their manifest entries, by texture name.
-    count(changed: bool) is told of each file (written, or already there with these bytes)."""
-    from ..reference.tables import baked, lookup, sha256, table_error
+    count(changed: bool) is told of each file (written, or already there with these bytes). A table whose
+    `input_key` (base: the build's key of the generator's own code and tools; the table, size, format and the
+    files its baker reads) is that of the `previous` manifest's row, with its file intact, keeps that row:
+    neither baked nor measured again."""
+    from ..reference.tables import baked, inputs, lookup, sha256, table_error
     from .ktx2 import encode
 
     decl = lib.tables()
     users = _users(manifest, decl)
+    old = {r.get("texture"): r for r in (previous or {}).get("tables", [])}
     rows = []
     for name in sorted(users):
         d = decl[name]
         w, h = d["size"]
+        try:
+            key = content_key(base, "table", d["table"], w, h, d["format"], d["tolerance"], inputs(d["table"]))
+        except LookupError:  # an unknown table: said below, with the brick
+            key = ""
+        kept = old.get(name)
+        if key and kept is not None and kept.get("input_key") == key and _intact(out, kept):
+            rows.append({**kept, "brick": d["brick"], "used_by": sorted(users[name])})
+            if count is not None:
+                count(False)
+            continue
         try:
             stored = baked(d["table"], d["size"], d["format"])
         except (LookupError, ValueError) as e:  # an unknown table, a size or format its baker refuses
@@ -69,7 +90,7 @@ def write_tables(out: Path, lib, manifest: dict, count=None) -> list[dict]:
         rows.append({"texture": name, "table": d["table"], "brick": d["brick"], "path": rel, "sha256": digest,
                      "texels_sha256": sha256(stored), "format": d["format"], "size": [w, h],
                      "dimension": "cube" if cube else "2d", "bytes": len(data), "reference": lookup(d["table"]).reference,
-                     "error": err, "used_by": sorted(users[name])})
+                     "error": err, "used_by": sorted(users[name]), "input_key": key})
     return rows
 
 

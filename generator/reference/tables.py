@@ -26,6 +26,7 @@ Conventions every table follows (so a brick can index it with one multiply-add):
 from __future__ import annotations
 
 import hashlib
+from pathlib import Path
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -50,6 +51,7 @@ class TableDef:
     exact: Callable | None = None
     painted: bool = False  # takes a source image
     extra: dict = field(default_factory=dict)
+    sources: tuple = ()  # files the baker reads beyond the generator's code (a painted example): see inputs()
 
 
 TABLES: dict[str, TableDef] = {}
@@ -60,15 +62,24 @@ class TableError(LookupError):
 
 
 def table(name: str, reference: str, *, cube: bool = False, exact: Callable | None = None,
-          painted: bool = False, doc: str = ""):
+          painted: bool = False, doc: str = "", sources: tuple = ()):
     """Register the baker of table `name` (a decorator)."""
     def register(fn):
         if name in TABLES:
             raise ValueError(f"two bakers for table '{name}'")
         TABLES[name] = TableDef(name, fn, reference, doc or (fn.__doc__ or "").strip().split("\n")[0], cube, exact,
-                                painted)
+                                painted, sources=tuple(sources))
         return fn
     return register
+
+
+def inputs(name: str) -> str:
+    """sha256 of the files table `name`'s baker reads beyond the generator's code (its declared sources);
+    with the generator's own sources, what its texels depend on (the build's key for reusing them)."""
+    h = hashlib.sha256()
+    for path in lookup(name).sources:
+        h.update(Path(path).read_bytes() + b"\0")
+    return h.hexdigest()
 
 
 def lookup(name: str) -> TableDef:
@@ -214,7 +225,6 @@ def _load() -> None:
     _LOADED = True
     import importlib
     import pkgutil
-    from pathlib import Path
     for m in sorted(pkgutil.iter_modules([str(Path(__file__).parent)]), key=lambda m: m.name):
         if m.name.startswith("tables_"):
             importlib.import_module(f"{__package__}.{m.name}")

@@ -301,7 +301,8 @@ def _source(name: str, image) -> Painted:
 # ------------------------------------------------------------------ bakers
 
 @table("ndf_map", "K_N p(θ_h) = D/4 of the painted isotropic NDF (Hoffman & Baker 2006, NDF maps), "
-       "D = p / ∫ p cos θ_h dω_h, at u = √(1 − n·h)", painted=True)
+       "D = p / ∫ p cos θ_h dω_h, at u = √(1 − n·h)", painted=True,
+       sources=(EXAMPLES / EXAMPLE_FILES["ndf_map"],))
 def ndf_map(w: int, h: int, image=None) -> np.ndarray:
     """K_N p(θ_h) along u = √(1 − cos θ_h) (one row; rows repeat)."""
     src = _source("ndf_map", image)
@@ -312,7 +313,8 @@ def ndf_map(w: int, h: int, image=None) -> np.ndarray:
 
 
 @table("ndf_map_anisotropic", "K_N p(h) = D/4 of the painted anisotropic NDF over (h·t, h·b) "
-       "(Hoffman & Baker 2006, NDF maps), ∫∫_disk D dx dy = 1", painted=True)
+       "(Hoffman & Baker 2006, NDF maps), ∫∫_disk D dx dy = 1", painted=True,
+       sources=(EXAMPLES / EXAMPLE_FILES["ndf_map_anisotropic"],))
 def ndf_map_anisotropic(w: int, h: int, image=None) -> np.ndarray:
     """K_N p at x = h·t, y = h·b in [−1, 1] (texel i at −1 + 2i/(W − 1))."""
     src = _source("ndf_map_anisotropic", image)
@@ -323,7 +325,8 @@ def ndf_map_anisotropic(w: int, h: int, image=None) -> np.ndarray:
 
 
 @table("ndf_fresnel_map", "K T(θ_h, α_h) of the painted NDF + Fresnel texture (Hoffman & Baker 2006), "
-       "row α_h = 0 a unit NDF / 4, at u = √(1 − n·h), v = 1 − l·h", painted=True)
+       "row α_h = 0 a unit NDF / 4, at u = √(1 − n·h), v = 1 − l·h", painted=True,
+       sources=(EXAMPLES / EXAMPLE_FILES["ndf_fresnel_map"],))
 def ndf_fresnel_map(w: int, h: int, image=None) -> np.ndarray:
     """K T at u = √(1 − cos θ_h) (x) and v = 1 − cos α_h (y)."""
     src = _source("ndf_fresnel_map", image)
@@ -334,7 +337,8 @@ def ndf_fresnel_map(w: int, h: int, image=None) -> np.ndarray:
 
 
 @table("fresnel_ramp", "R_F(α_h) per f0: exact dielectric Fresnel at η = (1 + √f0)/(1 − √f0) "
-       "(Cook & Torrance 1982), or a painted ramp, at x = 1 − cos α_h, y = √f0", painted=True)
+       "(Cook & Torrance 1982), or a painted ramp, at x = 1 − cos α_h, y = √f0", painted=True,
+       sources=(EXAMPLES / EXAMPLE_FILES["fresnel_ramp"],))
 def fresnel_ramp(w: int, h: int, image=None) -> np.ndarray:
     """R_F at x = 1 − cos α_h, y = √f0 (grey when computed: every channel the same ramp)."""
     src = _source("fresnel_ramp", image)
