@@ -31,14 +31,10 @@ FORMATS = ("unorm8", "fp16", "fp32")
 
 
 def declared(lib) -> list[dict]:
-    """Every table texture of the library's bricks: brick, texture, table, size, format."""
-    out = []
-    for (_kind, bid), b in sorted(lib.bricks.items()):
-        for tname, t in sorted(b.textures.items()):
-            if t.get("table"):
-                out.append({"brick": bid, "texture": tname, "table": t["table"], "size": list(t["size"]),
-                            "format": t["format"], "tolerance": b.tolerance})
-    return out
+    """Every table texture of the library (Library.tables(): one per texture name): brick, texture, table, size,
+    format, the brick's tolerance."""
+    return [{"brick": d["brick"], "texture": name, "table": d["table"], "size": list(d["size"]),
+             "format": d["format"], "tolerance": d["tolerance"]} for name, d in sorted(lib.tables().items())]
 
 
 def sweep(entry: dict) -> list[dict]:
