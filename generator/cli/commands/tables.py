@@ -35,21 +35,18 @@ def add_arguments(p) -> None:
 
 
 def listing(lib) -> list[dict]:
-    """One row per table texture a brick declares."""
+    """One row per table texture of the library (Library.tables())."""
     from ...reference.tables import lookup, table_error
     rows = []
-    for (_kind, bid), b in sorted(lib.bricks.items()):
-        for tname, t in sorted(b.textures.items()):
-            if not t.get("table"):
-                continue
-            d = lookup(t["table"])
-            w, h = t["size"]
-            texel = {"unorm8": 4, "fp16": 8, "fp32": 16}[t["format"]]
-            rows.append({"brick": bid, "texture": tname, "table": t["table"], "size": [w, h], "format": t["format"],
-                         "dimension": "cube" if d.cube else "2d",
-                         "bytes": w * h * texel * (6 if d.cube else 1), "painted": d.painted,
-                         "reference": d.reference, "error": table_error(t["table"], t["size"], t["format"]),
-                         "tolerance": b.tolerance})
+    for tname, t in sorted(lib.tables().items()):
+        d = lookup(t["table"])
+        w, h = t["size"]
+        texel = {"unorm8": 4, "fp16": 8, "fp32": 16}[t["format"]]
+        rows.append({"brick": t["brick"], "texture": tname, "table": t["table"], "size": [w, h], "format": t["format"],
+                     "dimension": "cube" if d.cube else "2d",
+                     "bytes": w * h * texel * (6 if d.cube else 1), "painted": d.painted,
+                     "reference": d.reference, "error": table_error(t["table"], t["size"], t["format"]),
+                     "tolerance": t["tolerance"]})
     return rows
 
 
@@ -63,7 +60,7 @@ def bake(lib, args) -> int:
         d = lookup(args.bake)
     except TableError as e:
         raise UsageError(f"--bake: {e}") from None
-    decl = next((t for b in lib.bricks.values() for t in b.textures.values() if t.get("table") == args.bake), {})
+    decl = next((t for t in lib.tables().values() if t["table"] == args.bake), {})
     size = decl.get("size")
     if args.size:
         m = re.fullmatch(r"([0-9]+)x([0-9]+)", args.size)
