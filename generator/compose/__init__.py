@@ -203,52 +203,44 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES, di
     """Vertex and fragment shaders of one permutation in each language, and in each platform dialect of
     `dialects` ("gl": GLSL 4.50 core for OpenGL, "essl": GLSL ES 3.10; targets/gl.py) into .dialects."""
     lp = link_permutation(perm, lib)
-    prog, iface = lp.program, lp.interface
-    h = perm.hash
-    bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
+    iface = lp.interface
+    bricks = {p: b.module.source_hash for p, b in lp.program.bricks.items()}
     templates = {}
     sources = []
-    call_args = _call_args(lp)
-    mat, lights = iface.block("Material"), iface.block("Lights")
     for lang in languages:
-        target = get_target(lang, perm.precision)
-        emitted = target.emit(prog.structs, prog.functions, prog.globals)
-        emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
-        for stage in ("vertex", "fragment"):
-            tname = f"{lang}/{stage}.{lang}.j2"
-            used = _templates_used(lang, tname)
-            templates.update(used)
-            ctx = {"provenance": _provenance("permutation", perm.canonical(), h, bricks, used),
-                   "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
-                   "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
-                   "textures": iface.textures, "call_args": call_args, "shade": shade, "surface": perm.surface,
-                   "iface": iface, "spell": lambda name, _t=get_target(lang): _t.type_name(BUILTIN_TYPES[name])}
-            sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
-                                   f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
-    extra = _dialect_sources(perm, lp, dialects, call_args, mat, lights, bricks, templates) if dialects else []
-    return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights,
-                    dialects=extra)
+        sources += _stage_sources(perm, lp, get_target(lang, perm.precision), lang, lang, "permutation",
+                                  get_target(lang), bricks, templates)
+    extra = []
+    if dialects:
+        from ..targets.gl import DIALECTS, gl_bindings
+        for d in dialects:  # the platform dialects (templates/gl/, with the Vulkan GLSL's macros)
+            extra += _stage_sources(perm, lp, DIALECTS[d](gl_bindings(iface.blocks, iface.textures), perm.precision),
+                                    "gl", d, f"permutation ({d})", get_target("glsl"), bricks, templates,
+                                    also=("glsl/macros.glsl.j2",))
+    return Composed(perm.canonical(), perm.hash, sources, bricks, templates, iface, material=lp.material,
+                    lights=lp.lights, dialects=extra)
 
 
-def _dialect_sources(perm, lp, dialects, call_args, mat, lights, bricks, templates) -> list[Source]:
-    """The permutation's vertex and fragment shaders in each platform dialect (templates/gl/)."""
-    from ..targets.gl import DIALECTS, gl_bindings
+def _stage_sources(perm, lp, target, tdir: str, ext: str, label: str, spelling, bricks, templates,
+                   also=()) -> list[Source]:
+    """A permutation's vertex and fragment shaders from templates/<tdir>/<stage>.<tdir>.j2 through `target`
+    (sources named <hash>.<vert|frag>.<ext>); `also`: templates the skeletons import from other folders;
+    `spelling`: the target whose type names the templates spell built-in types with."""
     prog, iface, h = lp.program, lp.interface, perm.hash
-    spell = lambda name, _t=get_target("glsl"): _t.type_name(BUILTIN_TYPES[name])  # noqa: E731
+    mat, lights = iface.block("Material"), iface.block("Lights")
+    emitted = target.emit(prog.structs, prog.functions, prog.globals)
+    emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
+    call_args = _call_args(lp)
     out = []
-    for d in dialects:
-        target = DIALECTS[d](gl_bindings(iface.blocks, iface.textures), perm.precision)
-        emitted = target.emit(prog.structs, prog.functions, prog.globals)
-        emitted, shade = target.entry32(emitted, _function(prog, "shade"))
-        for stage in ("vertex", "fragment"):
-            tname = f"gl/{stage}.gl.j2"
-            used = {**_templates_used("gl", tname), "glsl/macros.glsl.j2": _template_hash("glsl/macros.glsl.j2")}
-            templates.update(used)
-            ctx = {"provenance": _provenance(f"permutation ({d})", perm.canonical(), h, bricks, used),
-                   "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
-                   "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
-                   "textures": iface.textures, "call_args": call_args, "shade": shade, "iface": iface, "spell": spell,
-                   "surface": perm.surface}
-            out.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
-                               f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{d}"))
+    for stage in ("vertex", "fragment"):
+        tname = f"{tdir}/{stage}.{tdir}.j2"
+        used = {**_templates_used(tdir, tname), **{t: _template_hash(t) for t in also}}
+        templates.update(used)
+        ctx = {"provenance": _provenance(label, perm.canonical(), h, bricks, used),
+               "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
+               "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
+               "textures": iface.textures, "call_args": call_args, "shade": shade, "surface": perm.surface,
+               "iface": iface, "spell": lambda name, _t=spelling: _t.type_name(BUILTIN_TYPES[name])}
+        out.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
+                           f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{ext}"))
     return out
