@@ -63,7 +63,7 @@ def cli(*args, env=None) -> tuple[float, subprocess.CompletedProcess]:
 
 _MEASURED = """
 import resource, sys
-import generator.build.parallel as parallel
+import generator.assemble.parallel as parallel
 if {in_process}:
     parallel.MIN_PERMUTATIONS = float("inf")
 from generator.cli import main
@@ -89,7 +89,7 @@ def measured(*args, in_process: bool = False) -> tuple[float, float]:
 def scene_load(tmp: Path) -> dict:
     """Seconds to load the example scene's objects repeated to 1,000 and 10,000 (five permutations)."""
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     base = (REPO / "scenes" / "example.toml").read_text()
     head, rest = base.split("[[objects]]", 1)
     objects = ["[[objects]]" + o for o in ("[[objects]]" + rest).split("[[objects]]")[1:]]
@@ -153,10 +153,10 @@ def one_brick(scene_path: Path, out: Path, cache: Path) -> dict:
     """Rebuild after ndf=beckmann's source changes (its hash, in process): time, rebuilt, readers."""
     import copy
 
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from generator.io import Store
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     lib = load_library()
     scene = load_scene(scene_path, lib)
     key = ("ndf", "beckmann")

@@ -7,7 +7,7 @@ TARGET is one of
   brick    generator.library.bricks.load_brick on a file holding the fuzzed bytes, and the language alone
            (generator.lang.parse_module) on the same text
            (seeds: every shipped brick, bricks/**/*.py, and the test bricks under tests/);
-  scene    generator.matrix.scene.load_scene with the built-in library (seeds: scenes/*.toml, tests/scenes/*.toml);
+  scene    generator.scene.load.load_scene with the built-in library (seeds: scenes/*.toml, tests/scenes/*.toml);
   samples  the eval samples reader, load_samples of generator/cli/commands/eval.py, checked and unchecked
            (seeds: small valid .npy files of (N, 9) and (N, 12) float32/float64 samples).
 
@@ -180,7 +180,7 @@ def _target(target: str, workdir: Path):
 
     if target == "scene":
         from generator.library.bricks import load_library
-        from generator.matrix.scene import load_scene
+        from generator.scene.load import load_scene
 
         lib = load_library()
         path = workdir / "fz.toml"
@@ -243,9 +243,9 @@ def child(args) -> None:
         import generator.lang  # noqa: F401
         import generator.library.bricks  # noqa: F401
         import generator.library.schema  # noqa: F401
-        import generator.matrix.scene  # noqa: F401
-        import generator.matrix.schema  # noqa: F401
-        import generator.matrix.permutation  # noqa: F401
+        import generator.scene.load  # noqa: F401
+        import generator.scene.schema  # noqa: F401
+        import generator.spec.permutation  # noqa: F401
         import generator.cli.commands.eval  # noqa: F401
     if args.target == "samples":  # the samples reader relies on it: its branches are coverage too
         for fn in vars(npy_format).values():

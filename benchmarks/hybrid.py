@@ -44,9 +44,9 @@ from generator import __version__  # noqa: E402
 sys.path.insert(0, str(REPO / "benchmarks"))
 from cliargs import positive, size as size_arg  # noqa: E402
 from generator.analysis import entry_cost  # noqa: E402
-from generator.build import build_scene  # noqa: E402
+from generator.assemble import build_scene  # noqa: E402
 from generator.library.bricks import load_library  # noqa: E402
-from generator.matrix.scene import load_scene  # noqa: E402
+from generator.scene.load import load_scene  # noqa: E402
 from generator.runtime.device import Device  # noqa: E402
 from generator.runtime.placement import load_placement  # noqa: E402
 from generator.runtime.renderer import render_scene  # noqa: E402

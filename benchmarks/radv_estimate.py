@@ -30,7 +30,7 @@ from generator import __version__  # noqa: E402
 from generator.analysis import entry_cost  # noqa: E402
 from generator.compose import compose_eval  # noqa: E402
 from generator.library.bricks import load_library  # noqa: E402
-from generator.matrix.scene import load_scene  # noqa: E402
+from generator.scene.load import load_scene  # noqa: E402
 from generator.measure.gpu import GpuRequest, estimate_check, spearman, uber_load  # noqa: E402
 from generator.measure.plans import scene_rows  # noqa: E402
 from generator.measure.report import group, markdown  # noqa: E402

@@ -211,7 +211,7 @@ def studies(lib) -> tuple[list[Study], list[str]]:
                        params=measured, direct=True))
     else:
         notes.append("measured: left out, no HOMOMORPHIC_TARGET in generator/reference/specular.py")
-    from generator.matrix.permutation import SpecError, parse_brdf
+    from generator.spec.permutation import SpecError, parse_brdf
     have = []
     for st in s:
         specs = list(st.kernels.values()) + ([st.exact] if st.exact else [])

@@ -46,11 +46,11 @@ def brdfs(lib) -> list[str]:
 
 def packings(lib, brdf: str) -> list[str]:
     """The packings a material of this BRDF may have: constants and albedo_texture with every normal filler, kept
-    where scene loading accepts them (matrix/constraints.py): albedo_texture only for a BRDF that reads rho_d,
+    where scene loading accepts them (spec/constraints.py): albedo_texture only for a BRDF that reads rho_d,
     and only normals that carry the tangent for a BRDF that reads the tangent frame. Each term is parsed once."""
-    from generator.matrix.constraints import reads_tangent
-    from generator.matrix.permutation import parse_brdf
-    from generator.library.params import spec_params
+    from generator.spec.constraints import reads_tangent
+    from generator.spec.permutation import parse_brdf
+    from generator.spec.params import spec_params
     normals = [b.id for b in sorted(lib.of_kind("normal"), key=lambda b: b.id)]
     tangent, params = False, set()
     for term in brdf.split("+"):  # a BRDF is diffuse + specular terms; fillers have no '+'

@@ -24,7 +24,7 @@ def golden_sources() -> dict[str, tuple[str, str, str]]:
     """{relative path under tests/golden: (language, stage, text)} for every case."""
     from generator.library.bricks import load_library
     from generator.compose import compose_eval, compose_permutation
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     cases = tomllib.loads((GOLDEN / "cases.toml").read_text())
     lib = load_library()
@@ -51,7 +51,7 @@ def _link_sources(cases: dict) -> dict[str, tuple[str, str, str]]:
     from generator.compose import compose_eval, compose_permutation, compose_shade_kernel
     from generator.library.bricks import load_library
     from generator.link import switch_program
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     lib = load_library([REPO / cases["link_bricks"]])
     out = {}

@@ -123,7 +123,7 @@ def test_a_brick_id_that_is_not_a_name_and_a_packing_without_a_normal_slot(tmp_p
 
 def test_slot_defaults_that_form_a_cycle_are_one_error(tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.permutation import SpecError, parse_brdf
+    from generator.spec.permutation import SpecError, parse_brdf
 
     (tmp_path / "sp.py").write_text('"""S."""\nBRICK = {"kind": "specular", "cite": "x", '
                                     '"slots": {"ndf": {"kind": "ndf", "default": "cyc"}}}\n\n\n'
@@ -190,7 +190,7 @@ def test_the_glue_and_templates_generate_only_the_names_bricks_are_kept_from():
     from generator.library.bricks import GLUE_FUNCTIONS, REPO, load_library
     from generator.link import link_permutation, switch_program
     from generator.link.uber import link_ubershader
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     lib = load_library()
     perms = list(load_scene(REPO / "scenes" / "example.toml", lib).permutations.values())

@@ -18,14 +18,14 @@ def _tree(root: Path) -> dict[str, bytes]:
 @pytest.fixture(scope="module")
 def lib_scene():
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     lib = load_library()
     return lib, load_scene(EXAMPLE, lib)
 
 
 @pytest.mark.toolchain
 def test_a_rebuild_from_the_cache_compiles_nothing_and_writes_the_same_bytes(lib_scene, tmp_path):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from generator.io import Store
 
     lib, scene = lib_scene
@@ -42,7 +42,7 @@ def test_a_rebuild_from_the_cache_compiles_nothing_and_writes_the_same_bytes(lib
 
 @pytest.mark.toolchain
 def test_a_damaged_entry_is_detected_dropped_and_rebuilt_never_served(lib_scene, tmp_path):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from generator.io import Store
 
     lib, scene = lib_scene

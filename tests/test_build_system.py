@@ -30,7 +30,7 @@ def _consistent(out: Path, exact: bool = True) -> dict:
     directories hold nothing else. An interrupted build may leave new, not yet named files: never a named one
     changed or missing."""
     import hashlib
-    from generator.build.outputs import named
+    from generator.assemble.outputs import named
     m = json.loads((out / "manifest.json").read_text())
     files = {str(p.relative_to(out)) for p in out.rglob("*") if p.is_file() and p.parent != out}  # the trees
     assert named(m) <= files, sorted(named(m) - files)[:5]
@@ -64,7 +64,7 @@ def test_the_depfile_lists_the_scene_every_brick_and_every_template_read(tmp_pat
 
 
 def test_a_second_build_into_the_same_directory_waits_for_the_first(tmp_path):
-    from generator.build.outputs import locked
+    from generator.assemble.outputs import locked
     out = tmp_path / "out"
     with locked(out):  # a build holds the directory ...
         p = subprocess.Popen([sys.executable, "-m", "generator.cli", "build", str(EXAMPLE), "--out", str(out)],
@@ -110,7 +110,7 @@ def test_kill_9_at_any_moment_loses_nothing_and_the_next_build_cleans_up(tmp_pat
         p.wait()
         _consistent(out, exact=False)  # whatever the moment: the manifest (old or new) and the files it names agree
     assert landed >= 3, f"only {landed} of the kills found the build running (a build takes {took:.2f} s)"
-    from generator.build.outputs import STALE_S
+    from generator.assemble.outputs import STALE_S
     _orphans_done()
     for d in Path(tempfile.gettempdir()).glob("shadermatrix-*"):  # let the killed builds' temp dirs be old
         old = time.time() - STALE_S - 1
@@ -121,7 +121,7 @@ def test_kill_9_at_any_moment_loses_nothing_and_the_next_build_cleans_up(tmp_pat
     assert m["permutations"][0]["input_key"] != before["permutations"][0]["input_key"]
     assert all(p["status"] == "ok" for p in m["permutations"])
     assert not list(out.rglob("*.tmp"))
-    from generator.build.outputs import TEMP_DIR, _alive
+    from generator.assemble.outputs import TEMP_DIR, _alive
     left = [d for d in Path(tempfile.gettempdir()).glob("shadermatrix-*")
             if (m := TEMP_DIR.match(d.name)) and not _alive(int(m[1]))]
     assert left == []  # what the killed builds left in the temp dir went with the next build

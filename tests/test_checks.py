@@ -60,11 +60,11 @@ def test_check_passes_writes_and_diffs_golden_sources_per_platform(tmp_path):
 
 
 def test_check_usage_errors_and_selection(tmp_path):
-    from generator.build.checks import checks
+    from generator.assemble.checks import checks
     from generator.cli.commands.check import selection
     from generator.lang.errors import UsageError
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     assert _check(EXAMPLE, "--platform", "metal").returncode == 2
     assert _check(EXAMPLE, "--update-golden").returncode == 2

@@ -189,8 +189,8 @@ def test_compiler_failure_names_the_brick_line_and_other_permutations_still_buil
 def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, tools):
     from generator import io as cache
     from generator.library.bricks import load_library
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
 
     lib = load_library()
     scene = load_scene(EXAMPLE, lib)
@@ -199,7 +199,7 @@ def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, to
     before = tree(out)
     # Make the next build produce different bytes everywhere, then interrupt it mid-way.
     monkeypatch.setattr("generator.compose.__version__", "9.9.9")
-    monkeypatch.setattr("generator.build.__version__", "9.9.9")  # part of every permutation's input key
+    monkeypatch.setattr("generator.assemble.__version__", "9.9.9")  # part of every permutation's input key
     real_replace, calls = cache.os.replace, []
 
     def flaky_replace(src, dst):
@@ -221,7 +221,7 @@ def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, to
     again = build_scene(scene, lib, out)  # the next build finishes the job and leaves a consistent tree
     assert again.ok
     m = json.loads((out / "manifest.json").read_text())
-    from generator.build.outputs import named
+    from generator.assemble.outputs import named
     listed = named(m)
     files = {p for p in tree(out) if "/" in p}
     assert files == listed, "no file the manifest does not name, none it names missing"

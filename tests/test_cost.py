@@ -295,9 +295,9 @@ def test_scene_costs_markdown_and_csv(scene_json):
 @pytest.mark.toolchain
 def test_manifest_carries_the_same_costs(scene_json, tmp_path):
     from generator.library.bricks import load_library
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from generator.analysis import entry_cost
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     lib = load_library()
     res = build_scene(load_scene(EXAMPLE, lib), lib, tmp_path)
     assert res.ok

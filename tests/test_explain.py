@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 
 from generator.library.bricks import load_library
-from generator.matrix.constraints import CONSTRAINTS
-from generator.matrix.explain import violations
-from generator.matrix.permutation import Permutation
+from generator.spec.constraints import CONSTRAINTS
+from generator.scene.explain import violations
+from generator.spec.permutation import Permutation
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -97,7 +97,7 @@ def test_fp16_literals_saturate_and_carry_the_half_suffix():
 
 
 def test_precision_axis_and_key():
-    from generator.matrix.permutation import PRECISIONS, LightKey, Permutation
+    from generator.spec.permutation import PRECISIONS, LightKey, Permutation
 
     assert PRECISIONS == ("fp32", "fp16")
     a = Permutation("lambert", (LightKey("directional", "none"),), "constants")
@@ -108,7 +108,7 @@ def test_precision_axis_and_key():
 def test_fp16_permutation_keeps_a_32_bit_interface():
     """The fragment shader's stage inputs, outputs and uniform blocks stay 32-bit; shade() runs in half."""
     from generator.compose import compose_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     perm = Permutation("lambert+microfacet(ndf=ggx)", (LightKey("directional", "none"),), "constants",
                        precision="fp16")
@@ -237,8 +237,8 @@ def test_fp16_scene_builds(tmp_path):
     and their fragment shaders declare Float16."""
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
 
     lib = _lib()
     scene = load_scene(_fp16_scene(tmp_path), lib)
@@ -257,8 +257,8 @@ def test_fp16_scene_builds(tmp_path):
 def test_build_warns_for_an_fp16_unsafe_brick(tmp_path):
     """A brick whose metadata says "fp16": "unsafe: ..." makes an fp16 build warn (and only an fp16 one)."""
     from generator.library.bricks import load_library
-    from generator.matrix.permutation import fp16_warnings
-    from generator.matrix.scene import load_scene
+    from generator.spec.permutation import fp16_warnings
+    from generator.scene.load import load_scene
 
     bricks = tmp_path / "bricks" / "brdf" / "diffuse"
     bricks.mkdir(parents=True)
@@ -390,7 +390,7 @@ def test_fp16_scene_renders_like_fp32(tmp_path, monkeypatch):
     from PIL import Image
 
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
 
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):

@@ -98,7 +98,7 @@ def _bricks(n: int, seed: int, tmp_path):
 
 def _scenes(n: int, seed: int, tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     lib = load_library()
     rng = random.Random(seed)
     tmp_path.mkdir(parents=True, exist_ok=True)

@@ -1,4 +1,4 @@
-"""glTF 2.0 scenes (issue 12 items 1 and 6; generator/matrix/gltf.py): the Khronos sample-style cases written
+"""glTF 2.0 scenes (issue 12 items 1 and 6; generator/scene/gltf.py): the Khronos sample-style cases written
 here (a textured metal, an alpha-masked leaf, a double-sided cloth, a mesh without tangents, lights of all three
 types) map to the bricks, build in all three languages, share a permutation exactly where the shader is the same,
 and every malformed file or unsupported shading extension is one error with the file and the JSON pointer."""
@@ -146,7 +146,7 @@ def sample_doc(extra_lights=True) -> Doc:
 
 
 def test_sample_scene_maps_materials_lights_and_objects(tmp_path, lib):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     scene = load_scene(sample_doc().write_gltf(tmp_path / "model.gltf"), lib)
     m = scene.materials
     assert {x.brdf for x in m.values()} == {BRDF}
@@ -182,7 +182,7 @@ def test_sample_scene_maps_materials_lights_and_objects(tmp_path, lib):
 
 
 def _key_of(tmp_path, lib, mutate, name):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     g = sample_doc()
     mutate(g)
     scene = load_scene(g.write_gltf(tmp_path / f"{name}.gltf"), lib)
@@ -231,7 +231,7 @@ def test_permutations_change_exactly_where_the_shader_does(tmp_path, lib):
     assert got["leaf"] != ref["leaf"] and {k: v for k, v in got.items() if k != "leaf"} == \
         {k: v for k, v in ref.items() if k != "leaf"}
 
-    # the surface state (matrix/surface.py): each of these changes the one object's shader, and nothing else
+    # the surface state (spec/surface.py): each of these changes the one object's shader, and nothing else
     def no_colors(g):
         del g.d["meshes"][2]["primitives"][0]["attributes"]["COLOR_0"]
 
@@ -348,7 +348,7 @@ BAD_JSON = [  # (id, pointer changed, new value, pointer in the message, words o
 
 @pytest.mark.parametrize("case", BAD_JSON, ids=[c[0] for c in BAD_JSON])
 def test_malformed_gltf_names_the_json_pointer(tmp_path, lib, case):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     _, ptr, value, where, words = case
     g = sample_doc()
     path = g.write_gltf(tmp_path / "model.gltf")
@@ -366,7 +366,7 @@ def test_embedded_buffer_flat_normals_default_material_strip(tmp_path, lib):
     """A data-URI buffer, a primitive without NORMAL (flat normals, unwelded), without material (glTF's default:
     white, metallic 1, roughness 1) and drawn as a triangle strip; a LINES primitive is skipped with a note."""
     import base64
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     g = Doc()
     pos = g.accessor([[0, 0, 0], [1, 0, 0], [0, 0, -1], [1, 0, -1]], "VEC3")
     g.d["meshes"].append({"name": "strip", "primitives": [{"attributes": {"POSITION": pos}, "mode": 5},
@@ -390,7 +390,7 @@ def test_embedded_buffer_flat_normals_default_material_strip(tmp_path, lib):
 def test_generated_tangents_follow_mirrored_uvs_and_quantized_uvs_decode(tmp_path, lib):
     """u mirrored: T = −x and w = +1 (B = cross(N, T) w still points where v grows, +z); TEXCOORD_0 as normalized
     uint16 (KHR_mesh_quantization) decodes to [0, 1]."""
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     g = Doc()
     nrm = g.texture("n.png")
     mat = g.material(name="m", normalTexture={"index": nrm})
@@ -409,7 +409,7 @@ def test_generated_tangents_follow_mirrored_uvs_and_quantized_uvs_decode(tmp_pat
 
 
 def test_accepted_extensions_are_listed(tmp_path, lib):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     g = sample_doc()
     g.d["extensionsUsed"] += ["KHR_materials_emissive_strength", "EXT_texture_webp"]
     g.d["materials"][2]["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": 2.0}}
@@ -443,7 +443,7 @@ BAD_GLB = [  # (id, bytes → bytes, location, words)
 
 @pytest.mark.parametrize("case", BAD_GLB, ids=[c[0] for c in BAD_GLB])
 def test_broken_glb_chunks(tmp_path, lib, case):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     _, change, where, words = case
     path = tmp_path / "model.glb"
     path.write_bytes(change(_glb_bytes()))
@@ -454,7 +454,7 @@ def test_broken_glb_chunks(tmp_path, lib, case):
 
 
 def test_glb_without_its_bin_chunk(tmp_path, lib):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     d, _ = sample_doc().finish()
     path = tmp_path / "model.glb"
     path.write_bytes(glb(json.dumps(d).encode(), b"")[:-8])  # drop the (empty) BIN chunk's header

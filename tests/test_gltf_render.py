@@ -14,7 +14,7 @@ from tests.test_gltf import sample_doc
 @pytest.mark.toolchain
 def test_a_gltf_scene_renders_its_meshes_where_its_nodes_put_them(tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.placement import load_placement
     from generator.runtime.renderer import render_scene
 
@@ -49,7 +49,7 @@ def test_a_mirrored_single_sided_node_keeps_its_front_face(tmp_path):
     """glTF: a node whose world matrix has a negative determinant reverses its triangles' winding; the renderer
     culls the back faces of a single-sided material, so the mirrored quad must stay as visible as the plain one."""
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
     from tests.test_gltf import Doc
 

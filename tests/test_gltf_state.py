@@ -1,4 +1,4 @@
-"""The surface state in the key (issue 12 item 1; generator/matrix/surface.py): alpha mode, double-sided, vertex
+"""The surface state in the key (issue 12 item 1; generator/spec/surface.py): alpha mode, double-sided, vertex
 colours and emission change the permutation exactly where they change the shader, keep every earlier key, compile
 for every platform, and the renderer draws them (an alpha-masked object vanishes, a double-sided plane is lit from
 behind, an emissive one glows)."""
@@ -20,15 +20,15 @@ def lib():
 
 
 def _perm(lib, packing="constants(normal=vertex)", **state):
-    from generator.matrix.permutation import LightKey, Permutation, canonical, parse_brdf, parse_spec
-    from generator.matrix.surface import Surface
+    from generator.spec.permutation import LightKey, Permutation, canonical, parse_brdf, parse_spec
+    from generator.spec.surface import Surface
     return Permutation(canonical(parse_brdf(BRDF, lib)), (LightKey("point", "none"),),
                        canonical(parse_spec(packing, lib, ("packing",))), surface=Surface(**state))
 
 
 def test_the_default_state_keeps_every_earlier_key(lib):
-    from generator.matrix.permutation import Permutation
-    from generator.matrix.surface import Surface
+    from generator.spec.permutation import Permutation
+    from generator.spec.surface import Surface
     p = _perm(lib)
     assert p.canonical().endswith(";output=linear;precision=fp32")
     assert Permutation(p.brdf, p.lights, p.packing) == p and p.surface == Surface()
@@ -178,7 +178,7 @@ target = [0.0, 0.5, 0.0]
 
 
 def test_toml_scenes_take_the_same_keys(tmp_path, lib):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     path = tmp_path / "state.toml"
     path.write_text(TOML)
     scene = load_scene(path, lib)
@@ -215,7 +215,7 @@ def test_vertex_colours_need_the_brdfs_rho_d_not_a_packings(tmp_path):
     """The scene check is the glue's (link/glue.py surface_inputs: the BRDF's parameters): a rho_d that only the
     packing declares is refused at the material's vertex_color key, not at link time."""
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     (tmp_path / "bricks").mkdir()
     (tmp_path / "bricks" / "tinted.py").write_text(TINTED)
     lib = load_library([tmp_path / "bricks"])
@@ -235,7 +235,7 @@ def test_the_renderer_draws_the_state(tmp_path, lib):
     """One 96×64 render: the masked sphere is not drawn (base_alpha 0.2 < cutoff) and its twin is; seen from
     below with the light below, the single-sided plane is black and the double-sided one lit; the lamp glows
     red without lights."""
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.placement import load_placement
     from generator.runtime.renderer import render_scene
     path = tmp_path / "state.toml"

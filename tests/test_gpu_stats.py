@@ -76,7 +76,7 @@ def test_a_fixed_kernel_has_plausible_statistics_and_a_bigger_one_needs_more_reg
 
 def test_the_ubershader_needs_at_least_the_registers_of_every_specialized_shader(radv):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.measure.gpu import GpuRequest, estimate_check
     from generator.measure.plans import scene_rows
 

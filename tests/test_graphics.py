@@ -129,7 +129,7 @@ def test_layouts_from_an_interface_put_blocks_and_texture_pairs_at_their_binding
     from generator.compose import compose_permutation
     from generator.compose.uber import compose_ubershader
     from generator.library.bricks import load_library
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.runtime.graphics import layouts_from_interface, resource_keys
 
     lib = load_library()
@@ -181,7 +181,7 @@ def gpu(device):
     from generator.library.bricks import load_library
     from generator.link.interface import pack
     from generator.link.uber import SPEC_VARIANT
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.runtime import graphics as gx
     from generator.toolchain import CompileJob, compile_many
 

@@ -20,9 +20,9 @@ def _stamps(root: Path) -> dict:
 
 @pytest.fixture
 def built(tmp_path):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     lib = load_library()
     scene = load_scene(EXAMPLE, lib)
     out = tmp_path / "out"
@@ -34,7 +34,7 @@ def built(tmp_path):
 def test_a_no_op_rebuild_composes_compiles_and_writes_nothing(built, monkeypatch):
     import generator.compose as compose
     import generator.compose.uber as uber
-    from generator.build import build_scene
+    from generator.assemble import build_scene
 
     lib, scene, out = built
     before = _stamps(out)
@@ -50,7 +50,7 @@ def test_a_no_op_rebuild_composes_compiles_and_writes_nothing(built, monkeypatch
 
 
 def test_a_changed_brick_rebuilds_only_the_permutations_that_read_it(built):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
 
     lib, scene, out = built
     key = ("ndf", "beckmann")
@@ -65,7 +65,7 @@ def test_a_changed_brick_rebuilds_only_the_permutations_that_read_it(built):
 
 
 def test_a_changed_material_value_rebuilds_only_its_permutations(built):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
 
     lib, scene, out = built
     name = next(iter(scene.materials))
@@ -79,7 +79,7 @@ def test_a_changed_material_value_rebuilds_only_its_permutations(built):
 
 
 def test_a_damaged_output_is_rebuilt(built):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
 
     lib, scene, out = built
     victim = sorted((out / "vulkan" / "glsl").glob("*.frag.spv"))[0]

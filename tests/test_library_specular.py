@@ -365,7 +365,7 @@ def test_cook_torrance_is_lambert_and_microfacet_weighted_by_s(pairs):
 
 
 def test_cook_torrance_defaults_are_cook_and_torrances_choices():
-    from generator.matrix.permutation import canonical, parse_brdf
+    from generator.spec.permutation import canonical, parse_brdf
     assert canonical(parse_brdf("cook_torrance", LIB)) == \
         "cook_torrance(ndf=beckmann,fresnel=schlick,vis=torrance_sparrow)"
 
@@ -387,7 +387,7 @@ ANISOTROPIC = ["banks", "ward_anisotropic", "ashikhmin_shirley", "lafortune"]
 @pytest.mark.parametrize("brick", ANISOTROPIC)
 def test_anisotropic_brick_without_tangents_is_an_error_naming_the_material(brick, tmp_path):
     from generator.lang import SourceError
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     s = tmp_path / "s.toml"
     s.write_text(f'[materials.brushed_steel]\nbrdf = "{brick}"\n')
     with pytest.raises(SourceError) as e:
@@ -399,7 +399,7 @@ def test_anisotropic_brick_without_tangents_is_an_error_naming_the_material(bric
 
 
 def test_isotropic_specular_bricks_need_no_tangent(tmp_path):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     s = tmp_path / "s.toml"
     s.write_text("".join(f'[materials.m{i}]\nbrdf = "{b}"\n' for i, b in enumerate(
         ["phong", "phong_reciprocal", "blinn_phong_normalized_fresnel", "ward_isotropic", "lambert+cook_torrance"])))

@@ -85,7 +85,7 @@ def _light_samples(n=3000, seed=1):
 
 
 def _light_perm(light):
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     return Permutation("lambert", (LightKey(light, "none"),), "constants(normal=vertex)", "linear")
 
 
@@ -117,7 +117,7 @@ def test_light_brick_equals_its_float64_reference_in_numpy(lib, light, change):
 def test_a_storage_buffer_of_the_new_lights_equals_them_unrolled(lib, light):
     """`*light/none` (a loop over LightData, one vec4 per parameter) sums what two static lights give."""
     from generator.eval.shade import shade_samples
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     P = _light_samples(400, seed=9)
     N = np.tile([0.0, 1.0, 0.0], (len(P), 1))
@@ -253,7 +253,7 @@ def _dir_light_values():
 def test_gltf_metallic_roughness_gives_rho_d_f0_alpha_of_gltf_appendix_b(lib):
     """glTF 2.0 Appendix B: c_diff = base (1 − metallic), f0 = mix(0.04, base, metallic), α = roughness²,
     base = baseColorFactor · texture (sRGB decoded by the view), metallic/roughness = factor · ORM.b / .g."""
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     spec = f"lambert+{GGX}"
     perm = Permutation(spec, (LightKey("directional", "none"),), "gltf_metallic_roughness(normal=vertex)", "linear")
@@ -288,7 +288,7 @@ def test_gltf_metallic_roughness_gives_rho_d_f0_alpha_of_gltf_appendix_b(lib):
 
 def test_a_textured_ggx_metal_with_f0_roughness_texture(lib):
     """A specular-only GGX metal: f0 = f0 · texture.rgb, α = (roughness · texture.a)²."""
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     perm = Permutation(GGX, (LightKey("directional", "none"),), "f0_roughness_texture(normal=vertex)", "linear")
     fn, names, lp = _numpy_shade(lib, perm)
@@ -312,7 +312,7 @@ def _tangent_args(Ng, T):
 def test_normal_map_xy_reconstructs_z_and_equals_the_rgb_normal_map(lib):
     """A unit tangent-space normal stored as RGB (normal_map) and as RG only (normal_map_xy) shades the same;
     an xy beyond the unit disc (filtering) gives z = 0, not NaN."""
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.eval.shade import _surface
 
     rng = np.random.default_rng(5)
@@ -348,7 +348,7 @@ def test_normal_map_xy_reconstructs_z_and_equals_the_rgb_normal_map(lib):
 def test_normal_power_gloss_packs_normal_power_and_gloss_in_one_texture(lib):
     """The course's packed texture: one binding `normal_map` read by the packing (B, A) and its
     normal_map_xy filler (R, G); n = n_max^B, f0 = A · f0."""
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.eval.shade import _surface
 
     spec = "lambert+blinn_phong_normalized"
@@ -376,7 +376,7 @@ def test_normal_power_gloss_packs_normal_power_and_gloss_in_one_texture(lib):
 
 def test_specular_map_is_the_course_shift_variant_shader(lib):
     """Kd from albedo_map, Ks = specular_map.rgb, n = n_max^(specular_map.a)."""
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     spec = "lambert+blinn_phong_normalized"
     perm = Permutation(spec, (LightKey("directional", "none"),), "specular_map(normal=vertex)", "linear")
@@ -403,7 +403,7 @@ def test_specular_map_is_the_course_shift_variant_shader(lib):
     ("lambert+blinn_phong_normalized", "gltf_metallic_roughness", "alpha"),
 ])
 def test_a_packing_providing_what_the_brdf_does_not_read_is_one_clear_error(lib, brdf, packing, names):
-    from generator.matrix.permutation import LightKey, Permutation, check_packing, resolve
+    from generator.spec.permutation import LightKey, Permutation, check_packing, resolve
 
     r = resolve(Permutation(brdf, (LightKey("directional", "none"),), packing, "linear"), lib)
     problem, todo = check_packing(r)
@@ -443,7 +443,7 @@ def _output_inputs(n=4097):
 
 def _output_run(lib, output, target):
     from generator.eval.shade import shade_samples
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     x, N = _output_inputs()
     perm = Permutation("lambert", (LightKey("directional", "none"),), "constants(normal=vertex)", output)
@@ -463,7 +463,7 @@ def test_output_bricks_equal_their_references_in_numpy(lib):
     # saturate: out-of-range inputs are clipped as a UNORM target would, never NaN
     from generator.targets.numpy import NumpyTarget
     from generator.link import link_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     perm = Permutation("lambert", (LightKey("directional", "none"),), "constants(normal=vertex)", "srgb")
     lp = link_permutation(perm, lib)
@@ -480,7 +480,7 @@ def test_srgb_in_float32_numpy_is_within_a_few_ulp_of_float64():
     from generator.reference.outputs import srgb_encode
     from generator.library.bricks import load_library
     from generator.link import link_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.targets.numpy import NumpyTarget
 
     lib = load_library()
@@ -582,8 +582,8 @@ def _scene_text(output, materials):
 def test_a_scene_of_the_new_bricks_builds_in_every_language(lib, tmp_path, output, materials):
     """Every permutation (and the ubershader) compiles and validates in GLSL, HLSL and WGSL; the
     fragment shader declares exactly the textures its packing and normal read, with their color spaces."""
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
 
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         from tests.conftest import require_tool
@@ -616,7 +616,7 @@ def test_the_scene_renders_the_same_specialized_and_through_the_ubershader(lib, 
     (measured: identical)."""
     from PIL import Image
 
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
 
     path = tmp_path / "scene.toml"

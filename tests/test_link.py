@@ -153,7 +153,7 @@ def test_anisotropic_filler_on_lavapipe_against_float64(lib, frame, language):
 
 
 def test_tangent_brdf_needs_a_packing_with_a_tangent_frame(lib, tmp_path):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     scene = tmp_path / "s.toml"
     body = ('[scene]\nname = "t"\n[materials.brushed]\nbrdf = "microfacet(ndf=aniso_ggx)"\npacking = "{p}"\n'
@@ -173,7 +173,7 @@ def test_tangent_brdf_needs_a_packing_with_a_tangent_frame(lib, tmp_path):
 
 def test_output_brick_parameter_reaches_the_material_block_and_scales_the_output(lib):
     from generator.link import link_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.targets.numpy import NumpyTarget
 
     perm = Permutation("lambert", (LightKey("directional", "none"),), "constants(normal=vertex)", "exposure")
@@ -194,7 +194,7 @@ def test_output_brick_parameter_reaches_the_material_block_and_scales_the_output
 @pytest.mark.toolchain
 def test_output_brick_with_a_parameter_compiles_in_every_language(lib):
     from generator.compose import compose_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.toolchain import CompileJob, compile_many
 
     perm = Permutation("lambert", (LightKey("point", "none"),), "constants(normal=vertex)", "exposure")
@@ -230,8 +230,8 @@ def test_output_brick_must_take_color(tmp_path):
 
 
 def test_one_name_two_types_or_disjoint_ranges_is_an_error_naming_both_bricks(tmp_path):
-    from generator.matrix.permutation import parse_brdf
-    from generator.library.params import spec_params
+    from generator.spec.permutation import parse_brdf
+    from generator.spec.params import spec_params
 
     base = load_library()
     d = tmp_path / "b"
@@ -259,7 +259,7 @@ DYNAMIC = ("lambert+blinn_phong_normalized", "constants(normal=vertex)")
 def test_fragment_loops_over_a_storage_buffer_of_lights_with_a_runtime_count(lib):
     """shade() with *point lights read from a buffer of 3 = shade() with 3 static point lights (NumPy)."""
     from generator.link import link_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.targets.numpy import NumpyTarget
 
     brdf, packing = DYNAMIC
@@ -292,7 +292,7 @@ def test_fragment_loops_over_a_storage_buffer_of_lights_with_a_runtime_count(lib
 def test_buffer_light_loop_compiles_and_its_spirv_declares_the_storage_block(lib):
     from generator.analysis.reflect import flatten_layout, reflect
     from generator.compose import compose_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.toolchain import CompileJob, compile_many
 
     brdf, packing = DYNAMIC
@@ -327,7 +327,7 @@ def _lobes_expected(L, V, N, lobes, count):
 
 
 def test_array_parameter_count_is_part_of_the_key(lib):
-    from generator.matrix.permutation import LightKey, Permutation, SpecError, parse_brdf, canonical
+    from generator.spec.permutation import LightKey, Permutation, SpecError, parse_brdf, canonical
     from generator.link import link_permutation
 
     assert canonical(parse_brdf("lobes", lib)) == "lobes(lobes=4)"
@@ -443,7 +443,7 @@ def test_texture_reading_brdfs_compile_as_fragment_shaders_with_their_bindings(l
     """2D and cube lookup textures of BRDF bricks become material textures of the permutation (set 1)."""
     from generator.analysis.reflect import reflect
     from generator.compose import compose_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.toolchain import CompileJob, compile_many
 
     perm = Permutation("lut_diffuse+env_cube", (LightKey("point", "none"),), "constants(normal=vertex)")
@@ -532,7 +532,7 @@ def test_switch_over_arrays_counts_and_a_shared_texture(lib, frame, lut, target)
 @pytest.mark.toolchain
 def test_one_brick_at_two_array_counts_links_into_one_program(lib):
     from generator.link import Program
-    from generator.matrix.permutation import parse_brdf
+    from generator.spec.permutation import parse_brdf
 
     prog = Program()
     for spec in ("lobes(lobes=1)", "lobes(lobes=2)", "lobes"):
@@ -556,7 +556,7 @@ def test_loader_refuses_what_the_link_stage_cannot_bind(tmp_path):
 
 def test_packing_that_provides_a_parameter_with_the_wrong_type_is_a_clear_error(tmp_path):
     from generator.link import link_permutation
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
 
     d = tmp_path / "b"
     _brick(d, "packing/rough.py", '"""Rough."""\nBRICK = {"kind": "packing", "cite": "x", '
@@ -571,8 +571,8 @@ def test_packing_that_provides_a_parameter_with_the_wrong_type_is_a_clear_error(
 
 @pytest.mark.toolchain
 def test_scene_sets_output_parameters_per_material_and_the_upload_carries_them(lib, tmp_path):
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
     import json
     import struct as st
 
@@ -613,7 +613,7 @@ def test_buffer_light_loop_and_exposure_run_on_lavapipe(lib, surface, language):
     a storage buffer of 3 point lights with a runtime count equals 3 static point lights,
     an exposure of +1 stop doubles the output, and both agree with the float64 NumPy glue."""
     from generator.eval.shade import shade_samples
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.runtime.probe import lavapipe_present
     from tests.conftest import require
 
@@ -660,7 +660,7 @@ def test_bricks_linked_once_and_shared_compose_what_a_fresh_library_composes():
     exactly what a fresh library gives for each."""
     from generator.compose import compose_permutation
     from generator.compose.uber import compose_ubershader
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     def sources(lib, perm):
         return [(s.language, s.stage, s.text) for s in compose_permutation(perm, lib).sources]

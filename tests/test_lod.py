@@ -73,7 +73,7 @@ def _numpy_shade(lib, perm):
 
 
 def _perm(brdf, packing):
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     return Permutation(brdf, (LightKey("directional", "none"),), packing, "linear")
 
 
@@ -211,7 +211,7 @@ def test_one_normal_map_binding_and_only_the_parameters_read(lib, brdf, packing,
 @pytest.mark.parametrize("brdf,packing,provides", [(GGX, "toksvig_n", "n"),
                                                    (f"lambert+{BP}", "toksvig_alpha", "alpha")])
 def test_a_toksvig_packing_on_a_brdf_without_its_parameter_is_one_clear_error(lib, brdf, packing, provides):
-    from generator.matrix.permutation import check_packing, resolve
+    from generator.spec.permutation import check_packing, resolve
 
     problem, todo = check_packing(resolve(_perm(brdf, packing), lib))
     assert f"packing '{packing}' provides {provides}, which BRDF" in problem, problem
@@ -259,8 +259,8 @@ def test_a_scene_of_toksvig_materials_builds_in_every_language(lib, tmp_path):
     permutations: `shiny` (Toksvig) and `course` (the 30 % reduction alone) share one shader."""
     import json
 
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
     from tests.conftest import require_tool
 
     for tool in ("glslc", "naga", "spirv-val", "spirv-opt"):
@@ -285,7 +285,7 @@ def test_the_scene_renders_the_same_specialized_and_through_the_ubershader(lib, 
     between texels shortens N_a too): a lit image, and the ubershader draws the same pixels."""
     from PIL import Image
 
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
 
     path = tmp_path / "lod.toml"

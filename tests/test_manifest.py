@@ -22,9 +22,9 @@ EXAMPLE = REPO / "scenes" / "example.toml"
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     out = tmp_path_factory.mktemp("manifest")
     lib = load_library()

@@ -2,8 +2,8 @@
 import pytest
 
 from generator.library.bricks import load_library
-from generator.matrix.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
-from generator.matrix.scene import load_scene
+from generator.spec.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
+from generator.scene.load import load_scene
 from tests.regen_goldens import REPO
 
 

@@ -17,7 +17,7 @@ EXAMPLE = REPO / "scenes" / "example.toml"
 # ------------------------------------------------------------------ an independent minimal reader
 
 def minimal_read(data: bytes) -> dict:
-    """The layout of generator/build/pack.py's docstring, read with struct alone (no package code)."""
+    """The layout of generator/assemble/pack.py's docstring, read with struct alone (no package code)."""
     magic, version, count, key, meta_len, reserved = struct.unpack_from("<8sII32sII", data, 0)
     assert magic == b"SMPACK\r\n" and version == 1 and reserved == 0
     meta = json.loads(data[56:56 + meta_len])
@@ -40,7 +40,7 @@ def minimal_read(data: bytes) -> dict:
 def expected_entries(out: Path, manifest: dict, platform: str) -> dict:
     """{(permutation, stage): bytes} the pack of `platform` must hold: every ok entry's artifact (and the
     ubershader's GLSL SPIR-V in vulkan's)."""
-    from generator.build.platforms import PLATFORM_TABLE
+    from generator.assemble.platforms import PLATFORM_TABLE
     want = {}
     for e in manifest["permutations"]:
         if e.get("status") == "ok":
@@ -58,14 +58,14 @@ def expected_entries(out: Path, manifest: dict, platform: str) -> dict:
 @pytest.fixture(scope="module")
 def lib_scene():
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     lib = load_library()
     return lib, load_scene(EXAMPLE, lib)
 
 
 @pytest.fixture(scope="module")
 def packed(lib_scene, tmp_path_factory):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     lib, scene = lib_scene
     out = tmp_path_factory.mktemp("packed")
     res = build_scene(scene, lib, out, pack=True)
@@ -95,7 +95,7 @@ def test_build_pack_on_the_command_line_writes_one_pack_per_platform_listed_in_t
 
 @pytest.mark.toolchain
 def test_the_package_reader_and_an_independent_reader_agree_with_the_manifests_spirv(packed):
-    from generator.build.pack import lookup, read_pack
+    from generator.assemble.pack import lookup, read_pack
     out, manifest = packed
     keys = {p["hash"]: p["input_key"] for p in manifest["permutations"]} | {"ubershader": manifest["ubershader"]["input_key"]}
     for p in manifest["packs"]:
@@ -120,7 +120,7 @@ def test_the_package_reader_and_an_independent_reader_agree_with_the_manifests_s
 
 @pytest.mark.toolchain
 def test_packs_are_deterministic_and_a_rebuild_writes_nothing(packed, lib_scene, tmp_path):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     out, manifest = packed
     lib, scene = lib_scene
     again = build_scene(scene, lib, tmp_path / "b", pack=True)
@@ -138,7 +138,7 @@ def test_packs_are_deterministic_and_a_rebuild_writes_nothing(packed, lib_scene,
 
 @pytest.mark.toolchain
 def test_without_pack_the_manifest_is_what_it_was_and_no_pack_is_left(packed, lib_scene, tmp_path):
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     out, manifest = packed
     lib, scene = lib_scene
     plain = tmp_path / "plain"
@@ -155,8 +155,8 @@ def test_without_pack_the_manifest_is_what_it_was_and_no_pack_is_left(packed, li
 
 @pytest.mark.toolchain
 def test_a_changed_tool_version_changes_the_pack_key(packed, lib_scene, tmp_path, monkeypatch):
-    import generator.build as build
-    from generator.build.pack import read_pack
+    import generator.assemble as build
+    from generator.assemble.pack import read_pack
     out, manifest = packed
     lib, scene = lib_scene
     real = build.tool_versions()
@@ -173,7 +173,7 @@ def test_a_changed_tool_version_changes_the_pack_key(packed, lib_scene, tmp_path
 
 @pytest.mark.toolchain
 def test_a_damaged_built_pack_is_refused_naming_the_file(packed, tmp_path):
-    from generator.build.pack import PackError, read_pack
+    from generator.assemble.pack import PackError, read_pack
     out, manifest = packed
     data = bytearray((out / manifest["packs"][0]["path"]).read_bytes())
     data[-100] ^= 0x01  # one bit of the last blob
@@ -203,7 +203,7 @@ def _write(tmp_path, data: bytes) -> Path:
 
 
 def test_a_pack_round_trips(tmp_path):
-    from generator.build.pack import PackError, encode_pack, lookup, read_pack
+    from generator.assemble.pack import PackError, encode_pack, lookup, read_pack
     data, key = encode_pack(META, _entries())
     assert encode_pack(META, list(reversed(_entries()))) == (data, key)  # sorted: order-independent bytes
     pack = read_pack(_write(tmp_path, data))
@@ -256,7 +256,7 @@ def _corrupt(data: bytes, how: str) -> bytes:
     ("input_key", r"the pack key does not match its metadata and index"),
 ])
 def test_a_corrupt_or_truncated_pack_is_refused_with_what_is_wrong(tmp_path, how, message):
-    from generator.build.pack import PackError, encode_pack, read_pack
+    from generator.assemble.pack import PackError, encode_pack, read_pack
     from generator.lang.errors import UserError
     data, _ = encode_pack(META, _entries())
     path = _write(tmp_path, _corrupt(data, how))
@@ -266,7 +266,7 @@ def test_a_corrupt_or_truncated_pack_is_refused_with_what_is_wrong(tmp_path, how
 
 
 def test_an_empty_file_and_a_directory_are_refused(tmp_path):
-    from generator.build.pack import PackError, read_pack
+    from generator.assemble.pack import PackError, read_pack
     with pytest.raises(PackError, match="bad magic b''"):
         read_pack(_write(tmp_path, b""))
     with pytest.raises(PackError, match="not a regular file"):
@@ -276,7 +276,7 @@ def test_an_empty_file_and_a_directory_are_refused(tmp_path):
 
 
 def test_only_ok_entries_are_packed_and_a_damaged_tree_is_refused(tmp_path):
-    from generator.build.pack import PackError, read_pack, write_packs
+    from generator.assemble.pack import PackError, read_pack, write_packs
 
     def entry(h, status, spv):
         (tmp_path / "glsl").mkdir(exist_ok=True)

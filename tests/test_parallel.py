@@ -1,5 +1,5 @@
 """`build -j N` with N > 1 (issue 9): permutations are composed, compiled and analysed in N worker processes
-(generator/build/parallel.py); the output is byte-identical to an in-process build, the counts are the same,
+(generator/assemble/parallel.py); the output is byte-identical to an in-process build, the counts are the same,
 the depfile names the templates the workers read, and a worker's compose error or missing tool is reported as
 in-process."""
 from __future__ import annotations
@@ -25,7 +25,7 @@ def _cli(*args, env=None):
 
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory) -> Path:
-    from generator.build.parallel import MIN_PERMUTATIONS
+    from generator.assemble.parallel import MIN_PERMUTATIONS
     path = tmp_path_factory.mktemp("gen") / "gen.toml"
     n = MIN_PERMUTATIONS + 4
     r = subprocess.run([sys.executable, "benchmarks/scenegen.py", str(n), str(path)], cwd=REPO, capture_output=True,

@@ -24,7 +24,7 @@ def lib():
 
 @pytest.fixture(scope="module")
 def example(lib):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     return load_scene(EXAMPLE, lib)
 
 
@@ -64,7 +64,7 @@ def test_model_is_translate_rotate_y_scale():
 
 
 def test_without_a_placement_file_the_objects_stand_in_a_row(lib, tmp_path):
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.placement import camera, load_placement, placement
 
     shutil.copy(EXAMPLE, tmp_path / "bare.toml")
@@ -138,7 +138,7 @@ def test_the_render_command_reports_a_bad_placement_in_one_line(tmp_path):
 def test_non_finite_placements_are_located_errors(tmp_path):
     from generator.lang import SourceError
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.placement import load_placement
 
     lib = load_library()

@@ -30,8 +30,8 @@ def lib():
 
 
 def _build(lib, scene_path, out, **kw) -> dict:
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
     res = build_scene(load_scene(scene_path, lib), lib, out, **kw)
     assert res.ok, res.failures
     return json.loads((out / "manifest.json").read_text())
@@ -181,7 +181,7 @@ def test_essl_at_fp16_is_mediump_in_the_fragment_stage_only(lib, tmp_path):
     """fp16: the ES vertex transform stays highp (as the other languages' vertex shaders stay 32-bit), and
     Frame, declared by both stages, is highp in both (an ES program's uniforms match across stages)."""
     from generator.compose import compose_permutation
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.toolchain import CompileJob
     from generator.toolchain.platforms import validate_dialects
     scene_file = tmp_path / "fp16.toml"
@@ -202,10 +202,10 @@ def test_a_gl_core_failure_keeps_its_source_beside_like_a_compile_failure(lib, t
     error). The failure: a Vulkan-only specialization constant, which GL core has not (targets/gl.py)."""
     import dataclasses
 
-    from generator.build.platforms import write_platforms
+    from generator.assemble.platforms import write_platforms
     from generator.compose import compose_permutation
     from generator.io import atomic_write
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.toolchain import CompileJob
     from generator.toolchain.platforms import validate_dialects
     scene = load_scene(EXAMPLE, lib)

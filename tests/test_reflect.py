@@ -47,9 +47,9 @@ def by_binding(resources) -> dict:
 @pytest.fixture(scope="module")
 def example(tmp_path_factory, tools):
     """{(hash, stage): {lang: Reflection}} and {hash: GLSL sources by stage} of the built example scene."""
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     lib = load_library()
     out = tmp_path_factory.mktemp("reflect")

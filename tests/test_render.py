@@ -74,7 +74,7 @@ def test_modes_draw_every_object_and_hybrid_converges_to_the_matrix(renders):
 
 def test_the_example_is_the_courtyard_with_the_sun_s_shadow_map_from_a_depth_pass(renders):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.placement import load_placement
 
     for _, _, rep in renders.values():
@@ -175,7 +175,7 @@ def test_bad_arguments_are_one_line_errors(tmp_path):
 
 def test_the_specialization_constant_ubershader_renders_the_same_image(renders, tmp_path, monkeypatch):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
 
     lib = load_library()

@@ -1,5 +1,5 @@
 """Scene files against their schema (issue 10): every wrong key or type is one located line with what to do,
-checked before any value is interpreted (generator/matrix/schema.py); each case below was a traceback, or a
+checked before any value is interpreted (generator/scene/schema.py); each case below was a traceback, or a
 scene accepted that builds something else."""
 from __future__ import annotations
 
@@ -42,7 +42,7 @@ CASES = [  # (id, what replaces what, line of the error, words of the message)
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
 def test_a_malformed_scene_is_one_located_error(case, tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     _, (old, new), line, *words = case
     assert old in BASE
@@ -58,7 +58,7 @@ def test_a_malformed_scene_is_one_located_error(case, tmp_path):
 
 def test_deeply_nested_toml_is_one_located_error(tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     path = tmp_path / "deep.toml"
     path.write_text("x = " + "[" * 2000 + "]" * 2000 + "\n")
@@ -70,7 +70,7 @@ def test_deeply_nested_toml_is_one_located_error(tmp_path):
 def test_an_array_parameter_is_an_array_of_vectors_in_a_scene(tmp_path):
     """A brick parameter with a count (tests/link_bricks/specular/lobes.py) takes one vector per element."""
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     path = tmp_path / "lobes.toml"
     path.write_text('[materials.m]\nbrdf = "lobes(lobes=2)"\nparams = { lobes = [[-1.0, 1.0, 8.0, 0.5], '
@@ -82,7 +82,7 @@ def test_an_array_parameter_is_an_array_of_vectors_in_a_scene(tmp_path):
 
 def test_a_name_with_a_trailing_line_break_is_refused(tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     path = tmp_path / "nl.toml"
     path.write_text(BASE.replace('name = "bench"', 'name = "bench\\n"', 1))
@@ -94,7 +94,7 @@ def test_a_name_with_a_trailing_line_break_is_refused(tmp_path):
 def test_the_shipped_scenes_pass_the_schema():
     import tomllib
 
-    from generator.matrix.schema import SCENE_SCHEMA
+    from generator.scene.schema import SCENE_SCHEMA
     from jsonschema import Draft202012Validator
     Draft202012Validator.check_schema(SCENE_SCHEMA)
     for p in [REPO / "scenes" / "example.toml", REPO / "tests" / "scenes" / "shadow.toml"]:
@@ -103,7 +103,7 @@ def test_the_shipped_scenes_pass_the_schema():
 
 def test_a_light_set_past_the_limit_is_one_located_error(tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import MAX_LIGHTS_PER_SET, load_scene
+    from generator.scene.load import MAX_LIGHTS_PER_SET, load_scene
 
     n = MAX_LIGHTS_PER_SET + 1
     lights = "".join(f'[lights.l{i}]\ntype = "point"\n' for i in range(n))
@@ -129,7 +129,7 @@ TOML_FORMS = [  # (id, what replaces what, the line:col of the error) — each w
 @pytest.mark.parametrize("case", TOML_FORMS, ids=[c[0] for c in TOML_FORMS])
 def test_errors_in_other_toml_forms_are_located_at_the_key(case, tmp_path):
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     _, (old, new), where = case
     assert old in BASE
@@ -143,7 +143,7 @@ def test_errors_in_other_toml_forms_are_located_at_the_key(case, tmp_path):
 def test_the_first_error_reported_is_the_first_in_the_file(tmp_path):
     """Two violations: the one nearer the top is reported, whatever the order of the schema's key paths."""
     from generator.library.bricks import load_library
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     path = tmp_path / "scene.toml"
     text = BASE.replace('name = "bench"', 'name = "bench"\ncolour = 1')  # objects come after materials in the file
@@ -161,8 +161,8 @@ def test_loading_is_linear_in_the_objects(tmp_path, monkeypatch):
     only for the first object of each permutation (and for errors), and plain objects skip jsonschema (it walked
     every object: 1 s of the 10,000). Counted, not timed: benchmarks/build.py times it."""
     from generator.library.bricks import load_library
-    from generator.matrix import schema
-    from generator.matrix.scene import Locator, load_scene
+    from generator.scene import schema
+    from generator.scene.load import Locator, load_scene
 
     head, rest = BASE.split("[[objects]]", 1)
     objects = ["[[objects]]" + o for o in ("[[objects]]" + rest).split("[[objects]]")[1:]]

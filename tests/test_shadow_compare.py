@@ -157,7 +157,7 @@ def _hw_scene(lib, tmp_path, shadow="pcf_hardware", taps=3):
 
     scene = _scene(lib, tmp_path, shadow, f"pcf_taps = {float(taps)}, pcf_texel = 0.00390625")
     scene.path.write_text(scene.path.read_text().replace("shadow_bias = 0.003", "shadow_bias = 0.01"))
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     return load_scene(scene.path, lib)
 
 
@@ -179,7 +179,7 @@ def test_the_manifest_reflects_a_depth_texture_and_its_comparison_sampler_as_the
     import json
 
     from generator.analysis.reflect import reflect
-    from generator.build import build_scene
+    from generator.assemble import build_scene
     from tests.test_manifest import _expected_resources, _reflected_resources
 
     res = build_scene(_hw_scene(lib, tmp_path), lib, tmp_path / "out")
@@ -249,7 +249,7 @@ def test_an_ubershader_binds_depth_compares_beside_plain_shadow_maps_and_lit_sta
     the second light's depth through the comparison slot 0 and a lit 1×1 depth image in slot 1."""
     import shutil
 
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from tests.test_shadows_filtered import SCENE, _render
 
     text = SCENE.read_text().replace('shadow = "shadow_map"', 'shadow = "pcf_hardware"')

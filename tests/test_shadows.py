@@ -41,7 +41,7 @@ POINT = [2.0, 4.0, -0.8]  # the point-light variant's position
 
 def _scene(lib, tmp_path, shadow="shadow_map", light="directional"):
     """The test scene, or a copy (with its placement beside it) whose sun casts `shadow` / is a point light."""
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     if shadow == "shadow_map" and light == "directional":
         return load_scene(SCENE, lib)

@@ -43,7 +43,7 @@ _SERIAL = itertools.count()
 
 def _scene(lib, tmp_path, shadow, params=""):
     """A copy of the shadow test scene whose sun casts `shadow`, with extra light `params` ("k = v, ...")."""
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     d = tmp_path / f"scene-{shadow}-{next(_SERIAL)}"
     d.mkdir()
@@ -221,7 +221,7 @@ def test_vsm_under_a_point_light_needs_a_stronger_bleed_cut(device, lib, tmp_pat
     164, up to 9 of 255), vsm_bleed = 0.5 none (bricks/shadow/vsm.py); pcf shadows the footprint as shadow_map does."""
     from tests.test_shadows import _footprint, _scene as point_scene
 
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     for shadow, extra in [("pcf", ""), ("vsm", ", vsm_bleed = 0.5"), ("vsm", "")]:
         d = tmp_path / f"point-{next(_SERIAL)}"

@@ -404,7 +404,7 @@ def test_wgsl_vertex_keeps_the_vulkan_coordinate_space(require_tool):
     from generator.library.bricks import load_library
     from generator.compose import compose_permutation
     from generator.analysis import entry_cost
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     from generator.toolchain import CompileJob, compile_many
 
     for t in ("glslc", "naga", "spirv-opt", "spirv-val"):

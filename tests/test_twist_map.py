@@ -49,7 +49,7 @@ def _unit(a):
 
 
 def _perm(brdf, normal, packing="constants"):
-    from generator.matrix.permutation import LightKey, Permutation
+    from generator.spec.permutation import LightKey, Permutation
     return Permutation(brdf, (LightKey("directional", "none"),), f"{packing}(normal={normal})", "linear")
 
 
@@ -252,7 +252,7 @@ def test_an_isotropic_brdf_ignores_the_twist(lib):
 
 
 def test_twist_fillers_satisfy_the_tangent_frame_constraint(lib):
-    from generator.matrix.permutation import check_packing, resolve
+    from generator.spec.permutation import check_packing, resolve
 
     for normal in ("twist_map", "normal_twist_map"):
         for brdf in ANISOTROPIC:
@@ -306,8 +306,8 @@ def _scene(tmp_path, materials, **brdf):
 def test_a_scene_of_twist_materials_builds_in_every_language(lib, tmp_path):
     """GLSL, HLSL and WGSL compile and validate (and the ubershader); each fragment shader declares the
     textures and interpolants it reads: the tangent only where the BRDF is anisotropic."""
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
     from tests.conftest import require_tool
 
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
@@ -332,7 +332,7 @@ def test_twisted_spheres_render_the_same_specialized_and_through_the_ubershader(
     the image against normal_map_xy (same RG, no twist)."""
     from PIL import Image
 
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
 
     images = {}

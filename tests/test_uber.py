@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from generator.library.bricks import load_library
-from generator.matrix.permutation import LightKey, Permutation
+from generator.spec.permutation import LightKey, Permutation
 
 REPO = Path(__file__).resolve().parent.parent
 LANGS = ("glsl", "hlsl", "wgsl")
@@ -32,8 +32,8 @@ def lib():
 
 @pytest.fixture(scope="module")
 def example_build(tmp_path_factory):
-    from generator.build import build_scene
-    from generator.matrix.scene import load_scene
+    from generator.assemble import build_scene
+    from generator.scene.load import load_scene
 
     base = load_library()
     out = tmp_path_factory.mktemp("uber")
@@ -215,9 +215,9 @@ def test_a_scene_without_lights_gets_an_ubershader_without_a_light_loop(lib):
 @pytest.mark.toolchain
 def test_the_build_fails_naming_a_value_the_ubershader_cannot_reach(tmp_path, monkeypatch):
     """An ubershader that lost a variant (simulated by linking it from all but one permutation) fails the build."""
-    import generator.build as build
+    import generator.assemble as build
     import generator.compose.uber as uber
-    from generator.matrix.scene import load_scene
+    from generator.scene.load import load_scene
 
     base = load_library()
     scene = load_scene(REPO / "scenes" / "example.toml", base)

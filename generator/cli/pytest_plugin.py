@@ -5,7 +5,7 @@
 
 Registered through the `pytest11` entry point of the package, so installing
 shadermatrix is enough. Each test is named `<scene>::<hash>-<platform>` (vulkan, d3d12,
-gl, webgpu: what each validates is build/checks.py's table); a failure reads as the
+gl, webgpu: what each validates is assemble/checks.py's table); a failure reads as the
 brick line that caused it. With --shadermatrix-golden, a test also fails when the
 permutation's emitted sources drift from the golden directory
 (`shadermatrix check --golden DIR --update-golden` writes it). A gl test whose GLSL ES
@@ -48,7 +48,7 @@ class PermutationItem(pytest.Item):
         self.add_marker("shadermatrix")
 
     def runtest(self):
-        from ..build.checks import dxc_note, golden_diff
+        from ..assemble.checks import dxc_note, golden_diff
         res = self.parent.outcome(self)
         notes = [*res.notes, *([dxc_note()] if self.check.platform == "d3d12" else [])]
         for note in filter(None, notes):
@@ -80,7 +80,7 @@ class SceneCollector(pytest.Collector):
     def outcome(self, item):
         """The item's Outcome: every check of this scene the session runs is compiled in one batch, the first
         time one is asked for; an error of the batch (a missing tool: one line) fails each of its tests."""
-        from ..build.checks import default_store, run_checks
+        from ..assemble.checks import default_store, run_checks
         if item.check not in self.outcomes:
             mine = [i.check for i in self.session.items if isinstance(i, PermutationItem) and i.parent is self]
             todo = [c for c in mine if c not in self.outcomes] or [item.check]
@@ -94,10 +94,10 @@ class SceneCollector(pytest.Collector):
         return res
 
     def collect(self):
-        from ..build.checks import checks
+        from ..assemble.checks import checks
         from ..lang.errors import UserError
         from ..library.bricks import load_library
-        from ..matrix.scene import load_scene
+        from ..scene.load import load_scene
         from .commands.check import selection
         opt = self.config.getoption
         try:  # a bad scene, brick or option is the run's usage error, one line, not an INTERNALERROR

@@ -18,7 +18,7 @@ from .. import __version__
 from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link import EvalProgram, Interface, Slot, eval_program, link_permutation
-from ..matrix.permutation import Permutation
+from ..spec.permutation import Permutation
 from ..targets import LANGUAGES, get_target
 from ..targets.base import Emitted
 

@@ -6,7 +6,7 @@ import hashlib
 from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link.uber import Uber, link_ubershader
-from ..matrix.permutation import Permutation
+from ..spec.permutation import Permutation
 from ..targets import LANGUAGES, get_target
 from ..targets.base import Emitted
 from . import Composed, _function, _provenance, _render, _templates_used

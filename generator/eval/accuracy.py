@@ -420,7 +420,7 @@ def gpu_fp16() -> tuple[bool, str]:
 
 def declared_params(spec: str, lib) -> dict:
     """{name: (type, default, range)} of a BRDF spec's parameters, from the bricks' metadata."""
-    from ..matrix.permutation import parse_brdf
+    from ..spec.permutation import parse_brdf
     from ..reference import brdf_parameters
     return brdf_parameters(parse_brdf(spec, lib))
 
@@ -429,7 +429,7 @@ def spec_tolerance(spec: str, lib, tol: float) -> float:
     """The hemisphere tolerance a spec is judged at: tol, or the largest `tolerance` its bricks declare for
     their approximation (a baked table, a fit), whichever is larger."""
     from ..lang import SourceError
-    from ..matrix.permutation import SpecError, parse_brdf
+    from ..spec.permutation import SpecError, parse_brdf
     if lib is None:
         return tol
     try:

@@ -29,7 +29,7 @@ from ..library.bricks import library_or_builtin
 from ..compose import compose_eval
 from ..link import EvalProgram, eval_program
 from ..lang.errors import UserError
-from ..library.params import flat
+from ..spec.params import flat
 
 
 class EvalError(UserError, ValueError):

@@ -13,7 +13,7 @@ import numpy as np
 
 from .. import DTYPES, GPU_TARGETS
 from ..library.bricks import library_or_builtin
-from ..library.params import flat
+from ..spec.params import flat
 from ..link import EvalProgram, switch_program
 from .evaluate import EvalError, _numpy_arg, _numpy_texels, _param_block, _vectors, resolve_params, resolve_textures
 

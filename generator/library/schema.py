@@ -1,6 +1,6 @@
 """The BRICK metadata dict's shape as a JSON Schema, checked before its meaning (issue 10).
 
-Like the scene's (matrix/schema.py): keys and value types are data here; library/bricks.py then checks
+Like the scene's (scene/schema.py): keys and value types are data here; library/bricks.py then checks
 what a schema cannot (a kind's contract, a default inside its range, filler ids that exist). Every
 violation is one line at the offending key of the BRICK literal (its position in the brick's source),
 with the closest valid key for an unknown one. Names that reach generated code (parameters, slots,

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from ..lang import SourceError
 from ..lang.types import Type
 from ..library.bricks import Library
-from ..library.params import ParamSpec, flat
-from ..matrix.permutation import Node, Permutation, check_packing, parse_brdf, resolve
+from ..spec.params import ParamSpec, flat
+from ..spec.permutation import Node, Permutation, check_packing, parse_brdf, resolve
 from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue, switch_params, switch_textures
 from .interface import (FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
                         vec4_array_block)
@@ -34,7 +34,7 @@ class EvalProgram:
     spec: str  # canonical spec ('|'-joined for a switch over several BRDFs)
     nodes: list[Node]
     program: Program
-    specs: dict[str, ParamSpec]  # the one parameter policy (library/params.py)
+    specs: dict[str, ParamSpec]  # the one parameter policy (spec/params.py)
     signature: list[tuple[str, Type]]  # the entry's parameters
     slots: list[Slot]  # params in the vec4 parameter array
     param_vec4s: int
@@ -165,7 +165,7 @@ def link_permutation(perm: Permutation, lib: Library, kernel: bool = False) -> L
         blocks.append(Block(f"LightBuffer{elem.name[len('LightData'):]}", gl.set, gl.binding, "storage",
                             [{"name": "data", "type": f"{elem.name}[]", "offset": 0, "size": 0,
                               "array_stride": 16 * len(fields), "members": fields}]))
-    from ..library.params import spec_params
+    from ..spec.params import spec_params
     params = {"material": {p: s for _, p, _, _, s in g.material}}
     for i, (lb, sh) in enumerate(r.lights):
         params[f"light{i}"] = spec_params([Node(lb, ()), sh])

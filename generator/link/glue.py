@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 from ..lang import SourceError, ir
 from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, storage_buffer, struct
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
-from ..library.params import ParamSpec, flat, spec_params
-from ..matrix.permutation import Node, Resolved
-from ..matrix.surface import EMISSIVE_MAP
+from ..spec.params import ParamSpec, flat, spec_params
+from ..spec.permutation import Node, Resolved
+from ..spec.surface import EMISSIVE_MAP
 from .interface import Texture, texture_type
 from .irgen import Builder
 from .program import Program
@@ -284,7 +284,7 @@ VERTEX_COLOR = "vertex_color"  # shade()'s parameter: COLOR_0, interpolated (the
 
 
 def surface_inputs(b: Builder, bind: _Binder, r: Resolved, bg: BrdfGlue, provided: dict) -> list[ir.Stmt]:
-    """With vertex colours (matrix/surface.py): rho_d · COLOR_0.rgb, declared as `vc_rho_d` and given to the BRDF
+    """With vertex colours (spec/surface.py): rho_d · COLOR_0.rgb, declared as `vc_rho_d` and given to the BRDF
     in place of the packing's (or the material's) rho_d. Nothing otherwise."""
     if not r.surface.vertex_color:
         return []

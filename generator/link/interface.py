@@ -15,7 +15,7 @@ import struct
 from dataclasses import dataclass, field
 
 from ..lang.types import TEXTURE2D, TEXTURE2D_SHADOW, TEXTURECUBE, Type
-from ..library.params import ParamSpec
+from ..spec.params import ParamSpec
 
 VEC4_BYTES = 16
 
@@ -195,7 +195,7 @@ VERTEX_INPUTS = {"P": Location(0, "a_position", "vec3", "R32G32B32_SFLOAT"),
                  "N": Location(1, "a_normal", "vec3", "R32G32B32_SFLOAT"),
                  "T": Location(2, "a_tangent", "vec4", "R32G32B32A32_SFLOAT"),
                  "uv": Location(3, "a_uv", "vec2", "R32G32_SFLOAT"),
-                 "color": Location(4, "a_color", "vec4", "R32G32B32A32_SFLOAT")}  # COLOR_0 (matrix/surface.py)
+                 "color": Location(4, "a_color", "vec4", "R32G32B32A32_SFLOAT")}  # COLOR_0 (spec/surface.py)
 INTERPOLANTS = {"P": Location(0, "v_position", "vec3"), "N": Location(1, "v_normal", "vec3"),
                 "T": Location(2, "v_tangent", "vec4"), "uv": Location(3, "v_uv", "vec2"),
                 "color": Location(4, "v_color", "vec4")}

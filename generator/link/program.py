@@ -22,7 +22,7 @@ from ..lang import SourceError, ir
 from ..lang.types import Type
 from ..library.bricks import Brick
 from ..library.kinds import KINDS
-from ..matrix.permutation import Node
+from ..spec.permutation import Node
 
 
 def function_name(node: Node, fname: str) -> str:

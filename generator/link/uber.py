@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 from ..lang import SourceError, ir
 from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
 from ..library.inputs import SURFACE
-from ..library.params import flat, spec_params
-from ..matrix.permutation import Node, Permutation, parse_brdf, parse_spec
+from ..spec.params import flat, spec_params
+from ..spec.permutation import Node, Permutation, parse_brdf, parse_spec
 from .glue import _Binder, brdf_glue, has_tangent, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture
 from .irgen import Builder

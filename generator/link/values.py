@@ -7,7 +7,7 @@ ubershader's LightEntry / MaterialEntry storage buffers (link/uber.py).
 """
 from __future__ import annotations
 
-from ..matrix.scene import Scene
+from ..scene.load import Scene
 from .interface import pack
 
 

@@ -42,8 +42,8 @@ from ..toolchain.scenes import compile_scene, job_key, source_jobs
 from ..compose import Composed, compose_eval, compose_permutation
 from ..analysis import Cost, entry_cost
 from ..lang import SourceError
-from ..matrix.permutation import LightKey, Permutation, SpecError, parse_brdf, parse_spec
-from ..matrix.scene import Scene
+from ..spec.permutation import LightKey, Permutation, SpecError, parse_brdf, parse_spec
+from ..scene.load import Scene
 from ..toolchain import CompileJob, compile_many
 
 __all__ = ["Row", "CourseFigure", "CourseModel", "course_models", "course_figure", "brick_rows",
@@ -236,7 +236,7 @@ def _with_standin_slots(b: Brick, lib: Library, normal: str | None = None) -> st
 
 def _reads_tangent(spec: str, lib: Library) -> bool:
     """Whether a BRDF spec reads a tangent-frame row of the inputs table (an anisotropic model)."""
-    from ..matrix.constraints import reads_tangent
+    from ..spec.constraints import reads_tangent
     return bool(reads_tangent(parse_brdf(spec, lib)))
 
 

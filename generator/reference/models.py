@@ -149,8 +149,8 @@ def vis_smith_schlick(g: Geometry, alpha):
 # ------------------------------------------------------------------ whole BRDFs
 
 def brdf_parameters(nodes) -> dict:
-    """{name: (type, default, range)} of a parsed BRDF spec: the one parameter policy (library/params.py)."""
-    from ..library.params import spec_params
+    """{name: (type, default, range)} of a parsed BRDF spec: the one parameter policy (spec/params.py)."""
+    from ..spec.params import spec_params
     return {k: (p.ty, p.default, p.range) for k, p in spec_params(nodes).items()}
 
 
@@ -195,7 +195,7 @@ def reference_brdf(spec: str, L, V, N, T=None, params=None, lib=None) -> np.ndar
     ((N,) or (N, 3)). Missing parameters take the bricks' defaults.
     """
     from ..library.bricks import library_or_builtin
-    from ..matrix.permutation import parse_brdf
+    from ..spec.permutation import parse_brdf
     nodes = parse_brdf(spec, library_or_builtin(lib))
     g = shading_geometry(L, V, N, T)
     p = _param_values(brdf_parameters(nodes), params, g.count)

@@ -11,7 +11,7 @@
   format), descriptor sets described by ``set_layouts`` ({set: {binding: kind}}, kinds of
   :mod:`.compute`: UNIFORM, STORAGE, SAMPLED_IMAGE, SAMPLER), as :func:`layouts_from_interface`
   reads them off an Interface. Triangle lists, cull mode none (back with ``cull_back``: a single-sided
-  material, matrix/surface.py), front faces counter-clockwise, depth test LESS with writes, viewport and
+  material, spec/surface.py), front faces counter-clockwise, depth test LESS with writes, viewport and
   scissor = the target, no blending (source-over with ``blend``: glTF's BLEND, src·a + dst·(1 − a)).
 - :class:`GpuMesh`: a :class:`~.meshes.Mesh` uploaded, one vertex buffer per attribute, and its
   uint32 index buffer.
@@ -121,7 +121,7 @@ class GraphicsPipeline:
                  vert_entry: str = "main", frag_entry: str = "main", cache=None, flags: int = 0,
                  cull_back: bool = False, blend: bool = False):
         vk = self.vk = device.vk
-        self.cull_back, self.blend = cull_back, blend  # render state of the surface (matrix/surface.py)
+        self.cull_back, self.blend = cull_back, blend  # render state of the surface (spec/surface.py)
         self.flags = flags  # VkPipelineCreateFlags (e.g. capture statistics: runtime/gpu_stats.py)
         self.cache = cache  # a runtime.pipeline_cache.PipelineCacheFile, or None
         self.device, self.target = device, target

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..matrix.mesh import ATTRIBUTES, Mesh  # noqa: F401  (the scene stage's mesh data; here re-exported)
+from ..scene.mesh import ATTRIBUTES, Mesh  # noqa: F401  (the scene stage's mesh data; here re-exported)
 
 
 def _mesh(p, n, t, uv, idx) -> Mesh:

@@ -162,7 +162,7 @@ def load_placement(scene, path=None) -> Placement:
     model = translate · rotate_y · scale. Every mistake is a SourceError ``path:line:col: what — what to do``.
     """
     from ..lang.errors import UserError
-    from ..matrix.scene import read_toml
+    from ..scene.load import read_toml
 
     names = [o["name"] for o in scene.objects]
     explicit = path is not None

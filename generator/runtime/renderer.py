@@ -30,7 +30,7 @@ box-filtered on the host (:func:`moments_map`) and uploaded as an RGBA32F image.
 (runtime/depth_images.py: linear, compareOp LESS_OR_EQUAL), where no map is drawn a lit 1×1 depth image
 (depth 1.0); a device that cannot linearly filter D32_SFLOAT is refused for it. Other textures
 are generated: an sRGB albedo checker, a normal map of known bumps. The surface state of a permutation
-(matrix/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
+(spec/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
 pipelines blend source-over and are drawn after the opaque ones (not sorted by depth), the back faces of
 what a glTF file calls single-sided are culled (TOML objects keep cull mode none); the ubershader implements
 none of it (it stands in for the BRDF, packing and output only), and the depth pass ignores coverage. Pipelines are created through
@@ -134,7 +134,7 @@ class _TestTextures(dict):
 
 def shadow_textures(lib, shadow: str) -> list[str]:
     """The textures a shadow filter spec samples ([] for "none")."""
-    from ..matrix.permutation import parse_spec
+    from ..spec.permutation import parse_spec
 
     node = parse_spec(shadow, lib, ("shadow",))[0]
     return [t for n in node.walk() for t in n.brick.textures]
@@ -323,7 +323,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
 
         object_bufs = [buf(gx.object_bytes(o.model), U) for o in placed.objects]
         # Back faces are culled for what a glTF file says is single-sided (its objects carry double_sided
-        # False); a TOML scene's objects keep cull mode none, as they were always drawn (matrix/surface.py).
+        # False); a TOML scene's objects keep cull mode none, as they were always drawn (spec/surface.py).
         single_sided = {o["permutation"] for o in scene.objects if o.get("double_sided") is False}
 
         # Depth passes: one DepthTarget per shadowed light, every object drawn by a vertex-only pipeline.
@@ -537,7 +537,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
 
 
 def _light_specs(lib, light) -> dict:
-    from ..library.params import spec_params
-    from ..matrix.permutation import Node, parse_spec
+    from ..spec.params import spec_params
+    from ..spec.permutation import Node, parse_spec
 
     return spec_params([Node(lib.get("light", light.type), ()), parse_spec(light.shadow, lib, ("shadow",))[0]])

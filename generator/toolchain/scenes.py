@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 from ..io import show_progress
 from ..lang import SourceError
 from ..library.bricks import Library
-from ..matrix.scene import Scene
+from ..scene.load import Scene
 from ..targets import LANGUAGES
 from . import CompileJob, CompileResult, compile_many
 

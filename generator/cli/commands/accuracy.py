@@ -64,7 +64,7 @@ def _list(value: str, allowed: tuple, what: str) -> list[str]:
 
 
 def _is_scene(arg: str) -> bool:
-    from ...matrix.scene import SCENE_SUFFIXES
+    from ...scene.load import SCENE_SUFFIXES
     return arg.lower().endswith(SCENE_SUFFIXES)
 
 
@@ -72,7 +72,7 @@ def scene_materials(path: Path, lib) -> dict:
     """{"material: brdf": (brdf, params)} of a scene's materials, in the scene's order: the BRDF parameters
     the material sets (packing and output parameters left out); the others take the bricks' defaults."""
     from ...eval.accuracy import declared_params
-    from ...matrix.scene import load_scene
+    from ...scene.load import load_scene
     scene = load_scene(path, lib)
     out = {}
     for m in scene.materials.values():
@@ -86,7 +86,7 @@ def run(args) -> int:
     from ...library.bricks import load_library
     from ...io import atomic_write
     from ...eval.evaluate import EvalError
-    from ...matrix.permutation import SpecError
+    from ...spec.permutation import SpecError
     from ...reference import ReferenceMissing
     from ...runtime.device import VulkanUnavailable
 

@@ -37,7 +37,7 @@ def add_arguments(p) -> None:
                         "\"removed\" (default: they are deleted)")
     p.add_argument("--pack", action="store_true",
                    help="also write one shader pack per platform, DIR/packs/<platform>.<key16>.smpack (an index and "
-                        "the platform's artifacts; format: generator/build/pack.py), listed under the manifest's "
+                        "the platform's artifacts; format: generator/assemble/pack.py), listed under the manifest's "
                         "\"packs\"")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
@@ -66,8 +66,8 @@ def summary(scene, res, out, seconds: float, pack: bool = False) -> dict:
 
 def run(args) -> int:
     from ...library.bricks import load_library
-    from ...build import build_scene
-    from ...matrix.scene import load_scene
+    from ...assemble import build_scene
+    from ...scene.load import load_scene
     import time
 
     from ...io import Store, default_cache_dir
@@ -81,7 +81,7 @@ def run(args) -> int:
         raise UsageError(f"-j {args.jobs}: give at least one job")
     if args.executor and not args.executor.startswith("dask://"):
         raise UsageError(f"--executor {args.executor}: write dask://HOST:PORT")
-    from ...build.platforms import PLATFORMS, parse_platforms
+    from ...assemble.platforms import PLATFORMS, parse_platforms
     try:
         platforms = parse_platforms(args.platform) if args.platform is not None else list(PLATFORMS)
     except ValueError as e:
@@ -93,7 +93,7 @@ def run(args) -> int:
         if args.json:  # a script reading stdout gets its answer too
             print(json.dumps({"ok": False, "failures": [str(e)]}, indent=2))
         raise
-    from ...matrix.permutation import fp16_warnings
+    from ...spec.permutation import fp16_warnings
     for w in fp16_warnings(scene.permutations.values(), lib):  # bricks marked "fp16": "unsafe: ..."
         print(f"warning: {w}", file=sys.stderr)
     root = args.cache_dir or default_cache_dir()

@@ -1,7 +1,7 @@
 """`shadermatrix check SCENE [--golden DIR]`: compile and validate every permutation × platform, as a CI does.
 
 One line per check, `ok <hash>-<platform>` or the failure as the brick line that caused it
-(build/checks.py: what each platform's check validates), then a summary; with --golden DIR, the
+(assemble/checks.py: what each platform's check validates), then a summary; with --golden DIR, the
 emitted sources are compared with DIR/<platform>/<hash>.<stage>.<ext> and every drift is printed as a
 unified diff (--update-golden writes them instead). Exit 1 on a failure or a drift. A permutation whose
 GLSL ES 3.10 does not validate passes its gl check with a note, as `build` ships GLSL 4.50 core alone
@@ -35,8 +35,8 @@ def add_arguments(p) -> None:
 
 def selection(platform: str | None, languages: str | None, flag: str = "--") -> tuple[list[str], list[str]]:
     """(platforms checked, languages) of the options' text; UsageError naming the option (flag: its prefix)."""
-    from ...build.checks import MADE_FROM, checked_platforms
-    from ...build.platforms import PLATFORMS, parse_platforms
+    from ...assemble.checks import MADE_FROM, checked_platforms
+    from ...assemble.platforms import PLATFORMS, parse_platforms
     from ...targets import LANGUAGES, parse_languages
     opt_p, opt_l = ("--platform", "--languages") if flag == "--" else (f"{flag}platforms", f"{flag}languages")
     try:
@@ -55,10 +55,10 @@ def selection(platform: str | None, languages: str | None, flag: str = "--") -> 
 
 
 def run(args) -> int:
-    from ...build.checks import checks, default_store, dxc_note, golden_diff, run_checks, stale_golden
+    from ...assemble.checks import checks, default_store, dxc_note, golden_diff, run_checks, stale_golden
     from ...io import atomic_write
     from ...library.bricks import load_library
-    from ...matrix.scene import load_scene
+    from ...scene.load import load_scene
 
     plats, langs = selection(args.platform, args.languages)
     if args.update_golden and not args.golden:

@@ -118,7 +118,7 @@ def run(args) -> int:
     if args.gpu is not None:
         from ...measure.gpu import GpuRequest
         from ...runtime.gpu_stats import DEFAULT_FAMILIES, check_families
-        from ...matrix.scene import SCENE_SUFFIXES
+        from ...scene.load import SCENE_SUFFIXES
         if "/" in args.gpu or args.gpu.lower().endswith(SCENE_SUFFIXES):  # `costs --gpu SCENE`: the scene taken for families
             raise UsageError(f"--gpu {args.gpu}: that is a file, not AMD families — put the scene first "
                              f"(`costs SCENE --gpu`) or write `--gpu=navi21,...`")
@@ -137,7 +137,7 @@ def run(args) -> int:
         model_errors = factored_errors(models, lib)
     else:
         from ...library.bricks import load_library
-        from ...matrix.scene import load_scene
+        from ...scene.load import load_scene
         lib = load_library(args.bricks)
         scene = load_scene(args.scene, lib)
         rows = scene_rows(scene, lib, gpu=gpu, store=store)

@@ -136,7 +136,7 @@ def run(args) -> int:
     from ...library.bricks import load_library
     from ...io import atomic_write
     from ...eval.evaluate import EvalError, evaluate
-    from ...matrix.permutation import SpecError
+    from ...spec.permutation import SpecError
 
     params = parse_params(args.param)  # a usage error: the CLI's exit 2
     try:

@@ -34,8 +34,8 @@ def add_arguments(p) -> None:
 def spirv_identities(scene, lib, cache_dir, no_cache: bool = False) -> tuple[dict[str, tuple], list[str]]:
     """({permutation hash: its SPIR-V (sha256 per language and stage)}, the build's failures), from a build into a
     temporary directory through the compile cache."""
-    from ...build import build_scene
-    from ...build.checks import default_store
+    from ...assemble import build_scene
+    from ...assemble.checks import default_store
     with tempfile.TemporaryDirectory(prefix="shadermatrix-matrix-") as tmp:
         res = build_scene(scene, lib, Path(tmp), store=None if no_cache else default_store(cache_dir))
         ids = {p["hash"]: tuple(sorted((lang, stage, item.get("spirv_sha256") or item["spirv"])
@@ -46,8 +46,8 @@ def spirv_identities(scene, lib, cache_dir, no_cache: bool = False) -> tuple[dic
 
 def run(args) -> int:
     from ...library.bricks import load_library
-    from ...matrix.explain import markdown, report
-    from ...matrix.scene import load_scene
+    from ...scene.explain import markdown, report
+    from ...scene.load import load_scene
 
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)

@@ -23,7 +23,7 @@ def add_arguments(p) -> None:
 def run(args) -> int:
     from ...io import show_progress as progress
     from ...library.bricks import load_library
-    from ...matrix.scene import load_scene
+    from ...scene.load import load_scene
     from ...runtime.renderer import render_scene
 
     m = re.fullmatch(r"(\d+)x(\d+)", args.size)

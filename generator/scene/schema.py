@@ -14,7 +14,7 @@ import difflib
 import itertools
 import re
 
-from .surface import ALPHA_MODES, EMISSIVE
+from ..spec.surface import ALPHA_MODES, EMISSIVE
 
 NAME = {"type": "string", "minLength": 1, "maxLength": 256,
         "pattern": r"^[^\x00-\x1f\x7f\u0085\u2028\u2029]*(?!\n)$"}  # (?!\n): Python's $ also matches before a final \n
@@ -35,7 +35,7 @@ SCENE_SCHEMA = {
         "materials": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["brdf"],
             "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS,
-                           # the surface state (matrix/surface.py); absent = the default, the key unchanged
+                           # the surface state (spec/surface.py); absent = the default, the key unchanged
                            "alpha": {"type": "string", "enum": list(ALPHA_MODES)},
                            "double_sided": {"type": "boolean"}, "vertex_color": {"type": "boolean"},
                            "emissive": {"type": "string", "enum": list(EMISSIVE)}}}},

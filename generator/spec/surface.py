@@ -31,12 +31,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..lang.types import FLOAT, VEC3
-from ..library.params import ParamSpec
+from .params import ParamSpec
 
 ALPHA_MODES = ("opaque", "mask", "blend")
 EMISSIVE = ("none", "factor", "texture")
 EMISSIVE_MAP = "emissive_map"  # the material texture of emissive = "texture" (sRGB, as glTF's emissiveTexture)
-_WHERE = ("generator/matrix/surface.py",)
+_WHERE = ("generator/spec/surface.py",)
 # The glue's material parameters, per axis value that reads them. Ranges: alpha and cutoff as glTF (a cutoff
 # above 1 culls every fragment, which glTF allows; 1e4 is a bound a uniform never needs to exceed), emission
 # as the light colours' "game intensity" (KHR_materials_emissive_strength multiplies it past 1).

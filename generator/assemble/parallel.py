@@ -36,7 +36,7 @@ MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than i
 # multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted: the pool's
 # queues, which it then removes itself. Noise to whoever pressed Ctrl-C: its process starts with this filter.
 _QUIET_TRACKER = "ignore::UserWarning:multiprocessing.resource_tracker"
-_PRELOAD = ["generator.build.parallel", "generator.compose", "generator.analysis", "jinja2"]
+_PRELOAD = ["generator.assemble.parallel", "generator.compose", "generator.analysis", "jinja2"]
 _WORKER: dict = {}  # this worker's library, store and languages (set by _start)
 
 

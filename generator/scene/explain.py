@@ -14,7 +14,7 @@ precision. Four counts:
 4. merged — used permutations whose optimized SPIR-V is identical in every
    language and stage are one shader (needs a build; its cache makes it cheap).
 
-The constraints are data (matrix/constraints.py): one Constraint per rule, each a
+The constraints are data (spec/constraints.py): one Constraint per rule, each a
 predicate over a permutation's resolved bricks with the message and the fix it
 gives (Filament's variant filters, Unity's stripping log made readable);
 tests/test_explain.py holds their truth table.
@@ -24,9 +24,9 @@ from __future__ import annotations
 from itertools import product
 
 from ..library.bricks import Library
-from .constraints import CONSTRAINTS
-from .permutation import Permutation, resolve
-from .scene import Scene
+from ..spec.constraints import CONSTRAINTS
+from ..spec.permutation import Permutation, resolve
+from .load import Scene
 
 
 def violations(perm: Permutation, lib: Library) -> list[tuple[str, str]]:
@@ -65,7 +65,7 @@ def _lights_text(config) -> str:
 def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) -> dict:
     """The pruning report as data. spirv: {permutation hash: identity of its optimized SPIR-V (every language
     and stage)} from a build, or None to leave the merged stage out."""
-    from .permutation import LightKey
+    from ..spec.permutation import LightKey
 
     ax = axes(scene)
     full = 1
@@ -159,7 +159,7 @@ def markdown(rep: dict, explain: bool) -> str:
     out += ["", "## Combinations the constraints forbid", ""]
     out += ([f"- `{x['brdf']}` with `{x['packing']}`: {'; '.join(x['why'])}" for x in rep["invalid"]]
             or ["None: every BRDF × packing pair of the scene is valid."])
-    out += ["", "Constraints (generator/matrix/constraints.py): "
+    out += ["", "Constraints (generator/spec/constraints.py): "
             + "; ".join(f"`{c['name']}` — {c['doc']}" for c in rep["constraints"]) + "."]
     if rep.get("notes"):  # what an importer (glTF) accepted without shading it, or left out
         out += ["", "## Importer notes: what was mapped, accepted or left out", ""] + [f"- {n}" for n in rep["notes"]]

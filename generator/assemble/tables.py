@@ -2,7 +2,7 @@
 
 A permutation (or the ubershader) that samples a texture a brick declares as a table
 (reference/tables.py) needs the table's texels at run time; the engine loads them from
-``OUT/tables/<table>.<W>x<H>.<format>.<sha12>.ktx2`` (build/ktx2.py: one level, RGBA, linear). The file
+``OUT/tables/<table>.<W>x<H>.<format>.<sha12>.ktx2`` (assemble/ktx2.py: one level, RGBA, linear). The file
 name carries the texels' sha256, so a changed baker writes a new file and never overwrites one a
 manifest names; the manifest's ``tables`` list says, per table: the texture name the shaders bind, the
 table, path, sha256 of the file, format, size, bytes, the reference it is baked from, its filtered error

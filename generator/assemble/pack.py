@@ -1,6 +1,6 @@
 """Shader packs (`build --pack`): one content-addressed file per platform, its artifacts by permutation.
 
-A pack holds what its platform loads (build/platforms.py PLATFORM_TABLE ``blob``): ``vulkan`` the optimized SPIR-V of
+A pack holds what its platform loads (assemble/platforms.py PLATFORM_TABLE ``blob``): ``vulkan`` the optimized SPIR-V of
 the GLSL, ``d3d12`` DXIL where dxc built it and the HLSL text otherwise, ``gl`` the GLSL 4.50 core text,
 ``webgpu`` the WGSL text; the metadata's ``blob`` says which (``spirv``, ``dxil``, ``hlsl``, ``glsl``,
 ``wgsl``). ``DIR/packs/<platform>.<key16>.smpack``, ``key16`` the first 16 hex digits of the pack key.

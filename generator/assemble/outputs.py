@@ -28,7 +28,7 @@ from ..io import atomic_write
 from ..targets import LANGUAGES
 
 LOCK = ".shadermatrix-lock"
-# the trees a build writes (build/platforms.py), and the language trees of builds before platforms (emptied)
+# the trees a build writes (assemble/platforms.py), and the language trees of builds before platforms (emptied)
 TREES = (*(f"vulkan/{lang}" for lang in LANGUAGES), "d3d12", "gl", "webgpu", *LANGUAGES)
 TEMP_DIR = re.compile(r"^shadermatrix-(?:radv-)?(\d+)-")
 OWN_TMP = re.compile(r"^\..+\.[^.]+\.tmp$")  # io.atomic_write: .<name>.<random>.tmp
@@ -100,7 +100,7 @@ def named(manifest: dict) -> set[str]:
         out.update(e.get("failed_sources", {}).values())
         for p, d in (e.get("platforms") or {}).items():
             out.update(a["path"] for item in d.get("stages", {}).values() for a in item.values())
-    out.update(t["path"] for t in manifest.get("tables", []))  # baked lookup tables (build/tables.py)
+    out.update(t["path"] for t in manifest.get("tables", []))  # baked lookup tables (assemble/tables.py)
     return out
 
 

@@ -1,7 +1,7 @@
 """Per-permutation compile checks an engine's CI runs: `shadermatrix check` and the pytest plugin share them.
 
 A check is one permutation of a scene on one platform (issue 12, items 3 and 5), validated by the
-tools that validate what `build --platform` ships for it (build/platforms.py):
+tools that validate what `build --platform` ships for it (assemble/platforms.py):
 
     platform  what a check compiles and validates                       golden sources
     vulkan    GLSL, HLSL and WGSL to SPIR-V (glslc, glslang, naga),      vulkan/<hash>.<stage>.{glsl,hlsl,wgsl}
@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..library.bricks import Library
-from ..matrix.scene import Scene
+from ..scene.load import Scene
 from ..targets import LANGUAGES
 from .platforms import DIALECTS, EXT, PLATFORMS
 

@@ -200,7 +200,7 @@ class Permutation:
     packing: str  # canonical packing spec
     output: str = "linear"
     precision: str = "fp32"
-    surface: Surface = DEFAULT_SURFACE  # alpha mode, double-sided, vertex colours, emission (matrix/surface.py)
+    surface: Surface = DEFAULT_SURFACE  # alpha mode, double-sided, vertex colours, emission (spec/surface.py)
 
     def canonical(self) -> str:
         """The key as text; the surface state at its defaults writes nothing (earlier keys and hashes unchanged)."""
@@ -248,7 +248,7 @@ def resolve(perm: Permutation, lib: Library) -> Resolved:
 
 def check_packing(r: Resolved) -> tuple[str, str]:
     """('', '') when the packing fits the BRDF, else (what is wrong, what to do): the first rule of
-    matrix/constraints.py the permutation breaks."""
+    spec/constraints.py the permutation breaks."""
     from .constraints import first_problem
     return first_problem(r)
 

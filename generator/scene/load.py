@@ -4,7 +4,7 @@ Schema (README "Scene files"):
     [scene]            name, output (default "linear"), precision (default "fp32")
     [materials.NAME]   brdf = spec, packing = spec (default "constants"), params = {...},
                        alpha = "opaque"|"mask"|"blend", double_sided, vertex_color = true|false,
-                       emissive = "none"|"factor"|"texture" (the surface state: matrix/surface.py)
+                       emissive = "none"|"factor"|"texture" (the surface state: spec/surface.py)
     [lights.NAME]      type = light brick, shadow = spec (default "none"), params = {...}
     [light_sets]       NAME = [light names, in order]
     [[objects]]        name, material = NAME, lights = light set NAME
@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..library.bricks import Library
-from ..library.params import spec_params
+from ..spec.params import spec_params
 from ..lang import SourceError
 from ..lang.errors import read_text
-from .permutation import (PRECISIONS, LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf,
+from ..spec.permutation import (PRECISIONS, LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf,
                           parse_spec, resolve)
-from .surface import DEFAULT as DEFAULT_SURFACE, Surface
+from ..spec.surface import DEFAULT as DEFAULT_SURFACE, Surface
 
 
 class Locator:
@@ -131,7 +131,7 @@ class Scene:
     # ubershader's, which every material feeds, points at [scene]
     where: dict[str, tuple[int, int]] = field(default_factory=dict)
     head_at: tuple[int, int] = (1, 1)
-    notes: list[str] = field(default_factory=list)  # what an importer accepted or did not apply (matrix/gltf.py)
+    notes: list[str] = field(default_factory=list)  # what an importer accepted or did not apply (scene/gltf.py)
     extra: dict = field(default_factory=dict)  # an importer's own data: glTF's extensions and pygltflib document
 
 
@@ -152,12 +152,12 @@ def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]
     return data, Locator(shown, text)
 
 
-SCENE_SUFFIXES = (".toml", ".gltf", ".glb")  # what a SCENE argument may be: TOML, or glTF 2.0 (matrix/gltf.py)
+SCENE_SUFFIXES = (".toml", ".gltf", ".glb")  # what a SCENE argument may be: TOML, or glTF 2.0 (scene/gltf.py)
 MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed SPIR-V's 255 function arguments
 
 
 def load_scene(path, lib: Library) -> Scene:
-    """Read, validate and reduce a TOML scene (or a glTF 2.0 .gltf/.glb: matrix/gltf.py) to its permutations."""
+    """Read, validate and reduce a TOML scene (or a glTF 2.0 .gltf/.glb: scene/gltf.py) to its permutations."""
     path = Path(path)
     if path.suffix.lower() in SCENE_SUFFIXES[1:]:
         from .gltf import load_gltf
@@ -167,7 +167,7 @@ def load_scene(path, lib: Library) -> Scene:
         raise SourceError(shown, 1, 1, "is a directory, not a scene file", "pass a .toml scene file")
     data, loc = read_toml(path, "scene", "fix the scene file's syntax")
     from .schema import check
-    check(data, loc)  # the shape first: keys and types (matrix/schema.py), then what the names mean
+    check(data, loc)  # the shape first: keys and types (scene/schema.py), then what the names mean
     head = data.get("scene", {})
     output = head.get("output", "linear")
     precision = head.get("precision", "fp32")
@@ -276,7 +276,7 @@ def load_scene(path, lib: Library) -> Scene:
 
 
 def surface_specs(specs: dict, brdf: dict, surface: Surface, error) -> dict:
-    """The material's parameter specs with those its surface state reads (matrix/surface.py); `brdf` the BRDF's
+    """The material's parameter specs with those its surface state reads (spec/surface.py); `brdf` the BRDF's
     own specs (spec_params of its nodes); error(key, what, todo) makes the exception for a state the material's
     bricks cannot take. Vertex colours scale the rho_d the BRDF shades with, so the BRDF must have one: the
     rule of link/glue.py surface_inputs, checked here to point at the material's key (a packing's or output's
@@ -323,7 +323,7 @@ def _spec(loc: Locator, header: str, key: str, value, resolve) -> str:
 
 
 def _check_params(loc: Locator, header: str, params, specs: dict, owner: str) -> None:
-    """Scene values against the one parameter policy (library/params.py)."""
+    """Scene values against the one parameter policy (spec/params.py)."""
     if not isinstance(params, dict):
         raise loc.error(loc.find(header, "params"), "params must be a table", "write params = { n = 64.0 }")
     for k, v in params.items():

@@ -18,8 +18,8 @@ from .. import __version__
 from ..library.bricks import Library
 from ..io import atomic_write, content_key, sha256
 from ..analysis import cost_dict
-from ..matrix.permutation import SpecError, parse_brdf, parse_spec
-from ..matrix.scene import Scene
+from ..spec.permutation import SpecError, parse_brdf, parse_spec
+from ..scene.load import Scene
 from ..targets import LANGUAGES
 from ..lang import SourceError
 from ..link.uber import coverage
@@ -50,7 +50,7 @@ class BuildResult:
     aliased: int = 0  # SPIR-V files another item of this build already wrote (identical modules: one file)
     costs: dict = field(default_factory=dict)  # SPIR-V sha256 -> cost dict: each module analysed once per build
     templates: set = field(default_factory=set)  # template files worker processes read
-    platforms: tuple = PLATFORMS  # what this build writes (build/platforms.py)
+    platforms: tuple = PLATFORMS  # what this build writes (assemble/platforms.py)
     _manifest: dict | None = None
     _done: set = field(default_factory=set)  # files this build has written or found in place
 
@@ -80,8 +80,8 @@ def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, stor
     workers: tool processes at once (default: the core count); executor: where compiles run instead
     (toolchain/dask.py). Neither changes a byte of the output. keep_removed: the outputs of permutations that
     left the scene stay, listed under the manifest's ``removed`` (marked so), instead of being deleted.
-    pack: also write one shader pack per platform (build/pack.py), listed under the manifest's ``packs``.
-    platforms: what to write besides the SPIR-V checks of every language (build/platforms.py: vulkan, d3d12,
+    pack: also write one shader pack per platform (assemble/pack.py), listed under the manifest's ``packs``.
+    platforms: what to write besides the SPIR-V checks of every language (assemble/platforms.py: vulkan, d3d12,
     gl, webgpu; one tree each, OUT/<platform>/, and per permutation a ``platforms`` section in the manifest).
 
     Incremental: each permutation's manifest entry records ``input_key``, the sha256 of everything its

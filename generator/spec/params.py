@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from ..lang.errors import SourceError
 from ..lang.types import Type
-from .bricks import check_value
+from ..library.bricks import check_value
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ def _brdf_text(r) -> str:
 
 
 def _provides_unread(r) -> tuple[str, str]:
-    from ..library.params import spec_params
+    from .params import spec_params
     params = spec_params(r.brdf)
     for f in r.packing.brick.entries:
         name = f.name[len("get_"):]
@@ -38,7 +38,7 @@ def _provides_unread(r) -> tuple[str, str]:
 
 
 def _provides_wrong_type(r) -> tuple[str, str]:
-    from ..library.params import spec_params
+    from .params import spec_params
     params = spec_params(r.brdf)
     for f in r.packing.brick.entries:
         name = f.name[len("get_"):]

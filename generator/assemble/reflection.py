@@ -11,7 +11,7 @@ laid out by that permutation's Interface (little-endian float32, hex).
 from __future__ import annotations
 
 from ..link.values import light_values, material_values
-from ..matrix.scene import Scene
+from ..scene.load import Scene
 
 
 def scene_tables(scene: Scene, interfaces: dict, previous: dict | None = None) -> dict:

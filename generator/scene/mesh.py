@@ -1,4 +1,4 @@
-"""A mesh as scenes carry it (glTF import, matrix/gltf.py) and the renderer draws it (runtime/meshes.py).
+"""A mesh as scenes carry it (glTF import, scene/gltf.py) and the renderer draws it (runtime/meshes.py).
 
 Separate float32 arrays, one per vertex attribute, named as the vertex shaders' inputs
 (link/interface.VERTEX_INPUTS), and uint32 triangle-list indices; the conventions (tangent

@@ -1,4 +1,4 @@
-"""glTF 2.0 scenes (`.gltf`, `.glb`) → the same Scene a TOML scene gives (matrix/scene.py), through pygltflib.
+"""glTF 2.0 scenes (`.gltf`, `.glb`) → the same Scene a TOML scene gives (scene/load.py), through pygltflib.
 
 pygltflib (pinned in requirements.lock) reads the container: the JSON text into its GLTF2 object, a
 `.glb`'s chunks (after the strict checks below), data URIs. pygltflib checks nothing, so every value
@@ -23,7 +23,7 @@ Its packing follows the textures present (each changes the shader, so each chang
     not applied (normal_map has no scale): a note.
   - occlusionTexture is not read (it scales indirect light; the light loop has direct lights only): a
     note, and it does not change the key.
-  - the surface state (matrix/surface.py) is part of the key where it changes the shader: alphaMode →
+  - the surface state (spec/surface.py) is part of the key where it changes the shader: alphaMode →
     alpha opaque | mask | blend (base_alpha = baseColorFactor[3] and alpha_cutoff are material uniforms,
     so other cutoffs share the shader); doubleSided → double_sided (the back-face flip; the renderer culls
     back faces otherwise); emissiveFactor · KHR_materials_emissive_strength ≠ 0 → emissive "factor", with
@@ -79,14 +79,14 @@ import numpy as np
 
 from ..lang import SourceError
 from ..library.bricks import Library
-from ..library.params import spec_params
-from .permutation import LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf, parse_spec, resolve
-from .scene import Light, Material, Scene, surface_specs
-from .surface import EMISSIVE_MAP, Surface
+from ..spec.params import spec_params
+from ..spec.permutation import LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf, parse_spec, resolve
+from .load import Light, Material, Scene, surface_specs
+from ..spec.surface import EMISSIVE_MAP, Surface
 
 BRDF = "lambert+microfacet(ndf=ggx,fresnel=schlick,vis=smith_ggx_height_correlated)"
 MAX_GLTF_BYTES = 256 << 20  # a .gltf, .glb or .bin larger than this is refused
-MAX_LIGHTS_PER_SET = 32  # as matrix/scene.py: a specialized shader unrolls its lights
+MAX_LIGHTS_PER_SET = 32  # as scene/load.py: a specialized shader unrolls its lights
 SPOT_NO_RANGE = 1.0e6  # a spot light without `range` (infinite in glTF): the spot brick's largest radius
 
 SHADING_EXTENSIONS = {  # change what the shader computes; no brick implements them yet
@@ -773,7 +773,7 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list, col
         params = {"base_color": base[:3], "metallic": metallic, "roughness": roughness}
         textures["base_color_map"] = tex_base or "white"
         textures["orm_map"] = tex_mr or "white"
-    # the surface state (matrix/surface.py): each part only where it changes what the shader computes
+    # the surface state (spec/surface.py): each part only where it changes what the shader computes
     lit = [c * strength for c in emissive]
     surface = Surface(alpha=alpha_mode.lower(), double_sided=double, vertex_color=colors,
                       emissive="texture" if tex_e is not None and any(lit) else "factor" if any(lit) else "none")

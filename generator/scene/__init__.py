@@ -1,0 +1,1 @@
+"""Scenes (TOML, glTF) and the permutations they use; explain."""

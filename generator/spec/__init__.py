@@ -1,0 +1,1 @@
+"""Permutation keys and spec strings, their constraints, and the parameter policy: what one permutation is."""
