@@ -2,7 +2,7 @@
 VENV := .venv
 PY   := $(VENV)/bin/python
 
-.PHONY: setup demo test goldens doctor clean distclean
+.PHONY: setup demo test lint goldens doctor clean distclean
 
 setup:
 	bash scripts/setup.sh
@@ -10,8 +10,21 @@ setup:
 demo: setup
 	$(VENV)/bin/shadermatrix build scenes/example.toml --out out/example
 
+# The tests that differ between Python patch releases (the loader on odd bytes, interrupts of a worker pool):
+# run again on the second Python that scripts/setup.sh found (.venv-alt), whichever of the two is not .venv's.
+ALT_TESTS := tests/test_fuzz.py tests/test_fuzz_regressions.py tests/test_hostile_files.py tests/test_lang_errors.py \
+             tests/test_parallel.py
+
 test: setup
+	$(VENV)/bin/ruff check .
 	$(PY) -m pytest -q
+	@if [ -x .venv-alt/bin/python ]; then \
+	  echo "make test: $(ALT_TESTS) on $$(.venv-alt/bin/python -V)"; \
+	  .venv-alt/bin/python -m pytest -q -p no:cacheprovider $(ALT_TESTS); \
+	fi
+
+lint: setup
+	$(VENV)/bin/ruff check .
 
 goldens: setup
 	$(PY) -m tests.regen_goldens
@@ -25,4 +38,4 @@ clean:  # build outputs and caches; keeps .venv and .tools
 	find . -path ./.venv -prune -o -path ./.tools -prune -o -name __pycache__ -type d -exec rm -rf {} +
 
 distclean: clean  # also the Python environment and the locally built tools
-	rm -rf $(VENV) .tools
+	rm -rf $(VENV) .venv-alt .tools

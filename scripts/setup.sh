@@ -106,3 +106,28 @@ if [[ ! -f $stamp || "$(cat $stamp)" != "$want_stamp" ]]; then
   .venv/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation --config-settings editable_mode=compat -e .
   echo "$want_stamp" > "$stamp"
 fi
+
+# A second Python, when this machine has one of another version: `make test` runs the loader, fuzz and
+# interrupt tests on it too (Debian 12's own 3.11.2 and a newer 3.11 on PATH differ there: ast.parse of a NUL
+# byte, a worker pool's shutdown). In a bare Debian 12 root there is one Python and no second environment.
+py_version() { "$1" -c 'import sys; print(sys.version.split()[0])' 2>/dev/null || true; }
+main_version=$(py_version .venv/bin/python)
+alt=""
+for cand in /usr/bin/python3 "$(command -v python3 || true)" "$(command -v python3.11 || true)" "$(command -v python3.12 || true)"; do
+  [[ -n "$cand" && -x "$cand" ]] || continue
+  v=$(py_version "$cand")
+  [[ -n "$v" && "$v" != "$main_version" ]] && "$cand" -c 'import sys; sys.exit(sys.version_info < (3, 11))' &&
+    "$cand" -c 'import ensurepip, venv' >/dev/null 2>&1 && { alt=$cand; break; }
+done
+if [[ -n "$alt" ]]; then
+  if [[ "$(py_version .venv-alt/bin/python)" != "$(py_version "$alt")" ]]; then
+    rm -rf .venv-alt
+    "$alt" -m venv .venv-alt
+  fi
+  if [[ ! -f .venv-alt/.setup-stamp || "$(cat .venv-alt/.setup-stamp)" != "$want_stamp" ]]; then
+    echo "setup: installing Python packages into .venv-alt (Python $(py_version "$alt"), the second Python of make test)"
+    .venv-alt/bin/python -m pip install -q --disable-pip-version-check -r requirements.lock
+    .venv-alt/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation --config-settings editable_mode=compat -e .
+    echo "$want_stamp" > .venv-alt/.setup-stamp
+  fi
+fi

@@ -37,6 +37,7 @@ def test_a_rebuild_from_the_cache_compiles_nothing_and_writes_the_same_bytes(lib
     warm = build_scene(scene, lib, tmp_path / "b", store=Store(tmp_path / "cache"))
     assert warm.ok and warm.compile.compiled == 0 and warm.compile.cached == warm.compile.distinct
     plain = build_scene(scene, lib, tmp_path / "c")  # no cache at all
+    assert plain.ok
     assert _tree(tmp_path / "a") == _tree(tmp_path / "b") == _tree(tmp_path / "c")
 
 

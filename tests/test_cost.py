@@ -226,7 +226,7 @@ def test_course_models_are_data_and_a_new_brick_adds_its_row(fixture_brick_rows)
         assert {(r.course.table, r.course.texture, r.course.alu) for r in rows} == tables
         variant = [r for r in rows if r.course.table == "shift-variant"]
         assert all(r.cost.texture == 1 for r in variant)  # the albedo texture
-    from generator.measure.plans import brick_rows, course_models, load_cost_library
+    from generator.measure.plans import course_models
     assert "Ashikhmin-Shirley" in {m.name for m in course_models()[0]}
     # every model has its bricks now (issue 11: the direct forms; issue 13: the factored ones)
     for model in ("Ashikhmin-Shirley", "Lafortune"):

@@ -27,7 +27,6 @@ samples): 0.4 of the bound (GPU vs float64, sharp lobes).
 """
 from __future__ import annotations
 
-import io
 import re
 import subprocess
 import sys

@@ -127,7 +127,7 @@ def test_a_scene_with_the_brick_builds_and_shadows_its_footprint_in_every_langua
 
 
 def test_pcf_softens_the_shadow_edge_where_shadow_map_has_none(device, lib, tmp_path):
-    counts = {}
+    counts, images_map = {}, None
     for name, shadow, params in [("shadow_map", "shadow_map", ""),
                                  ("pcf1", "pcf", "pcf_taps = 1.0, pcf_texel = 0.00390625"),
                                  ("pcf3", "pcf", "pcf_taps = 3.0, pcf_texel = 0.00390625"),

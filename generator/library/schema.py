@@ -11,8 +11,9 @@ from __future__ import annotations
 import ast
 import difflib
 
-IDENT = {"type": "string", "pattern": r"^[A-Za-z_][A-Za-z0-9_]{0,63}(?!\n)$"}  # Python's $ matches before a final \n
 from ..lang.exprs import F32_MAX
+
+IDENT = {"type": "string", "pattern": r"^[A-Za-z_][A-Za-z0-9_]{0,63}(?!\n)$"}  # Python's $ matches before a final \n
 
 NUMBER = {"type": "number", "minimum": -F32_MAX, "maximum": F32_MAX}  # parameters are float32 in every shader
 VALUE = {"anyOf": [NUMBER, {"type": "array", "items": NUMBER, "minItems": 1, "maxItems": 64},

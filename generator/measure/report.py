@@ -16,11 +16,11 @@ from collections import Counter
 
 from .. import __version__
 from ..analysis import COUNT_FIELDS
+from ..toolchain import tool_versions
 from .plans import REPORT_LANGUAGES, CourseModel, Row
 
 LANGS_SLASH = " / ".join(x.upper() for x in REPORT_LANGUAGES)  # the order of every report's cells
 LANGS_AND = ", ".join(x.upper() for x in REPORT_LANGUAGES[:-1]) + " and " + REPORT_LANGUAGES[-1].upper()
-from ..toolchain import tool_versions
 
 # Markdown columns: (header, Cost field or derived name).
 MD_COLUMNS = [("tex", "texture"), ("ALU", "alu"), ("transc.", "transcendental"), ("ALU+T", "alu_t"),

@@ -10,7 +10,6 @@ it is used: the bricks' algebra (cancellation-free rewrites, the erfc fit) is th
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
