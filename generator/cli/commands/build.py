@@ -43,6 +43,10 @@ def add_arguments(p) -> None:
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
     p.add_argument("--json", action="store_true",
                    help="print the summary as one JSON object on stdout (counts, seconds, failures) instead of text")
+    p.add_argument("--validate-ir", action="store_true",
+                   help="debug: check the IR the link stage builds for every permutation and the ubershader against "
+                        "the emitters' invariants (generator/lang/validate.py) before compiling; a violation is a "
+                        "generator bug, reported and exit 1")
     p.add_argument("--depfile", metavar="PATH",
                    help="write a Make-syntax depfile (Ninja: deps = gcc): OUT/manifest.json and every file read")
 
@@ -96,6 +100,14 @@ def run(args) -> int:
     from ...spec.permutation import fp16_warnings
     for w in fp16_warnings(scene.permutations.values(), lib):  # bricks marked "fp16": "unsafe: ..."
         print(f"warning: {w}", file=sys.stderr)
+    if args.validate_ir:
+        from ...link.checked import ir_violations
+        found = ir_violations([p for _, p in sorted(scene.permutations.items())], lib)
+        for v in found:
+            print(f"internal error: {v} — the generator built invalid IR: please report it with the scene",
+                  file=sys.stderr)
+        if found:
+            return 1
     root = args.cache_dir or default_cache_dir()
     if root is None and not args.no_cache:
         print("note: no home directory for the compile cache — building without it (--cache-dir DIR to keep one)",
