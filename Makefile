@@ -29,6 +29,10 @@ lint: setup
 goldens: setup
 	$(PY) -m tests.regen_goldens
 
+.PHONY: reference
+reference: setup  # docs/reference/ from the code; tests/test_docs_reference.py fails when it is stale
+	$(PY) scripts/gen_reference.py docs/reference
+
 doctor: setup
 	$(VENV)/bin/shadermatrix doctor
 
