@@ -1,31 +1,39 @@
 #!/usr/bin/env bash
 # Install everything shadermatrix needs on Debian 12, as root. Idempotent; pinned.
-# Versions live here and in pyproject.toml / requirements.lock; README says why.
+# Versions live here, in generator/toolchain/pins.toml (the tools) and requirements.lock; README says why.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+# The tools' versions have one source, generator/toolchain/pins.toml (package data: `shadermatrix doctor`
+# checks the tools against the same file); its lines are `name = "version"`.
+pin() {
+  sed -n "s/^$1 *= *\"\([^\"]*\)\".*/\1/p" generator/toolchain/pins.toml | grep . ||
+    { echo "setup: no pin for $1 in generator/toolchain/pins.toml" >&2; return 1; }
+}
+GLSLC_V=$(pin glslc); GLSLANG_V=$(pin glslang-tools); SPIRV_TOOLS_V=$(pin spirv-tools)
+MESA_V=$(pin mesa-vulkan-drivers); NAGA_VERSION=$(pin naga)
 
 # Debian 12 (bookworm) packages, pinned to the versions in bookworm + security.
 APT_PKGS=(
   "libvulkan1=1.3.239.0-1"                 # Vulkan loader
   "vulkan-validationlayers=1.3.239.0-2"    # VK_LAYER_KHRONOS_validation for tests
-  "glslc=2023.2-1"                         # shaderc: batches many GLSL/HLSL compiles in one process
-  "glslang-tools=12.0.0-2"                 # glslangValidator (HLSL front end, version reporting)
-  "spirv-tools=2023.1-2"                   # spirv-val, spirv-opt, spirv-as, spirv-dis
+  "glslc=$GLSLC_V"                         # shaderc: batches many GLSL/HLSL compiles in one process
+  "glslang-tools=$GLSLANG_V"               # glslangValidator (HLSL front end, version reporting)
+  "spirv-tools=$SPIRV_TOOLS_V"             # spirv-val, spirv-opt, spirv-as, spirv-dis
 )
 # Mesa from bookworm-backports, pinned: its shader disk cache reports hits and misses
 # (MESA_SHADER_CACHE_SHOW_STATS; Mesa 22.3 cannot), which is how a render shows that it was served
 # from its persisted cache (lavapipe's VkPipelineCache stays empty in both). The libdrm and
 # gallium versions are the ones this Mesa needs. bookworm-backports keeps only its latest upload:
 # when these versions are gone, set-up says so; bump them to what `apt-cache policy
-# mesa-vulkan-drivers` offers from bookworm-backports (and the versions in pyproject.toml, README).
+# mesa-vulkan-drivers` offers from bookworm-backports (mesa's in generator/toolchain/pins.toml; README).
 BPO_PKGS=(
-  "mesa-vulkan-drivers=25.0.7-2~bpo12+1"   # lavapipe (software Vulkan 1.4) and RADV
-  "mesa-libgallium=25.0.7-2~bpo12+1"
+  "mesa-vulkan-drivers=$MESA_V"            # lavapipe (software Vulkan 1.4) and RADV
+  "mesa-libgallium=$MESA_V"                # the same Mesa source package
   "libdrm2=2.4.123-1~bpo12+1"
   "libdrm-amdgpu1=2.4.123-1~bpo12+1"
   "libdrm-common=2.4.123-1~bpo12+1"
 )
-NAGA_VERSION=30.0.1
 RUST_TOOLCHAIN=1.95.0   # only used when cargo is missing; naga 30 needs rust >= 1.87
 BPO_SOURCES=/etc/apt/sources.list.d/shadermatrix-bookworm-backports.sources
 
@@ -59,9 +67,8 @@ if ((${#missing[@]} + ${#missing_bpo[@]})); then
   fi
 fi
 
-# naga (WGSL front end + validator), pinned, from crates.io into .tools/bin
-# (generator/toolchain/__init__.py looks there before PATH). A naga of the pinned
-# version already on PATH is used as is.
+# naga (WGSL front end + validator), pinned, from crates.io into .tools/bin, which the end of this
+# script links into .venv/bin. A naga of the pinned version already on PATH is used as is.
 naga_version() { "$1" --version 2>/dev/null || true; }
 if [[ "$(naga_version .tools/bin/naga)" != "$NAGA_VERSION" ]] &&
    ! { command -v naga >/dev/null 2>&1 && [[ "$(naga_version naga)" == "$NAGA_VERSION" ]]; }; then
@@ -131,3 +138,12 @@ if [[ -n "$alt" ]]; then
     echo "$want_stamp" > .venv-alt/.setup-stamp
   fi
 fi
+
+# The naga built into .tools/bin, linked into the venv's bin/: shadermatrix looks for its tools in
+# $SHADERMATRIX_TOOLS, then in the bin/ of the Python that runs it (so also when .venv is not activated),
+# then on PATH (generator/toolchain/locate.py).
+for venv in .venv .venv-alt; do
+  if [[ -x .tools/bin/naga && -d $venv/bin ]]; then
+    ln -sfn ../../.tools/bin/naga "$venv/bin/naga"
+  fi
+done

@@ -25,7 +25,7 @@ def require(condition: bool, reason: str) -> None:
 
 
 def require_tool(name: str) -> str:
-    """Path of an external tool (``<repo>/.tools/bin`` first, then PATH)."""
+    """Path of an external tool, found as the build finds it (generator.toolchain.find_tool)."""
     from generator.toolchain import find_tool
 
     path = find_tool(name)

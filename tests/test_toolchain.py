@@ -1,6 +1,7 @@
 """The real compilers and validators, no mocks: glslc, naga, spirv-val, spirv-opt."""
 from __future__ import annotations
 
+import os
 import struct
 import subprocess
 
@@ -189,18 +190,33 @@ def test_no_temp_files_left(tmp_path, monkeypatch):
 
 
 def test_missing_tool_raises_clear_error(tmp_path, monkeypatch):
-    monkeypatch.setattr(toolchain, "TOOLS_BIN", tmp_path)
+    monkeypatch.setenv("SHADERMATRIX_TOOLS", str(tmp_path))
+    monkeypatch.setattr("sysconfig.get_path", lambda name: str(tmp_path))
     monkeypatch.setenv("PATH", str(tmp_path))
     with pytest.raises(ToolMissing, match=r"glslc not found — run `make setup`"):
         compile_many([CompileJob("a.frag.glsl", "glsl", "frag", GLSL_FRAG)])
 
 
-def test_repo_tools_dir_comes_before_path(tmp_path, monkeypatch):
-    fake = tmp_path / "naga"
+def _fake_tool(folder, name="naga"):
+    folder.mkdir(exist_ok=True)
+    fake = folder / name
     fake.write_text("#!/bin/sh\necho 0.0.0\n")
     fake.chmod(0o755)
-    monkeypatch.setattr(toolchain, "TOOLS_BIN", tmp_path)
-    assert toolchain.find_tool("naga") == str(fake)
+    return str(fake)
+
+
+def test_tools_setting_comes_before_the_environment_and_path(tmp_path, monkeypatch):
+    on_path, in_env, in_setting = (_fake_tool(tmp_path / d) for d in ("path", "venv", "setting"))
+    monkeypatch.setenv("PATH", str(tmp_path / "path"))
+    monkeypatch.setattr("sysconfig.get_path", lambda name: str(tmp_path / "venv"))
+    assert toolchain.find_tool("naga") == in_env  # the venv's bin/ (where `make setup` links naga) before PATH
+    monkeypatch.setenv("SHADERMATRIX_TOOLS", os.pathsep.join([str(tmp_path / "none"), str(tmp_path / "setting")]))
+    assert toolchain.find_tool("naga") == in_setting
+    monkeypatch.delenv("SHADERMATRIX_TOOLS")
+    monkeypatch.setattr("sysconfig.get_path", lambda name: str(tmp_path / "none"))
+    assert toolchain.find_tool("naga") == on_path
+    (tmp_path / "path" / "naga").chmod(0o644)  # not executable: not a tool
+    assert toolchain.find_tool("naga") is None
 
 
 def test_bad_jobs_are_rejected():

@@ -70,16 +70,15 @@ from typing import Iterable
 from ..io import content_key
 from ..lang.errors import EnvironmentMissing
 from ..targets import LANGUAGES
+from .locate import TOOLS_ENV, pinned_versions, tool_dirs
 
 __all__ = ["Diagnostic", "CompileJob", "CompileResult", "CompileStats", "ToolMissing",
-           "compile_many", "cache_key", "tool_versions", "find_tool",
+           "compile_many", "cache_key", "tool_versions", "find_tool", "tool_dirs", "pinned_versions", "TOOLS_ENV",
            "TARGET_ENV", "SPIRV_VERSION", "SPIRV_MAGIC"]
 
 TARGET_ENV = "vulkan1.1"      # every tool gets this target environment
 SPIRV_VERSION = "1.3"         # what glslc emits for vulkan1.1; naga is told the same
 SPIRV_MAGIC = 0x07230203
-REPO_ROOT = Path(__file__).resolve().parents[2]
-TOOLS_BIN = REPO_ROOT / ".tools" / "bin"
 STAGES = ("vert", "frag", "comp")
 _SENTINEL = "SHADERMATRIX_SENTINEL"
 _MAX_BATCH = 256  # jobs per glslc process
@@ -134,18 +133,17 @@ class ToolMissing(EnvironmentMissing):
     """A required external tool is not installed."""
 
     def __init__(self, name: str):
-        super().__init__(f"{name} not found — run `make setup` (scripts/setup.sh)")
+        super().__init__(f"{name} not found — run `make setup` (scripts/setup.sh) in a clone, or put it on PATH "
+                         f"or in a directory named by ${TOOLS_ENV}; `shadermatrix doctor` lists what is missing")
         self.tool = name
 
 
 def find_tool(name: str) -> str | None:
-    """Path of an executable: ``<repo>/.tools/bin`` first, then ``PATH``."""
+    """Path of an executable: ``$SHADERMATRIX_TOOLS``, then the running environment's scripts directory
+    (a venv's bin/), then ``PATH`` (see toolchain.locate); None when it is in none of them."""
     if os.environ.get("SHADERMATRIX_FORBID_TOOLS"):  # the test tiers: a unit test runs no external tool
         raise RuntimeError(f"external tool '{name}' used where none may run ({os.environ['SHADERMATRIX_FORBID_TOOLS']})")
-    local = TOOLS_BIN / name
-    if local.is_file() and os.access(local, os.X_OK):
-        return str(local)
-    return shutil.which(name)
+    return shutil.which(name, path=os.pathsep.join(tool_dirs()))
 
 
 def _need(name: str) -> str:
