@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ from generator.reference import tables, tables_painted as tp
 from generator.reference.models import reference_brdf
 from tests.lavapipe import device, no_validation_messages  # noqa: F401 (fixtures)
 
-REPO = tp.REPO
+REPO = Path(__file__).resolve().parent.parent
 PAINTED_SPECS = ["ndf_map", "ndf_map_anisotropic", "ndf_fresnel_map", "microfacet(fresnel=fresnel_ramp)"]
 
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..library.bricks import Library
+from ..library.bricks import BUILTIN_BRICKS, Library
 from ..io import atomic_write, content_key, sha256
 from ..analysis import cost_dict
 from ..spec.permutation import SpecError, parse_brdf, parse_spec
@@ -327,7 +327,8 @@ def _own_sources() -> str:
     h = hashlib.sha256()
     for root in (_PACKAGE, _TEMPLATES):
         for p in sorted(root.rglob("*")):
-            if p.is_file() and p.suffix in (".py", ".j2", ".toml"):
+            # the built-in bricks (package data inside generator/ when installed) are keyed per permutation
+            if p.is_file() and p.suffix in (".py", ".j2", ".toml") and BUILTIN_BRICKS not in p.parents:
                 h.update(str(p.relative_to(root.parent)).encode() + b"\0" + p.read_bytes() + b"\0")
     return h.hexdigest()
 

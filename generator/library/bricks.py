@@ -22,8 +22,11 @@ from .kinds import KINDS
 
 BRDF_ARRAY_KINDS = ("diffuse", "specular", "ndf", "fresnel", "visibility")
 
-REPO = Path(__file__).resolve().parents[2]
-BUILTIN_BRICKS = REPO / "bricks"
+REPO = Path(__file__).resolve().parents[2]  # a clone's root (installed: the folder that holds generator/)
+# The built-in bricks: package data beside this module when installed from a wheel (setup.py maps the
+# repository's bricks/ there), else the clone's bricks/ (an editable install runs from the clone).
+_INSTALLED_BRICKS = Path(__file__).resolve().parent / "bricks_data"
+BUILTIN_BRICKS = _INSTALLED_BRICKS if _INSTALLED_BRICKS.is_dir() else REPO / "bricks"
 
 
 PARAM_TYPES = ("float", "vec2", "vec3", "vec4", "mat4")
@@ -109,8 +112,12 @@ def display(path: Path, root: Path | None = None) -> str:
     """A path as shown in messages, provenance, #line directives and the manifest: relative to the repo when
     inside it, else to the brick directory's parent (an engine's ``/src/engine/bricks/x.py`` is
     ``bricks/x.py``), so that no absolute path of this machine reaches an output and moving a brick
-    directory changes nothing that is built."""
+    directory changes nothing that is built. A built-in brick is ``bricks/…`` wherever the package is installed."""
     path = path.resolve()
+    try:
+        return str(Path("bricks", path.relative_to(BUILTIN_BRICKS)))
+    except ValueError:
+        pass
     try:
         return str(path.relative_to(REPO))
     except ValueError:

@@ -72,16 +72,15 @@ brick's size and format, validating it with errors that name the file.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
 from ..lang.errors import SourceError
+from ..library.bricks import BUILTIN_BRICKS, display
 from . import exact
 from .tables import axis, quantize, table
 
-REPO = Path(__file__).resolve().parents[2]
-EXAMPLES = REPO / "bricks" / "brdf" / "painted"
+EXAMPLES = BUILTIN_BRICKS / "brdf" / "painted"  # the painted bricks' own example images, package data with them
 EXAMPLE_FILES = {"ndf_map": "ndf_map.png", "ndf_map_anisotropic": "ndf_map_anisotropic.png",
                  "ndf_fresnel_map": "ndf_fresnel_map.png", "fresnel_ramp": "fresnel_ramp.png"}
 MAX_SIDE = 4096  # as the brick schema's table sizes: a larger painted image is a mistake, not a table
@@ -244,7 +243,7 @@ class Painted:
             self.rgb = None  # computed from material properties
             return
         if image is None:
-            shown = str((EXAMPLES / EXAMPLE_FILES[name]).relative_to(REPO))
+            shown = display(EXAMPLES / EXAMPLE_FILES[name])
             image = example_image(name)
         self.rgb = check_image(name, image, shown)
         h, w = self.rgb.shape[:2]
