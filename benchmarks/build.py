@@ -20,7 +20,7 @@ Every command runs with bytecode caching as on an ordinary installation (PYTHOND
 from the environment: where it is set, as on the machine these results came from, each run compiles the
 package again, +0.3 s on the no-op).
 
-Targets (issue 9): cold ≤ 1.5 × floor; no-op ≤ 0.5 s with 0 files written; a one-brick change rebuilds
+Targets: cold ≤ 1.5 × floor; no-op ≤ 0.5 s with 0 files written; a one-brick change rebuilds
 only what reads it. Writes benchmarks/results/build.md and build.json.
 """
 from __future__ import annotations

@@ -9,8 +9,8 @@ slot filler at least once (`--all-combinations`: every combination), at the
 bricks' default parameters. Per spec, two panels:
 
 - top: a unit sphere seen from +z (orthographic) under one directional light,
-  L_o = π f_r c_light cos θ_l with c_light = 1 (DESIGN.md's point-light
-  equation), f_r from that language's eval kernel on lavapipe (float32). The
+  L_o = π f_r c_light cos θ_l with c_light = 1 (the punctual-light
+  equation, c_light the game intensity), f_r from that language's eval kernel on lavapipe (float32). The
   radiance is multiplied by an exposure chosen per spec so that its 99.5th
   percentile maps to 0.8 after Reinhard tone mapping (x / (1 + x)), then
   sRGB-encoded — so a dim microfacet lobe (f0 = 0.04) is as visible as a

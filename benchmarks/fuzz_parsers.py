@@ -1,4 +1,4 @@
-"""Coverage-guided fuzzing of the input parsers with atheris (issue 10: hostile and malformed inputs).
+"""Coverage-guided fuzzing of the input parsers with atheris: hostile and malformed inputs.
 
     .venv/bin/python benchmarks/fuzz_parsers.py TARGET [--seconds S | --runs N] [--seed N] [--keep-going]
         [--all-warnings] [--artifacts DIR] [--corpus DIR] [-- LIBFUZZER_ARGS]

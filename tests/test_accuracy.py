@@ -1,6 +1,6 @@
 """Accuracy: the sample domains, the error metrics, robust bricks on the stress set, and `shadermatrix accuracy`.
 
-Robustness (issue 3 part 5): no brick yields NaN or Inf in float32 anywhere on
+Robustness: no brick yields NaN or Inf in float32 anywhere on
 the stress set — on the NumPy emission always, and on lavapipe in GLSL, HLSL
 and WGSL where a Vulkan device is present. float16 is reported, not required.
 """

@@ -1,4 +1,4 @@
-"""BRICK metadata against its schema (issue 10): every case here was a traceback or an invalid brick accepted;
+"""BRICK metadata against its schema: every case here was a traceback or an invalid brick accepted;
 each is now one line at the offending key of the BRICK literal (generator/library/schema.py)."""
 from __future__ import annotations
 
@@ -160,7 +160,7 @@ def diffuse(NdotL: float, rho_d: vec3) -> vec3:
 
 @pytest.mark.parametrize("helper", ["lit", "switch", "lit_0"])
 def test_a_brick_whose_functions_link_as_the_glues_is_one_error_at_load(helper, tmp_path):
-    """Issue 10: a brick brdf.py with a helper `lit` was linked as `brdf_lit`, the glue's function: composing it
+    """A brick brdf.py with a helper `lit` was linked as `brdf_lit`, the glue's function: composing it
     failed at `<glue>:1:1` ("generated twice when linking"), with a hint about bricks of different kinds."""
     from generator.library.bricks import load_library
 

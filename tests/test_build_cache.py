@@ -1,4 +1,4 @@
-"""The content-addressed compile cache (issue 9): hits skip the compilers, output never changes, damage is rebuilt."""
+"""The content-addressed compile cache: hits skip the compilers, output never changes, damage is rebuilt."""
 from __future__ import annotations
 
 import subprocess

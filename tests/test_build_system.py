@@ -1,4 +1,4 @@
-"""The build as a build system calls it (issue 9): depfiles, one build at a time, kill -9 loses nothing,
+"""The build as a build system calls it: depfiles, one build at a time, kill -9 loses nothing,
 failures keep the last good outputs, removed permutations leave the tree, no machine paths in outputs."""
 from __future__ import annotations
 

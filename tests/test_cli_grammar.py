@@ -1,4 +1,4 @@
-"""One CLI grammar (issue 15): the same brick-directory option everywhere, a subcommand's own usage on a usage
+"""One CLI grammar: the same brick-directory option everywhere, a subcommand's own usage on a usage
 error, the exit codes in every --help and the same across commands (2 usage, 3 a missing tool or device, never a
 silent skip), and a machine-readable build summary."""
 from __future__ import annotations

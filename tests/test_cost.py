@@ -228,7 +228,7 @@ def test_course_models_are_data_and_a_new_brick_adds_its_row(fixture_brick_rows)
         assert all(r.cost.texture == 1 for r in variant)  # the albedo texture
     from generator.measure.plans import course_models
     assert "Ashikhmin-Shirley" in {m.name for m in course_models()[0]}
-    # every model has its bricks now (issue 11: the direct forms; issue 13: the factored ones)
+    # every model has its bricks: the direct forms and the factored ones
     for model in ("Ashikhmin-Shirley", "Lafortune"):
         rows = [r for r in fixture_brick_rows if r.table == "model" and r.subject == model]
         assert {r.course.table for r in rows} == {"shift-invariant", "shift-variant"} and not any(r.error for r in rows)

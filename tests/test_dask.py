@@ -1,4 +1,4 @@
-"""`build --executor dask://...` (issue 9): the compiles run on a real Dask cluster (a distributed.LocalCluster
+"""`build --executor dask://...`: the compiles run on a real Dask cluster (a distributed.LocalCluster
 the test starts), the output is byte-identical to a local build, and a worker without the tools fails the
 build with one line."""
 from __future__ import annotations

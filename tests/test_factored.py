@@ -1,4 +1,4 @@
-"""Factored (lookup-table) specular bricks (issue 13 item 1): blinn_phong_factored, banks_factored,
+"""Factored (lookup-table) specular bricks: blinn_phong_factored, banks_factored,
 ashikhmin_shirley_factored and the diffuse half ashikhmin_shirley_diffuse_factored, against their direct
 references within their declared tolerances; the remap constants at texel centres; reciprocity; the GPU
 languages on lavapipe against NumPy."""

@@ -1,4 +1,4 @@
-"""fp16 for real (issue 11): half emission in HLSL/GLSL/WGSL, fp16 eval kernels on lavapipe, the fp16
+"""fp16 for real: half emission in HLSL/GLSL/WGSL, fp16 eval kernels on lavapipe, the fp16
 columns of `accuracy`, the `fp16` brick metadata key and the build's warning.
 
 What fp16 means here: the brick language's `float` is the language's 16-bit float — GLSL `float16_t`

@@ -1,4 +1,4 @@
-"""A seeded fuzz suite over the inputs (issue 10): mutated copies of the shipped bricks, the example scene and
+"""A seeded fuzz suite over the inputs: mutated copies of the shipped bricks, the example scene and
 sample files.
 
 Every case must either load (and, for a BRDF term, compose in every language), or fail with exactly one

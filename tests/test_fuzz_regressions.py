@@ -1,4 +1,4 @@
-"""Regression cases of the coverage-guided fuzzer, benchmarks/fuzz_parsers.py (issue 10; results in
+"""Regression cases of the coverage-guided fuzzer, benchmarks/fuzz_parsers.py (results in
 benchmarks/results/fuzz_parsers.md): each case is the exact input a campaign reported, and the message the
 parser now gives for it — one line, `path: …` (the samples reader) or `path:line:col: …`, with ` — what to do`,
 and nothing printed besides it."""

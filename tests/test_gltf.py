@@ -1,4 +1,4 @@
-"""glTF 2.0 scenes (issue 12 items 1 and 6; generator/scene/gltf.py): the Khronos sample-style cases written
+"""glTF 2.0 scenes (generator/scene/gltf.py): the Khronos sample-style cases written
 here (a textured metal, an alpha-masked leaf, a double-sided cloth, a mesh without tangents, lights of all three
 types) map to the bricks, build in all three languages, share a permutation exactly where the shader is the same,
 and every malformed file or unsupported shading extension is one error with the file and the JSON pointer."""

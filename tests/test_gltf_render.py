@@ -1,5 +1,5 @@
-"""The renderer draws a glTF scene's own meshes at their nodes' world matrices (issue 12: "meshes are read
-too, for the renderer")."""
+"""The renderer draws a glTF scene's own meshes at their nodes' world matrices: a scene's meshes
+are read for the renderer too."""
 from __future__ import annotations
 
 import json

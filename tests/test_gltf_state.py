@@ -1,4 +1,4 @@
-"""The surface state in the key (issue 12 item 1; generator/spec/surface.py): alpha mode, double-sided, vertex
+"""The surface state in the key (generator/spec/surface.py): alpha mode, double-sided, vertex
 colours and emission change the permutation exactly where they change the shader, keep every earlier key, compile
 for every platform, and the renderer draws them (an alpha-masked object vanishes, a double-sided plane is lit from
 behind, an emissive one glows)."""

@@ -1,4 +1,4 @@
-"""AMD compiler statistics from Mesa RADV's null device (issue 14): real ACO figures, no AMD GPU.
+"""AMD compiler statistics from Mesa RADV's null device: real ACO figures, no AMD GPU.
 
 Every test here compiles on RADV for real (`generator/runtime/gpu_stats.py`: one process per family,
 RADV_FORCE_FAMILY and RADV's ICD); without mesa-vulkan-drivers they skip, and under CI=true they fail.

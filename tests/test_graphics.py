@@ -1,4 +1,4 @@
-"""The offscreen graphics renderer (issue 8): meshes, PNGs, and real permutations drawn on lavapipe.
+"""The offscreen graphics renderer: meshes, PNGs, and real permutations drawn on lavapipe.
 
 The generator's own vertex and fragment shaders (compose_permutation) and its fragment
 ubershader (compose_ubershader) are compiled by the real toolchain and drawn through

@@ -1,4 +1,4 @@
-"""Hostile files (issue 10, first part): only regular files of a bounded size are read, and no brick path can
+"""Hostile files: only regular files of a bounded size are read, and no brick path can
 carry a line break or control character into generated code."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Incremental builds (issue 9): a no-op rebuild composes, compiles and writes nothing; a change rebuilds
+"""Incremental builds: a no-op rebuild composes, compiles and writes nothing; a change rebuilds
 only the permutations it reaches."""
 from __future__ import annotations
 

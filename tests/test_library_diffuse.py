@@ -1,4 +1,4 @@
-"""The diffuse bricks of issue 11: closed forms, albedos by quadrature (ACCURACY-FACTS §4.7, §4.9),
+"""The diffuse bricks: closed forms, albedos by quadrature (ACCURACY-FACTS §4.7, §4.9),
 the seed misprints they correct, and Gotanda's fit against the microfacet model it fits.
 
 Bricks run through their NumPy float64 emission (generator.evaluate), references through

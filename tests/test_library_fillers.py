@@ -1,4 +1,4 @@
-"""The microfacet slot fillers of issue 11: NDF normalization, Fresnel closed forms, visibility identities,
+"""The microfacet slot fillers: NDF normalization, Fresnel closed forms, visibility identities,
 white furnace figures (ACCURACY-FACTS §4.4, §4.5, §4.11, §4.12).
 
 Bricks run through their NumPy emission (float64 unless said otherwise) inside the microfacet

@@ -1,4 +1,4 @@
-"""The classic specular bricks of issue 11: the properties each model claims, and its formulations.
+"""The classic specular bricks: the properties each model claims, and its formulations.
 
 Phong (the course's original form and its two plausibility steps), Blinn-Phong with R_F(α_h),
 Banks, Ward (isotropic, anisotropic), Ashikhmin-Shirley, Lafortune, Cook-Torrance

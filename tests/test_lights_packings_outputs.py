@@ -1,4 +1,4 @@
-"""Issue 13, items 5, 7 and 9: the new light, packing and output bricks.
+"""Range-limited, spot and uber lights, texture packings and output encodings: what each adds and its checks.
 
 - Lights (`point_range`, `spot`, `uberlight`): shade() with a Lambert BRDF of albedo 1 and the normal
   toward the light returns c_light exactly (π · (1/π) · c_light · 1); that equals the float64

@@ -1,4 +1,4 @@
-"""Issue 13, item 8: level of detail — Toksvig's factor and the course's per-MIP exponent reduction.
+"""Level of detail — Toksvig's factor and the course's per-MIP exponent reduction.
 
 - The packings `toksvig_n` (Blinn-Phong exponent) and `toksvig_alpha` (microfacet α): shade() in NumPy,
   with textures of filtered (shortened) normals sampled at texel centres, equals π f_r c cosθ of the

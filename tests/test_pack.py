@@ -1,4 +1,4 @@
-"""`build --pack` (issue 12 item 4): one shader pack per platform, its documented format, its reader."""
+"""`build --pack`: one shader pack per platform, its documented format, its reader."""
 from __future__ import annotations
 
 import hashlib

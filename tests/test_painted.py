@@ -1,4 +1,4 @@
-"""Hand-painted BRDFs (issue 13 item 2): NDF maps, Fresnel ramp, NDF + Fresnel map
+"""Hand-painted BRDFs: NDF maps, Fresnel ramp, NDF + Fresnel map
 (generator/reference/tables_painted.py; bricks ndf_map, ndf_map_anisotropic, ndf_fresnel_map, fresnel_ramp)."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""`build -j N` with N > 1 (issue 9): permutations are composed, compiled and analysed in N worker processes
+"""`build -j N` with N > 1: permutations are composed, compiled and analysed in N worker processes
 (generator/assemble/parallel.py); the output is byte-identical to an in-process build, the counts are the same,
 the depfile names the templates the workers read, and a worker's compose error or missing tool is reported as
 in-process."""

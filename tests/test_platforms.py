@@ -1,4 +1,4 @@
-"""`build --platform` (issue 12, item 3): one tree per platform, and reflection in each platform's binding model.
+"""`build --platform`: one tree per platform, and reflection in each platform's binding model.
 
 The example scene and a glTF scene (written here) build for all four platforms; each platform's
 reflection in the manifest is checked against the artifacts themselves: read back from the SPIR-V for

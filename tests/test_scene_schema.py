@@ -1,4 +1,4 @@
-"""Scene files against their schema (issue 10): every wrong key or type is one located line with what to do,
+"""Scene files against their schema: every wrong key or type is one located line with what to do,
 checked before any value is interpreted (generator/scene/schema.py); each case below was a traceback, or a
 scene accepted that builds something else."""
 from __future__ import annotations

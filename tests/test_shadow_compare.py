@@ -1,4 +1,4 @@
-"""Hardware depth compare (issue 13, item 6): texture2d_shadow and sample_compare, and the pcf_hardware brick.
+"""Hardware depth compare: texture2d_shadow and sample_compare, and the pcf_hardware brick.
 
 tests/bricks/ext_shadow_compare.py reads a depth texture through its comparison sampler in a compute
 kernel per language (GLSL sampler2DShadow, HLSL SamplerComparisonState, WGSL texture_depth_2d +

@@ -1,4 +1,4 @@
-"""The shadow depth pass (issue 8): every shadowed light's depth rendered from the light, sampled as its shadow map.
+"""The shadow depth pass: every shadowed light's depth rendered from the light, sampled as its shadow map.
 
 tests/scenes/shadow.toml: a Lambert floor (8 × 8, y = 0) and a ball (r = 0.6) above it, one directional light with
 shadow_map and nothing else, so a lit floor pixel has one uniform colour and a shadowed one is black. The ball's

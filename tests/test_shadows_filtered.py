@@ -1,4 +1,4 @@
-"""Filtered shadows (issue 13, item 6): `pcf` (k × k depth compares, averaged) and `vsm` (variance shadow map).
+"""Filtered shadows: `pcf` (k × k depth compares, averaged) and `vsm` (variance shadow map).
 
 The scene is tests/scenes/shadow.toml (a Lambert floor, a ball above it, one directional light, nothing else:
 a lit floor pixel has one colour, a shadowed one is black) with the sun's shadow swapped for the brick under

@@ -1,4 +1,4 @@
-"""Issue 13, item 7: the twist map (Hoffman & Baker 2006, "Anisotropic BRDF with Normal and Twist Maps").
+"""The twist map (Hoffman & Baker 2006, "Anisotropic BRDF with Normal and Twist Maps").
 
 The normal fillers `normal_twist_map` (one RGBA texture: RG normal xy, BA twist direction) and
 `twist_map` (vertex normal, RG twist texture) define the normal kind's optional `tangent` entry; the

@@ -1,6 +1,6 @@
 """Per-permutation compile checks an engine's CI runs: `shadermatrix check` and the pytest plugin share them.
 
-A check is one permutation of a scene on one platform (issue 12, items 3 and 5), validated by the
+A check is one permutation of a scene on one platform, validated by the
 tools that validate what `build --platform` ships for it (assemble/platforms.py):
 
     platform  what a check compiles and validates                       golden sources

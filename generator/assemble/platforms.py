@@ -1,4 +1,4 @@
-"""Platforms (issue 12, item 3): what `build --platform vulkan,d3d12,gl,webgpu` writes for each, and its manifest.
+"""Platforms: what `build --platform vulkan,d3d12,gl,webgpu` writes for each, and its manifest.
 
 A platform is what an engine loads, built from the languages (the SPIR-V checks of every language —
 glslc/naga, spirv-opt, spirv-val, cost — run whatever the platforms):

@@ -47,7 +47,7 @@ def scene_tables(scene: Scene, interfaces: dict, previous: dict | None = None) -
                          "permutation": o["permutation"]} for o in scene.objects]}
 
 
-# ------------------------------------------------------------------ per platform (issue 12, item 3)
+# ------------------------------------------------------------------ per platform: each one's binding model
 
 _STAGES = {"Frame": ["vert", "frag"], "Object": ["vert"]}  # every other block and texture: the fragment stage
 _WGPU_FORMAT = {"R32G32B32_SFLOAT": "float32x3", "R32G32B32A32_SFLOAT": "float32x4", "R32G32_SFLOAT": "float32x2"}

@@ -1,4 +1,4 @@
-"""Baked tables as build artifacts: KTX2 files beside the shaders, listed in the manifest (issue 13, item 4).
+"""Baked tables as build artifacts: KTX2 files beside the shaders, listed in the manifest.
 
 A permutation (or the ubershader) that samples a texture a brick declares as a table
 (reference/tables.py) needs the table's texels at run time; the engine loads them from

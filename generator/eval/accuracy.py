@@ -4,7 +4,7 @@ Two sample sets per BRDF spec:
 - `hemisphere`: L and V stratified jointly over the upper hemisphere (uniform in
   solid angle: cos θ and φ in a jittered k⁴ grid), with the bricks' default
   parameters, in a rotated frame so that float32 directions carry rounding;
-- `stress`: the degenerate and extreme configurations of issue 3, plus the extremes of every
+- `stress`: the degenerate and extreme configurations below, plus the extremes of every
   tangent-frame row of the inputs table (library/inputs.py) for anisotropic models (grazing cosines
   0, 1e-7, 1e-4, 1e-2; L = V; L = -V; V below the horizon; the mirror direction,
   also at grazing; h = n and 0.05° off it) crossed with parameter sweeps (alpha
@@ -46,7 +46,7 @@ SWEEPS = {
     "alpha": (0.0, 1e-4, 1e-3, 1e-2, 0.3, 1.0),
     "n": (1.0, 10.0, 100.0, 1e3, 1e4, 1e5),
     "f0": (0.0, 0.04, 1.0),
-    "alpha_u": (1e-4, 1e-2, 0.5),  # anisotropic GGX/Beckmann NDF and Smith (issue 11 fillers)
+    "alpha_u": (1e-4, 1e-2, 0.5),  # the anisotropic GGX/Beckmann NDF and Smith fillers
     "alpha_v": (1e-3, 1.0),
     "eta": (0.2, 1.0, 1.5),  # conductor_exact: metal-like, the degenerate index 1 (with k = 0), glass
     "k": (0.0, 3.5),

@@ -213,7 +213,8 @@ class ExprChecker:
         if fname == "range":
             raise self.err(n, "range() is only allowed in a for loop", "write for i in range(N)")
         raise self.err(n, f"unknown function '{fname}'",
-                       "call an intrinsic (see DESIGN.md), a type constructor, or a function of this brick or its slots")
+                       "call an intrinsic (docs/reference/language.md), a type constructor, or a function of "
+                       "this brick or its slots")
 
     def construct(self, n, ty: Type, args) -> ir.Expr:
         loc = self.loc(n)

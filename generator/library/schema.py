@@ -1,4 +1,4 @@
-"""The BRICK metadata dict's shape as a JSON Schema, checked before its meaning (issue 10).
+"""The BRICK metadata dict's shape as a JSON Schema, checked before its meaning.
 
 Like the scene's (scene/schema.py): keys and value types are data here; library/bricks.py then checks
 what a schema cannot (a kind's contract, a default inside its range, filler ids that exist). Every

@@ -1,4 +1,5 @@
-"""Float64 references of the diffuse bricks of issue 11, and the microfacet diffuse model Gotanda fits.
+"""Float64 references of the diffuse bricks (Oren-Nayar and its variants, Ashikhmin-Shirley, Gotanda), and
+the microfacet diffuse model Gotanda fits.
 
 Each function is written from its paper's formula (cited per function), never from
 the brick sources; the geometry is the shading policy's (geometry.py: n·v clamped to

@@ -1,4 +1,5 @@
-"""Float64 references of the microfacet slot fillers of issue 11, written from the papers.
+"""Float64 references of the microfacet slot fillers beyond models.py's basic ones (anisotropic NDFs, Ward,
+exact and spherical-Gaussian Fresnel, the Smith and approximate visibility terms), written from the papers.
 
 Registered in models.REFERENCES (imported at the end of models.py). Signatures per kind
 (models.py): ndf f(cos_h, sin2_h, alpha[, *, g, p]) -> D; fresnel f(f0, cos_d[, *, p]) -> F;

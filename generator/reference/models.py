@@ -210,6 +210,6 @@ def missing_references(lib=None) -> list[str]:
     from ..library.bricks import library_or_builtin
     lib = library_or_builtin(lib)
     return [f"{k}/{b.id}" for k in REFERENCES for b in lib.of_kind(k) if b.id not in REFERENCES[k]]
-from . import diffuse as _diffuse  # noqa: E402,F401  (the diffuse references of issue 11)
+from . import diffuse as _diffuse  # noqa: E402,F401  (registers the diffuse references)
 from . import specular as _specular  # noqa: E402,F401
 from . import fillers as _fillers  # noqa: E402,F401

@@ -1,4 +1,4 @@
-"""Float64 references of the classic specular bricks (issue 11), written from the papers.
+"""Float64 references of the classic specular bricks, written from the papers.
 
 Phong (original and its plausibility steps), Blinn-Phong with R_F(alpha_h), Banks, Ward
 (isotropic, anisotropic), Ashikhmin-Shirley, Lafortune, Cook-Torrance. Each function cites
@@ -262,7 +262,7 @@ def homomorphic_factorization(g: Geometry, p: dict, slots: dict) -> np.ndarray:
     return ashikhmin_shirley(g, {**t, "f0": np.broadcast_to(t["f0"], (g.count, 3))}, slots)
 
 
-# ------------------------------------------------------------------ hand-painted BRDFs (issue 13)
+# ------------------------------------------------------------------ hand-painted BRDFs
 
 from .tables_painted import register_references as _painted_references  # noqa: E402
 

@@ -239,7 +239,7 @@ class Device:
         have = {e.extensionName for e in vk.vkEnumerateDeviceExtensionProperties(self.physical, None)}
         self.extensions = [e for e in ("VK_EXT_pipeline_creation_feedback",) if e in have]
         features = None
-        # fp16 (issue 11): half arithmetic (shaderFloat16) and 16-bit storage access, which naga's f16
+        # fp16: half arithmetic (shaderFloat16) and 16-bit storage access, which naga's f16
         # modules declare, are enabled wherever the device reports them; self.features says which.
         self.features = self._fp16_features(have)
         storage = {k: vk.VK_TRUE for k in ("storageBuffer16BitAccess", "uniformAndStorageBuffer16BitAccess")

@@ -1,4 +1,4 @@
-"""The scene file's shape as a JSON Schema, checked before any value is interpreted (issue 10).
+"""The scene file's shape as a JSON Schema, checked before any value is interpreted.
 
 Why a schema (jsonschema, pinned): the rules are data, not code spread over the reader — one place
 says which keys a table has and what type each value is, and an engine's tools can read the same

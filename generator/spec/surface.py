@@ -1,5 +1,5 @@
 """The surface's render state in a permutation key: what of glTF's alphaMode, doubleSided, COLOR_0 and emission
-changes the shader (issue 12, item 1), and nothing that does not.
+changes the shader, and nothing that does not.
 
 glTF 2.0 specification, 3.9.4 "Alpha Coverage", 3.9.5 "Double Sided", 3.9.3 "Additional Textures" (emissive),
 3.7.2.1 (COLOR_0). Four axes, each with a default that is what every permutation had before, so a key at the

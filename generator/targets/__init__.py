@@ -12,7 +12,7 @@ from .hlsl import HlslHalfTarget, HlslTarget
 from .wgsl import WgslHalfTarget, WgslTarget
 
 TARGETS: dict[str, Target] = {"glsl": GlslTarget(), "hlsl": HlslTarget(), "wgsl": WgslTarget()}
-# fp16 variants: the brick language's float is the language's 16-bit float (issue 11, "fp16 for real")
+# fp16 variants: the brick language's float is the language's 16-bit float (half arithmetic, not only storage)
 HALF_TARGETS: dict[str, Target] = {"glsl": GlslHalfTarget(), "hlsl": HlslHalfTarget(), "wgsl": WgslHalfTarget()}
 LANGUAGES: tuple[str, ...] = ("glsl", "hlsl", "wgsl")  # the shading languages, in output order
 

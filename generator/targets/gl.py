@@ -1,4 +1,4 @@
-"""OpenGL GLSL: 4.50 core and ES 3.10, the `gl` platform's dialects of the GLSL target (issue 12, item 3).
+"""OpenGL GLSL: 4.50 core and ES 3.10, the `gl` platform's dialects of the GLSL target.
 
 The same IR walk as Vulkan GLSL (glsl.py: this is a subclass, no text is rewritten), spelled for
 OpenGL's binding model (GLSL 4.50 spec §4.4.5 "Uniform and Shader Storage Block Layout Qualifiers",

@@ -6,7 +6,7 @@ half-vector density (Walter 2005, "Notes on the Ward BRDF", Cornell PCG-05-06) i
 this D. Hoffman & Baker 2006 describe Ward's model as using "a modified Beckmann NDF"; this
 D is Beckmann's (beckmann.py) times cos theta_h.
 
-Decisions (issue 11):
+Decisions:
 - Isotropic, with Ward's slope parameter m read from the host's `alpha` (the slot contract
   passes one roughness; Beckmann's alpha is also the RMS slope m, so ndf=ward and
   ndf=beckmann are comparable at one alpha). The anisotropic Gaussian of Ward's eq. 5a is
