@@ -1,4 +1,4 @@
-"""Hand-painted BRDF tables: NDF maps, Fresnel ramps and NDF + Fresnel maps (issue 13, item 2).
+"""Hand-painted BRDF tables: NDF maps, Fresnel ramps and NDF + Fresnel maps.
 
 Hoffman & Baker 2006 ("Physically-Based Reflectance for Games", "Other Types of BRDFs"):
 
