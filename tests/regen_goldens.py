@@ -13,14 +13,18 @@ Names (tests/golden/README.md has the table): a case is named for what it is, ne
   ir/<dir>/<name>[.shade].ir                           the linked program of each case above
                                                        (generator/lang/dump.py), one for all languages
 
-Normalization: a golden is the emitted text with exactly two line shapes rewritten, so that a brick's
-comment or docstring edit (which moves its lines and changes its file's hash) changes no golden:
-  `// brick <path> sha256:<12 hex>` and `// template <path> sha256:<12 hex>`  → `sha256:<elided>`
-  `#line <digits> "<file>"` (GLSL and HLSL; WGSL has none)                   → `#line N "<file>"`
-Each pattern matches a whole line, at column 0, and keeps the line (paths included), so a normalized
-golden has the emitted line count and every other line byte for byte: no code can hide behind it.
-A template's edit shows in the code it emits; provenance hashes are the build's business (its cache
-keys), not a reviewer's. spirv.json is measured on the emitted text itself.
+Normalization: a golden is the emitted text with two kinds of line rewritten, so that a brick's comment
+or docstring edit (which moves its lines and changes its file's hash) changes no golden:
+  `// brick <path> sha256:<12 hex>`, `// template <path> sha256:<12 hex>`   → the hash becomes `<elided>`
+  `#line <digits> "<file>"` (GLSL and HLSL; WGSL has none)                 → `#line N "<file>"`, and dropped
+                                                                             when the directive before it
+                                                                             names the same file
+The emitters write a directive wherever the next line is not the line after the last one, so a comment
+between two statements adds one; a change of file always has one. What is kept is therefore one directive
+per change of file: each function still says which brick it came from, whatever the line numbers.
+Both patterns match whole lines at column 0; every other line is kept byte for byte (a test checks that
+for every golden), so no code can hide behind the normalization. spirv.json is measured on the emitted
+text itself (a `#line N` does not compile); a template's edit shows in the code it emits.
 """
 from __future__ import annotations
 
@@ -38,12 +42,20 @@ GOLDEN = REPO / "tests" / "golden"
 LANGUAGE_DIRS = ("glsl", "hlsl", "wgsl")
 
 HEADER_HASH = re.compile(r"^(// (?:brick|template) [^ \n]+ sha256:)[0-9a-f]{12}$", re.M)
-LINE_DIRECTIVE = re.compile(r'^#line [0-9]+ ("[^"\n]*")$', re.M)
+LINE_DIRECTIVE = re.compile(r'^#line [0-9]+ ("[^"\n]*")$')
 
 
 def normalize(text: str) -> str:
     """The emitted text as checked in (see the module docstring): provenance hashes and #line numbers out."""
-    return LINE_DIRECTIVE.sub(r"#line N \1", HEADER_HASH.sub(r"\1<elided>", text))
+    out, last = [], None
+    for line in HEADER_HASH.sub(r"\1<elided>", text).split("\n"):
+        m = LINE_DIRECTIVE.match(line)
+        if m and m.group(1) == last:
+            continue
+        if m:
+            line, last = f"#line N {m.group(1)}", m.group(1)
+        out.append(line)
+    return "\n".join(out)
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,7 @@ def test_goldens_cover_every_language_and_stage(goldens):
 
 @pytest.mark.golden
 def test_every_golden_case_has_its_ir_and_no_name_is_a_hash(goldens):
-    cases = {re.sub(rf"^\w+/(.*)\.(?:vert|frag|comp)\.\w+$", r"ir/\1.ir", rel)
+    cases = {re.sub(r"^\w+/(.*)\.(?:vert|frag|comp)\.\w+$", r"ir/\1.ir", rel)
              for rel, g in goldens.items() if g.language != "ir"}
     assert cases == {rel for rel, g in goldens.items() if g.language == "ir"}
     names = {rel.split("/")[-1].split(".")[0] for rel in goldens}
@@ -44,34 +44,45 @@ def test_every_golden_case_has_its_ir_and_no_name_is_a_hash(goldens):
 
 
 @pytest.mark.golden
-def test_normalization_rewrites_only_the_provenance_hashes_and_line_numbers():
+def test_normalization_rewrites_only_the_provenance_hashes_and_line_directives():
     emitted = "\n".join([
         "// brick bricks/brdf/diffuse/lambert.py sha256:571e572632b7",
         "// template glsl/fragment.glsl.j2 sha256:35dbc3ce7a17",
         '#line 19 "bricks/brdf/diffuse/lambert.py"',
+        "vec3 f() {",
+        '#line 22 "bricks/brdf/diffuse/lambert.py"',  # the same file after a gap: dropped
+        "}",
         '#line 3 "<glue>"',
         "// hash: 3492f48173ec",
         "    float x = 19.0; // brick bricks/a.py sha256:571e572632b7",  # code, not a header line
         '    #line 19 "indented"',  # not the shape the emitters write: kept, so it would show in a diff
         "// brick bricks/a.py sha256:571e572632b7 trailing",
-        "float y = 2.0;",
+        '#line 4 "bricks/brdf/diffuse/lambert.py"',  # back to a file: kept
     ])
     assert normalize(emitted).split("\n") == [
         "// brick bricks/brdf/diffuse/lambert.py sha256:<elided>",
         "// template glsl/fragment.glsl.j2 sha256:<elided>",
         '#line N "bricks/brdf/diffuse/lambert.py"',
+        "vec3 f() {",
+        "}",
         '#line N "<glue>"',
-        *emitted.split("\n")[4:],
+        *emitted.split("\n")[7:11],
+        '#line N "bricks/brdf/diffuse/lambert.py"',
     ]
 
 
 @pytest.mark.golden
 def test_a_normalized_golden_differs_from_the_emitted_text_only_in_those_lines(goldens):
-    shapes = re.compile(r'^(// (brick|template) [^ ]+ sha256:[0-9a-f]{12}|#line [0-9]+ "[^"]*")$')
+    """Without #line lines the two are equal but for the hashes; the directives kept are one per change of file."""
+    directive = re.compile(r'^#line (?:[0-9]+|N) ("[^"]*")$')
+    header = re.compile(r"^// (brick|template) [^ ]+ sha256:[0-9a-f]{12}$")
     for rel, g in goldens.items():
-        before, after = g.emitted.split("\n"), g.text.split("\n")
-        assert len(before) == len(after), rel
-        assert all(a == b or shapes.match(a) for a, b in zip(before, after)), rel
+        before = [x for x in g.emitted.split("\n") if not directive.match(x)]
+        after = [x for x in g.text.split("\n") if not directive.match(x)]
+        assert len(before) == len(after) and all(a == b or header.match(a) for a, b in zip(before, after)), rel
+        files = [m.group(1) for x in g.emitted.split("\n") if (m := directive.match(x))]
+        kept = [m.group(1) for x in g.text.split("\n") if (m := directive.match(x))]
+        assert kept == [f for i, f in enumerate(files) if i == 0 or files[i - 1] != f], rel
 
 
 def _edit(tmp_path, change) -> Path:
@@ -85,17 +96,19 @@ def _edit(tmp_path, change) -> Path:
 
 
 def _comments_and_docstrings(text: str, tree) -> str:
-    """A comment line on top, a line more in the module docstring, a function docstring and a comment
-    between two statements of the first function: every line below the top moves."""
+    """A comment line on top, a line more in the module docstring, a function docstring, and a comment and
+    a blank line between the first function's first two statements: every line below the top moves, and
+    two statements that were adjacent no longer are (the emitters add a #line directive between them)."""
     lines = text.split("\n")
     doc = tree.body[0]
     fn = next(n for n in tree.body if isinstance(n, ast.FunctionDef))
-    first = fn.body[0]
-    assert isinstance(doc, ast.Expr) and doc.end_lineno > doc.lineno and not isinstance(first, ast.Expr), \
+    first, second = fn.body[0], fn.body[1]
+    assert isinstance(doc, ast.Expr) and doc.end_lineno > doc.lineno and not isinstance(first, ast.Expr) \
+        and second.lineno == first.end_lineno + 1, \
         f"{EDITED} no longer has a multi-line module docstring and an undocumented function: pick another brick"
     pad = " " * first.col_offset
-    lines[first.lineno - 1:first.lineno - 1] = [f'{pad}"""What this function does (a docstring the test adds)."""',
-                                                f"{pad}# a comment the test adds between statements"]
+    lines[second.lineno - 1:second.lineno - 1] = [f"{pad}# a comment the test adds between statements", ""]
+    lines[first.lineno - 1:first.lineno - 1] = [f'{pad}"""What this function does (a docstring the test adds)."""']
     lines[doc.lineno:doc.lineno] = ["A line the test adds to the module docstring.", ""]
     return "\n".join(["# a comment line the test adds above the docstring", *lines])
 
