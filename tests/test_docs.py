@@ -150,3 +150,37 @@ def test_commands_are_parsed_as_the_convention_says():
         commands_of("p.md", "```sh\nls\n")
     assert NOT_RUN.match("make test  # slow") and NOT_RUN.match("make distclean")
     assert not NOT_RUN.match("make demo") and not NOT_RUN.match("make testing")
+
+
+def _anchors(text: str) -> set[str]:
+    """GitHub's anchors of a page's headings: lower case, punctuation dropped, spaces to hyphens, -1, -2 … for
+    repeats (headings inside fenced blocks are not headings)."""
+    seen: dict[str, int] = {}
+    out = set()
+    for title in re.findall(r"^#{1,6}\s+(.+?)\s*#*\s*$", re.sub(r"```.*?```", "", text, flags=re.S), re.M):
+        slug = re.sub(r"[^\w\- ]", "", re.sub(r"`", "", title).lower()).replace(" ", "-")
+        n = seen.get(slug, 0)
+        seen[slug] = n + 1
+        out.add(slug if n == 0 else f"{slug}-{n}")
+    return out
+
+
+def test_relative_links_lead_to_a_file_and_heading():
+    broken = []
+    for page in pages():
+        text = page.read_text(encoding="utf-8")
+        prose = re.sub(r"```.*?```", "", text, flags=re.S)
+        for target in re.findall(r"\]\(([^)\s]+)\)", prose):
+            if re.match(r"[a-z][a-z0-9+.-]*:", target):  # https:, mailto:
+                continue
+            path, _, frag = target.partition("#")
+            dest = (page.parent / path).resolve() if path else page
+            where = f"{page.relative_to(REPO)}: ({target})"
+            if not dest.exists():
+                broken.append(f"{where}: no such file")
+            elif not dest.is_relative_to(REPO):
+                broken.append(f"{where}: outside the repository")
+            elif frag and dest.suffix == ".md" and frag not in _anchors(dest.read_text(encoding="utf-8")):
+                broken.append(f"{where}: no heading #{frag} there")
+    assert not broken, "links that lead nowhere:\n" + "\n".join(broken)
+
