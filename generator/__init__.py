@@ -3,7 +3,7 @@ __version__ = "0.1.0"
 
 # Targets and dtypes of evaluate(), here so that the CLI's argument parser reads them without
 # importing generator.eval (numpy, jinja2, the emitters).
-EVAL_TARGETS = ("reference", "numpy", "glsl", "hlsl", "wgsl")  # what evaluate() runs on (targets.TARGETS: the emitters)
+EVAL_TARGETS = ("reference", "numpy", "glsl", "hlsl", "wgsl")  # what evaluate() runs on (backends.TARGETS: the emitters)
 GPU_TARGETS = ("glsl", "hlsl", "wgsl")
 DTYPES = ("float64", "float32", "float16")
 

@@ -101,7 +101,7 @@ SHELLS = {
 
 def shader(m: ir.Module, lang: str, stage: str):
     """(complete shader text, Emitted) for one language and stage."""
-    from generator.targets import get_target
+    from generator.backends import get_target
 
     t = get_target(lang)
     emitted = t.emit(list(m.structs.values()), list(m.functions.values()) + harness(m), globals_for(m))

@@ -1,10 +1,10 @@
-"""Cube face selection and its inverse (generator/targets/numpy_resources.py: cube_face, cube_texel_direction;
+"""Cube face selection and its inverse (generator/backends/numpy/resources.py: cube_face, cube_texel_direction;
 Vulkan "Cube Map Face Selection"), shared by the NumPy target's texturecube and the homomorphic factorization."""
 from __future__ import annotations
 
 import numpy as np
 
-from generator.targets.numpy_resources import cube_face, cube_texel_direction
+from generator.backends.numpy.resources import cube_face, cube_texel_direction
 
 
 def test_a_texel_centre_direction_selects_its_own_face_and_coordinates():

@@ -6,7 +6,7 @@ What fp16 means here: the brick language's `float` is the language's 16-bit floa
 -fhlsl-16bit-types; not min16float, which glslang lowers to a RelaxedPrecision 32-bit float), WGSL `f16`
 (`enable f16;`) — so the SPIR-V declares Float16 and lavapipe computes in half. Everything that crosses
 the interface (samples, uniforms, buffers, textures, stage inputs and outputs) stays 32-bit and is
-converted where brick code meets it (generator/targets/clike.py from32/to32/entry32).
+converted where brick code meets it (generator/backends/clike/walk.py from32/to32/entry32).
 
 Tolerance of the lavapipe fp16 kernels against the float64 reference (at the inputs as rounded to
 half, on the stratified hemisphere at the default parameters): FP16_RTOL relative, with the absolute
@@ -83,7 +83,7 @@ def test_fp16_emission_spells_half_types(lang):
 
 def test_fp16_literals_saturate_and_carry_the_half_suffix():
     from generator.lang.types import FLOAT
-    from generator.targets import get_target
+    from generator.backends import get_target
 
     assert get_target("glsl", "fp16").literal(FLOAT, 0.5) == "0.5hf"
     assert get_target("glsl", "fp16").literal(FLOAT, 1 / np.pi) == "0.318359375hf"  # rounded here, not by glslang

@@ -11,7 +11,7 @@ import pytest
 from generator.lang import ir, parse_module
 from generator.lang.types import (FLOAT, INT, TEXTURECUBE, UINT, VEC4, array, buffer_layout_error, storage_buffer,
                                   struct, uniform_buffer)
-from generator.targets import TARGETS, get_target
+from generator.backends import TARGETS, get_target
 from tests.conftest import require_tool
 from tests.ext_harness import globals_for, module, shader
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from generator.lang import ir, parse_module
-from generator.targets import get_target
+from generator.backends import get_target
 from tests.lavapipe import device, no_validation_messages  # noqa: F401  (fixtures)
 from tests.regen_goldens import REPO
 

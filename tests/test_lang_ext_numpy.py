@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from generator.lang import parse_module
-from generator.targets.numpy import NumpyTarget
+from generator.backends.numpy.emit import NumpyTarget
 
 BRICKS = Path(__file__).parent / "bricks"
 N = 301

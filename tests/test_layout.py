@@ -11,7 +11,7 @@ GENERATOR = Path(__file__).resolve().parent.parent / "generator"
 # The stages in data-flow order (docs/design/ describes them). reference/ and runtime/ come before eval/,
 # which evaluates on them, and before measure/, whose cost tables also read RADV's compiler statistics
 # (runtime/gpu_stats.py); io.py is the utility layer right after the language.
-ORDER = ["lang", "io", "library", "spec", "scene", "link", "targets", "compose", "toolchain", "analysis",
+ORDER = ["lang", "io", "library", "spec", "scene", "link", "backends", "compose", "toolchain", "analysis",
          "reference", "runtime", "measure", "eval", "assemble", "cli"]
 
 

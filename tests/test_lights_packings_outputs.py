@@ -202,7 +202,7 @@ def test_light_bricks_agree_with_the_reference_on_lavapipe(lib, device, language
 def _numpy_shade(lib, perm):
     """The fragment glue's shade() of a permutation, emitted to NumPy (float64); its signature names."""
     from generator.link import link_permutation
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
 
     lp = link_permutation(perm, lib)
     t = NumpyTarget()
@@ -461,7 +461,7 @@ def test_output_bricks_equal_their_references_in_numpy(lib):
         np.testing.assert_allclose(got[:, :3], ref(lin), rtol=1e-13, atol=1e-15)
         assert np.all(got[:, 3] == 1.0)
     # saturate: out-of-range inputs are clipped as a UNORM target would, never NaN
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
     from generator.link import link_permutation
     from generator.spec.permutation import LightKey, Permutation
 
@@ -481,7 +481,7 @@ def test_srgb_in_float32_numpy_is_within_a_few_ulp_of_float64():
     from generator.library.bricks import load_library
     from generator.link import link_permutation
     from generator.spec.permutation import LightKey, Permutation
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
 
     lib = load_library()
     perm = Permutation("lambert", (LightKey("directional", "none"),), "constants(normal=vertex)", "srgb")

@@ -47,7 +47,7 @@ def frame():
 
 def test_fillers_of_one_host_link_into_one_program_deterministically(lib):
     from generator.link import switch_program
-    from generator.targets import get_target
+    from generator.backends import get_target
 
     ep = switch_program(NDFS, lib)
     names = [f.name for f in ep.program.functions]
@@ -63,7 +63,7 @@ def test_fillers_of_one_host_link_into_one_program_deterministically(lib):
     import subprocess
     import sys
     code = ("import hashlib; from pathlib import Path; from generator.library.bricks import load_library; "
-            "from generator.link import switch_program; from generator.targets import get_target; "
+            "from generator.link import switch_program; from generator.backends import get_target; "
             f"ep = switch_program({NDFS!r}, load_library([Path({str(LINK_BRICKS)!r})])); "
             "print(hashlib.sha256(get_target('glsl').emit(ep.program.structs, ep.program.functions).text.encode())"
             ".hexdigest())")
@@ -174,7 +174,7 @@ def test_tangent_brdf_needs_a_packing_with_a_tangent_frame(lib, tmp_path):
 def test_output_brick_parameter_reaches_the_material_block_and_scales_the_output(lib):
     from generator.link import link_permutation
     from generator.spec.permutation import LightKey, Permutation
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
 
     perm = Permutation("lambert", (LightKey("directional", "none"),), "constants(normal=vertex)", "exposure")
     lp = link_permutation(perm, lib)
@@ -260,7 +260,7 @@ def test_fragment_loops_over_a_storage_buffer_of_lights_with_a_runtime_count(lib
     """shade() with *point lights read from a buffer of 3 = shade() with 3 static point lights (NumPy)."""
     from generator.link import link_permutation
     from generator.spec.permutation import LightKey, Permutation
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
 
     brdf, packing = DYNAMIC
     dyn = link_permutation(Permutation(brdf, (LightKey("point", "none", dynamic=True),), packing), lib)
@@ -655,7 +655,7 @@ def test_stress_set_covers_the_extremes_of_every_tangent_row_of_the_inputs_table
 
 def test_bricks_linked_once_and_shared_compose_what_a_fresh_library_composes():
     """Library.memo shares linked brick functions between programs and the emitters replay their text
-    (link/program.py, targets/clike.py): sound only while nothing changes a linked function afterwards.
+    (link/program.py, backends/clike/walk.py): sound only while nothing changes a linked function afterwards.
     Composing the example's permutations in two orders on one library, after its ubershader, must give
     exactly what a fresh library gives for each."""
     from generator.compose import compose_permutation

@@ -64,7 +64,7 @@ def bumpy_normal_map(size: int = 64, rms_slope: float = 0.25, waves: int = 12, s
 def _numpy_shade(lib, perm):
     """The fragment glue's shade() emitted to NumPy (float64), its argument names, the linked permutation."""
     from generator.link import link_permutation
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
 
     lp = link_permutation(perm, lib)
     t = NumpyTarget()

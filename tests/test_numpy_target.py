@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from generator.lang import parse_module
-from generator.targets.numpy import NumpyTarget
+from generator.backends.numpy.emit import NumpyTarget
 
 BRICKS = Path(__file__).parent / "bricks"
 DTYPES = (np.float16, np.float32, np.float64)

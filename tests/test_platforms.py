@@ -199,7 +199,7 @@ def test_essl_at_fp16_is_mediump_in_the_fragment_stage_only(lib, tmp_path):
 def test_a_gl_core_failure_keeps_its_source_beside_like_a_compile_failure(lib, tmp_path):
     """A GL core source that glslangValidator rejects fails the permutation and is written as
     gl/<hash>.<stage>.failed.glsl, named in failed_sources (as vulkan/<lang>/….failed.<lang> for a compile
-    error). The failure: a Vulkan-only specialization constant, which GL core has not (targets/gl.py)."""
+    error). The failure: a Vulkan-only specialization constant, which GL core has not (backends/gl/emit.py)."""
     import dataclasses
 
     from generator.assemble.platforms import write_platforms

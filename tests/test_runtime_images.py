@@ -5,7 +5,7 @@ cube images through :class:`generator.runtime.eval_kernel.EvalKernel`: set 0 is
 0 samples, 1 result, 2 params, then texture k's image at 3 + 2k and its sampler at
 4 + 2k. Results are compared with a float64 NumPy bilinear clamp-to-edge reference
 written here (texel centres at (i + 0.5) / W, level 0), the filter that
-generator/targets/numpy_resources.py reproduces.
+generator/backends/numpy/resources.py reproduces.
 
 Agreement measured on lavapipe (Mesa 25.0.7, LLVM 15.0.6), 200 000 random uv in
 [-0.2, 1.2]² per case, max abs difference GPU - float64 reference (Mesa 22.3.6 gives the

@@ -21,7 +21,7 @@ import pytest
 
 from generator.lang import ir, parse_module
 from generator.lang.types import TEXTURE2D_SHADOW
-from generator.targets import get_target
+from generator.backends import get_target
 from tests.lavapipe import device, no_validation_messages  # noqa: F401  (fixtures)
 from tests.regen_goldens import REPO
 

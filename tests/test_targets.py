@@ -17,8 +17,11 @@ import pytest
 
 from generator.lang import ir, parse_module
 from generator.lang.types import BOOL, FLOAT, INT, TEXTURE2D, VEC2, VEC3, Type, scalar
-from generator.targets import TARGETS, get_target, reserved
-from generator.targets.clike import float_literal
+from generator.backends import TARGETS, get_target
+from generator.backends.clike.walk import float_literal
+from generator.backends.glsl.keywords import WORDS as GLSL_WORDS
+from generator.backends.hlsl.keywords import WORDS as HLSL_WORDS
+from generator.backends.wgsl.keywords import WORDS as WGSL_WORDS
 
 ROOT = Path(__file__).resolve().parent.parent
 BRICK = "tests/bricks/constructs.py"
@@ -270,7 +273,7 @@ def test_reserved_words_are_renamed_identically_in_every_target(module):
         assert {TARGETS[t].ident(w) for t in LANGS} == {"_r_" + w}
     for w in ["albedo", "NdotH", "rough", "acc"]:
         assert {TARGETS[t].ident(w) for t in LANGS} == {w}
-    for w in reserved.GLSL | reserved.HLSL | reserved.WGSL:
+    for w in GLSL_WORDS | HLSL_WORDS | WGSL_WORDS:
         assert TARGETS["glsl"].ident(w) == TARGETS["hlsl"].ident(w) == TARGETS["wgsl"].ident(w) == "_r_" + w
     declared = [s.name for s in ir.walk_body(module.functions["surface_term"].body) if isinstance(s, ir.Decl)]
     for lang in LANGS:

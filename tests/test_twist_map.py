@@ -56,7 +56,7 @@ def _perm(brdf, normal, packing="constants"):
 def _shade_fn(lib, perm):
     """shade() of a permutation emitted to NumPy (float64), its parameter names and the linked permutation."""
     from generator.link import link_permutation
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
 
     lp = link_permutation(perm, lib)
     t = NumpyTarget()
@@ -204,7 +204,7 @@ def test_the_parallel_twist_guard_holds_in_float16(lib, normal):
     NaN, and the pixel came out black). An
     axis-aligned frame makes the cancellation exact: normal_twist_map tilts N' 90° onto T (normal xy (1, 0))
     with the twist along T; twist_map keeps N' = N and takes a degenerate interpolated T = N."""
-    from generator.targets.numpy import NumpyTarget
+    from generator.backends.numpy.emit import NumpyTarget
 
     _, names, lp = _shade_fn(lib, _perm("ward_anisotropic", normal))
     t = NumpyTarget()

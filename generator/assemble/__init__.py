@@ -20,7 +20,7 @@ from ..io import atomic_write, content_key, sha256
 from ..analysis import cost_dict
 from ..spec.permutation import SpecError, parse_brdf, parse_spec
 from ..scene.load import Scene
-from ..targets import LANGUAGES
+from ..backends import LANGUAGES
 from ..lang import SourceError
 from ..link.uber import coverage
 from ..toolchain import CompileStats, tool_versions

@@ -30,7 +30,7 @@ from pathlib import Path
 
 from ..library.bricks import Library
 from ..scene.load import Scene
-from ..targets import LANGUAGES
+from ..backends import LANGUAGES
 from .platforms import DIALECTS, EXT, PLATFORMS
 
 # the languages each platform's check is made from; gl's (GLSL) is composed as its GL dialects and validated

@@ -25,7 +25,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..io import atomic_write
-from ..targets import LANGUAGES
+from ..backends import LANGUAGES
 
 LOCK = ".shadermatrix-lock"
 # the trees a build writes (assemble/platforms.py), and the language trees of builds before platforms (emptied)

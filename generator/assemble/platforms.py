@@ -12,7 +12,7 @@ glslc/naga, spirv-opt, spirv-val, cost — run whatever the platforms):
                          [[vk::…]] attributes that DXC ignores for
                          DXIL); `dxil` when a `dxc` is on PATH
     gl        gl/        GLSL 4.50 core (`glsl`) and GLSL ES 3.10     glslangValidator (OpenGL     uniform-block bindings,
-                         (`essl`, where it validates) — targets/gl.py and ES rules)               texture units
+                         (`essl`, where it validates) — backends/gl/emit.py and ES rules)               texture units
     webgpu    webgpu/    WGSL (`wgsl`, the vulkan tree's text)        naga                         bind groups
 
 Per permutation the manifest's ``platforms`` maps each built platform to ``{"stages": {stage: {kind:

@@ -60,7 +60,7 @@ _SEMANTIC = {"a_position": ("POSITION", 0), "a_normal": ("NORMAL", 0), "a_tangen
 def _resources(iface):
     """(kind, set, binding, name, stages, extra) of every resource, in (set, binding) order: blocks, then each
     texture's image and sampler (the sampler at binding + 1)."""
-    from ..targets import get_target
+    from ..backends import get_target
     glsl = get_target("glsl")
     rows = [(b.kind, b.set, b.binding, b.name, _STAGES.get(b.name, ["frag"]), {}) for b in iface.blocks]
     for t in iface.textures:
@@ -76,7 +76,7 @@ def platform_reflection(iface, platform: str) -> dict:
 
     vulkan: descriptor (set, binding, descriptor type); d3d12: register class and number, space (the HLSL's
     ``register(xN, spaceM)``), and the input layout's semantics; gl: uniform-block binding points, texture
-    units and storage-block bindings (targets/gl.py gl_bindings: Vulkan's pairs flattened per namespace);
+    units and storage-block bindings (backends/gl/emit.py gl_bindings: Vulkan's pairs flattened per namespace);
     webgpu: bind group, binding and the GPUBindGroupLayoutEntry resource type."""
     rows = _resources(iface)
     vin = iface.vertex_inputs
@@ -93,7 +93,7 @@ def platform_reflection(iface, platform: str) -> dict:
                 "input_layout": [{"semantic": _SEMANTIC[v.name][0], "semantic_index": _SEMANTIC[v.name][1],
                                   "format": _DXGI_FORMAT[v.format], "name": v.name} for v in vin]}
     if platform == "gl":
-        from ..targets.gl import gl_bindings
+        from ..backends.gl.emit import gl_bindings
         m = gl_bindings(iface.blocks, iface.textures)
         blocks = [r for r in rows if r[0] in ("uniform", "storage")]
         return {"uniform_blocks": [{"name": n, "binding": m["uniform"][(s, b)], "stages": st}

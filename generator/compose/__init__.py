@@ -19,8 +19,8 @@ from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link import EvalProgram, Interface, Slot, eval_program, link_permutation
 from ..spec.permutation import Permutation
-from ..targets import LANGUAGES, get_target
-from ..targets.base import Emitted
+from ..backends import LANGUAGES, get_target
+from ..backends.base import Emitted
 
 TEMPLATES = Path(__file__).resolve().parents[2] / "templates"
 
@@ -201,7 +201,7 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
 
 def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES, dialects=()) -> Composed:
     """Vertex and fragment shaders of one permutation in each language, and in each platform dialect of
-    `dialects` ("gl": GLSL 4.50 core for OpenGL, "essl": GLSL ES 3.10; targets/gl.py) into .dialects."""
+    `dialects` ("gl": GLSL 4.50 core for OpenGL, "essl": GLSL ES 3.10; backends/gl/emit.py) into .dialects."""
     lp = link_permutation(perm, lib)
     iface = lp.interface
     bricks = {p: b.module.source_hash for p, b in lp.program.bricks.items()}
@@ -212,7 +212,7 @@ def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES, di
                                   get_target(lang), bricks, templates)
     extra = []
     if dialects:
-        from ..targets.gl import DIALECTS, gl_bindings
+        from ..backends.gl.emit import DIALECTS, gl_bindings
         for d in dialects:  # the platform dialects (templates/gl/, with the Vulkan GLSL's macros)
             extra += _stage_sources(perm, lp, DIALECTS[d](gl_bindings(iface.blocks, iface.textures), perm.precision),
                                     "gl", d, f"permutation ({d})", get_target("glsl"), bricks, templates,

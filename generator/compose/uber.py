@@ -7,8 +7,8 @@ from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link.uber import Uber, link_ubershader
 from ..spec.permutation import Permutation
-from ..targets import LANGUAGES, get_target
-from ..targets.base import Emitted
+from ..backends import LANGUAGES, get_target
+from ..backends.base import Emitted
 from . import Composed, _function, _provenance, _render, _templates_used
 
 MATERIAL_INDEX = {"glsl": "draw.material.x", "hlsl": "draw_material.x", "wgsl": "draw.material.x"}

@@ -154,7 +154,7 @@ def _run_reference(ep: EvalProgram, vecs, values, n: int) -> np.ndarray:
 
 
 def _numpy_brdf(ep: EvalProgram, lib, dtype: str):
-    from ..targets.numpy import NumpyTarget
+    from ..backends.numpy.emit import NumpyTarget
 
     key = ("numpy_brdf", ep.spec, dtype)
     if key not in lib.memo:

@@ -79,7 +79,7 @@ def _linked(perm, lib):
 
 
 def _numpy(lp, P, Ng, V, T, uv, vals, fields, globs) -> np.ndarray:
-    from ..targets.numpy import NumpyTarget
+    from ..backends.numpy.emit import NumpyTarget
 
     t = NumpyTarget()
     res = {globs[i].name: f for i, f in fields.items()}
@@ -225,7 +225,7 @@ def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "nu
         if name in u.surface and given is None:
             raise EvalError(f"the ubershader of these permutations reads {name}", f"pass {name}= per sample")
     if target == "numpy":
-        from ..targets.numpy import NumpyTarget
+        from ..backends.numpy.emit import NumpyTarget
         t = NumpyTarget()
         res = {"material_buffer": mat, "light_buffer": lts}
         if variant is not None:

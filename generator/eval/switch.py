@@ -72,7 +72,7 @@ def evaluate_switch(specs: list[str], ids, L, V, N, T=None, params: dict | None 
     args += [_numpy_texels(x, bool(d.get("srgb"))).astype(f) for x, (_, _, d) in zip(texels, ep.textures)]
     key = ("numpy_switch", ep.spec, np.dtype(f).name)
     if key not in lib.memo:
-        from ..targets.numpy import NumpyTarget
+        from ..backends.numpy.emit import NumpyTarget
         t = NumpyTarget()
         lib.memo[key] = t.load(t.emit(ep.program.structs, ep.program.functions), np.dtype(f))["brdf_switch"]
     out = lib.memo[key](*args)

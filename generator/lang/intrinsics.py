@@ -1,6 +1,6 @@
 """The intrinsics table: one row per intrinsic, its typing rule and its cost class.
 
-Spellings per target live with each target (generator/targets/*.py), keyed by
+Spellings per target live with each target (generator/backends/*/emit.py), keyed by
 the names here, so a new intrinsic is one row here plus one entry per target.
 
 Typing rules (`sig`):

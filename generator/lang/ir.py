@@ -1,7 +1,7 @@
 """Typed intermediate representation of brick functions.
 
 Every node carries its source location; every expression carries its type.
-Emitters (generator/targets/) walk these nodes; nothing else reads brick text.
+Emitters (generator/backends/) walk these nodes; nothing else reads brick text.
 
 Every node is a plain dataclass, so glue (the link stage) builds IR directly,
 without brick text. The rules the checker enforces on parsed bricks hold for
@@ -310,7 +310,7 @@ def clone(node):
     these trees, about 4× faster (the link stage copies every brick function it links)."""
     if isinstance(node, (Expr, Stmt, Function, Param)):
         new = object.__new__(type(node))
-        # an emitter's record of a function (targets/clike.py) is of that function, not of its copies
+        # an emitter's record of a function (backends/clike/walk.py) is of that function, not of its copies
         new.__dict__.update({k: clone(v) for k, v in node.__dict__.items() if k != "_emitted"})
         return new
     if isinstance(node, list):

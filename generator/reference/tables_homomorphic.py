@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..targets.numpy_resources import cube_face, cube_texel_direction
+from ..backends.numpy.resources import cube_face, cube_texel_direction
 from .tables import table
 
 # log f is floored at log(1e-6) (accuracy.REL_FLOOR: 1e-3 of an 8-bit step at unit light): f → 0

@@ -5,7 +5,7 @@ A brick's `texture2d_shadow` is a depth image and a comparison sampler (generato
 footprint (compareOp LESS_OR_EQUAL: 1 where ref <= stored depth) and to filter the four results with the
 bilinear weights (Vulkan, "Depth Compare Operation", then "Texel Filtering"). That is Reeves, Salesin &
 Cook 1987's percentage-closer filter over 2 × 2 texels, done by the texture unit; the NumPy target
-reproduces it (generator/targets/numpy_resources.py, _tex2d_compare).
+reproduces it (generator/backends/numpy/resources.py, _tex2d_compare).
 
 :class:`DepthImage` is a D32_SFLOAT image uploaded from (H, W) depths (the renderer's depth pass draws
 into a :class:`~.rendertarget.DepthTarget` instead; this one serves stand-ins and tests);

@@ -8,7 +8,7 @@ validation messages; :mod:`.compute` builds pipelines on top of it.
 Textures (runtime/images.py): :class:`Image` is a sampled 2D or cube image (level 0 only) uploaded
 from a NumPy array through a staging buffer; :class:`Sampler` is the one filter
 the project uses, exactly the one the NumPy target reproduces
-(generator/targets/numpy_resources.py): bilinear, clamp-to-edge, texel centres
+(generator/backends/numpy/resources.py): bilinear, clamp-to-edge, texel centres
 at (i + 0.5) / W, level 0.
 
 With ``validation=True`` the Khronos validation layer is enabled and a
@@ -288,7 +288,7 @@ class Device:
     def fit_spirv(self, spirv: bytes) -> bytes:
         """A module as this device takes it: naga declares StorageInputOutput16 in every module that enables
         f16, whether or not a 16-bit stage input or output exists; the project's fp16 shaders keep their
-        interface 32-bit (targets/clike.py), so where the device lacks storageInputOutput16 (lavapipe) the
+        interface 32-bit (backends/clike/walk.py), so where the device lacks storageInputOutput16 (lavapipe) the
         capability is dropped. Every other module passes unchanged. A module using 16-bit floats on a device
         without fp16 (Device.fp16) is Fp16Unsupported (exit 3): every pipeline is created through here."""
         if not uses_float16(spirv):

@@ -2,7 +2,7 @@
 
 :class:`Image` is a sampled 2D or cube image (level 0 only) uploaded from a NumPy array
 through a staging buffer; :class:`Sampler` is the one filter the project uses, exactly the
-one the NumPy target reproduces (generator/targets/numpy_resources.py): bilinear,
+one the NumPy target reproduces (generator/backends/numpy/resources.py): bilinear,
 clamp-to-edge, texel centres at (i + 0.5) / W, level 0.
 """
 from __future__ import annotations
@@ -213,7 +213,7 @@ class Sampler:
     VK_FILTER_LINEAR for min and mag (bilinear), mipmapMode NEAREST, minLod =
     maxLod = 0 (level 0 only), VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE on u, v and w,
     normalized coordinates (texel i's centre at (i + 0.5) / W), no anisotropy,
-    no compare. generator/targets/numpy_resources.py computes the same bilinear
+    no compare. generator/backends/numpy/resources.py computes the same bilinear
     clamp-to-edge fetch with exact float64 weights; a GPU rounds the weights to
     its sub-texel precision (see tests/test_runtime_images.py for lavapipe's).
     Cube views filter seamlessly across faces in Vulkan; the NumPy target clamps

@@ -20,7 +20,7 @@ from ..lang.errors import UserError
 from .surface import DEFAULT as DEFAULT_SURFACE, Surface
 
 _TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[0-9]+|[()+=,])")
-PRECISIONS = ("fp32", "fp16")  # fp16: the BRDF and glue arithmetic in half (targets/*Half*), the interface 32-bit
+PRECISIONS = ("fp32", "fp16")  # fp16: the BRDF and glue arithmetic in half (backends/*/emit.py, *Half*), the interface 32-bit
 
 
 class SpecError(UserError, ValueError):

@@ -69,7 +69,7 @@ from typing import Iterable
 
 from ..io import content_key
 from ..lang.errors import EnvironmentMissing
-from ..targets import LANGUAGES
+from ..backends import LANGUAGES
 from .locate import TOOLS_ENV, pinned_versions, tool_dirs
 
 __all__ = ["Diagnostic", "CompileJob", "CompileResult", "CompileStats", "ToolMissing",
@@ -301,7 +301,7 @@ def _glslc_batch(glslc: str, tmp: str, items: list[tuple[int, CompileJob]],
     every job, so that each message can be given to its job.
     """
     # -fhlsl-16bit-types: HLSL `half` is a real 16-bit float (DXC's -enable-16bit-types), what the fp16
-    # HLSL target emits (targets/hlsl.py HlslHalfTarget); fp32 HLSL never spells half, so its SPIR-V is unchanged
+    # HLSL target emits (backends/hlsl/emit.py HlslHalfTarget); fp32 HLSL never spells half, so its SPIR-V is unchanged
     args = [glslc, f"--target-env={TARGET_ENV}", "-fhlsl-16bit-types", "-c"]
     names: list[tuple[str, str, str]] = []
     for idx, job in items:

@@ -6,7 +6,7 @@
   descriptor sets, `constant_id`) are errors there. One process validates a batch of files (each a
   compilation unit of its own; the file extension gives the stage); it prints each file's name and
   then that file's messages (`ERROR: 0:LINE: what`), which are mapped back to the brick line through
-  the source's line map (GL sources carry no `#line`: targets/gl.py). Measured here: ~0.1 s for a
+  the source's line map (GL sources carry no `#line`: backends/gl/emit.py). Measured here: ~0.1 s for a
   batch of 20 shaders, most of it the process start.
   A valid source is remembered in the content-addressed store (namespace ``gl-validate-v1``, keyed by
   the text without its comments, the dialect, the stage, glslang's exact version and this module), so

@@ -7,7 +7,7 @@ from ..io import show_progress
 from ..lang import SourceError
 from ..library.bricks import Library
 from ..scene.load import Scene
-from ..targets import LANGUAGES
+from ..backends import LANGUAGES
 from . import CompileJob, CompileResult, compile_many
 
 if TYPE_CHECKING:

@@ -37,7 +37,7 @@ def selection(platform: str | None, languages: str | None, flag: str = "--") -> 
     """(platforms checked, languages) of the options' text; UsageError naming the option (flag: its prefix)."""
     from ...assemble.checks import MADE_FROM, checked_platforms
     from ...assemble.platforms import PLATFORMS, parse_platforms
-    from ...targets import LANGUAGES, parse_languages
+    from ...backends import LANGUAGES, parse_languages
     opt_p, opt_l = ("--platform", "--languages") if flag == "--" else (f"{flag}platforms", f"{flag}languages")
     try:
         plats = parse_platforms(platform) if platform else list(PLATFORMS)

@@ -1,11 +1,11 @@
-"""Runtime helpers of the numpy target for arrays, buffers and textures (injected like numpy_runtime).
+"""Runtime helpers of the numpy target for arrays, buffers and textures (injected like runtime.py's).
 
 Arrays. A value of array[T, N] is T's representation with one more axis, of length N,
 just before T's own trailing axes: array[float, N] is (..., N), array[vec4, N] is
 (..., N, 4), array[mat3, N] is (..., N, 3, 3); an array of structs is an instance
 of the struct class whose every field carries that axis ("a struct of arrays").
 Leading axes are sample axes, as for every value. `k` below is the element's
-rank descriptor (numpy.py's _rank): 0, 1, 2 trailing axes or ((field, k), ...).
+rank descriptor (emit.py's _rank): 0, 1, 2 trailing axes or ((field, k), ...).
 
 Buffers. A buffer is an array without sample axes: an object with the element
 struct's fields (attribute access), each an array whose first axis is the element
@@ -230,7 +230,7 @@ def unpack_buffer(elem, data, struct_class):
 
     elem: the element struct Type (buffer_layout_error holds); data: anything whose bytes
     are the buffer (a NumPy array of any dtype, bytes); struct_class(name, fields) builds
-    the attribute holders (numpy_runtime._struct). Floats stay float32 (the loader
+    the attribute holders (runtime._struct). Floats stay float32 (the loader
     converts them to the working dtype).
     """
     raw = bytes(data) if isinstance(data, (bytes, bytearray, memoryview)) else np.ascontiguousarray(data).tobytes()

@@ -8,10 +8,10 @@ created as F(...), the working dtype, so float16 runs compute in float16.
 Control flow is vectorized: both branches of an `if` run under masks, assignments to variables
 declared outside the branch become `x = _sel(mask, new, x, rank)`, and a `return` inside a branch
 records its value for the masked lanes (`_ret`, `_done`). Switches and loops with a runtime bound
-run the same way (numpy_control.py). The generated code never mutates an array in place
+run the same way (control.py). The generated code never mutates an array in place
 (component assignment builds a new array), so parameters keep copy semantics.
-The helpers the emitted code calls (_sel, _setc, _dot, ...) live in numpy_runtime.py; those for
-arrays, buffers and textures, and the representation of those values, in numpy_resources.py.
+The helpers the emitted code calls (_sel, _setc, _dot, ...) live in runtime.py; those for
+arrays, buffers and textures, and the representation of those values, in resources.py.
 
 Textures are passed as arguments (arrays of texel values, sampled bilinearly with clamp to
 edge at mip level 0); global resources (buffers, and textures a program reads as globals)
@@ -24,13 +24,13 @@ import functools
 
 import numpy as np
 
-from ..lang import ir
-from ..lang.intrinsics import CONSTANTS
-from ..lang.types import Type
-from .base import Emitted, Target
-from .numpy_control import ControlEmitter, returns_under_mask
-from .numpy_resources import RESOURCE_RUNTIME, unpack_buffer, value_rank
-from .numpy_runtime import RUNTIME, _coerce, _struct
+from ...lang import ir
+from ...lang.intrinsics import CONSTANTS
+from ...lang.types import Type
+from ..base import Emitted, Target
+from .control import ControlEmitter, returns_under_mask
+from .resources import RESOURCE_RUNTIME, unpack_buffer, value_rank
+from .runtime import RUNTIME, _coerce, _struct
 
 _SIMPLE = {"abs": "np.abs", "sign": "np.sign", "floor": "np.floor", "sqrt": "np.sqrt", "exp": "np.exp",
            "exp2": "np.exp2", "log": "np.log", "log2": "np.log2", "sin": "np.sin", "cos": "np.cos",
@@ -337,7 +337,7 @@ class NumpyTarget(Target):
         A loaded function takes arrays (or anything np.asarray accepts: floats, lists), converts
         them to the brick's types (floats to `dtype`, ints to int32, ...) and runs under
         np.errstate(all="ignore"), since masked-out lanes may divide by zero. Texture arguments
-        are arrays of texel values (numpy_resources.py).
+        are arrays of texel values (resources.py).
 
         resources: the global resources the functions read, by name: a buffer is an object (or
         dict) with the element struct's fields, each an array whose first axis is the element
@@ -363,7 +363,7 @@ class NumpyTarget(Target):
 
     @staticmethod
     def unpack_buffer(elem: Type, data):
-        """A buffer value of `elem` structs from the bytes of its GPU buffer (numpy_resources.py)."""
+        """A buffer value of `elem` structs from the bytes of its GPU buffer (resources.py)."""
         return unpack_buffer(elem, data, _struct)
 
 

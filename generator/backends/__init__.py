@@ -1,15 +1,15 @@
-"""Target emitters: one per language, all behind generator.targets.base.Target.
+"""The back ends: one package per language (glsl/, hlsl/, wgsl/, gl/ for the GL dialects, numpy/), each an
+emitter behind generator.backends.base.Target, and the registry of them (TARGETS, get_target, LANGUAGES).
 
-GLSL, HLSL and WGSL share the tree walk in clike.py; the NumPy target
-(numpy.py) is imported only when asked for, so the shader targets need
-nothing beyond the standard library.
+GLSL, HLSL and WGSL share the tree walk in clike/; the NumPy back end is imported only when asked
+for, so the shader back ends need nothing beyond the standard library.
 """
 from __future__ import annotations
 
 from .base import Emitted, Target
-from .glsl import GlslHalfTarget, GlslTarget
-from .hlsl import HlslHalfTarget, HlslTarget
-from .wgsl import WgslHalfTarget, WgslTarget
+from .glsl.emit import GlslHalfTarget, GlslTarget
+from .hlsl.emit import HlslHalfTarget, HlslTarget
+from .wgsl.emit import WgslHalfTarget, WgslTarget
 
 TARGETS: dict[str, Target] = {"glsl": GlslTarget(), "hlsl": HlslTarget(), "wgsl": WgslTarget()}
 # fp16 variants: the brick language's float is the language's 16-bit float (half arithmetic, not only storage)
@@ -34,8 +34,8 @@ def get_target(name: str, precision: str = "fp32") -> Target:
     if precision not in ("fp32", "fp16"):
         raise ValueError(f"unknown precision '{precision}' (known: fp32, fp16)")
     if name not in TARGETS and name == "numpy":
-        # Registered lazily: numpy.py imports NumPy, which the shader targets do not need.
-        from .numpy import NumpyTarget
+        # Registered lazily: numpy/emit.py imports NumPy, which the shader targets do not need.
+        from .numpy.emit import NumpyTarget
         TARGETS["numpy"] = NumpyTarget()
     try:
         return TARGETS[name]

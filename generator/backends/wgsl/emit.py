@@ -2,13 +2,13 @@
 
 Switches always carry a default clause (WGSL requires one) and never fall through;
 arrays are array<T, N> values; buffers are var<storage, read> / var<uniform> arrays
-(clike_resources.py).
+(clike/resources.py).
 """
 from __future__ import annotations
 
-from ..lang import ir
-from ..lang.types import Type
-from .clike import CLikeTarget, Writer
+from ...lang import ir
+from ...lang.types import Type
+from ..clike.walk import CLikeTarget, Writer
 
 PARAM_COPY_PREFIX = "_in_"
 

@@ -18,10 +18,10 @@ lines carry no brick location (the IR's cases have none); the switch line does.
 """
 from __future__ import annotations
 
-from ..lang import ir
-from ..lang.control import always_returns
-from ..lang.types import Type
-from .clike_resources import ResourceMixin
+from ...lang import ir
+from ...lang.control import always_returns
+from ...lang.types import Type
+from .resources import ResourceMixin
 
 
 class ControlMixin(ResourceMixin):

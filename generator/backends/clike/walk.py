@@ -3,8 +3,8 @@
 A subclass supplies tables (type spellings, intrinsic spellings, literal
 suffixes) and overrides the few hooks where a language's structure differs
 (declarations, signatures, matrix products in HLSL, `select` in WGSL).
-Switches and runtime-bounded loops are in clike_control.py, buffers, global
-declarations and arrays in clike_resources.py (mixins).
+Switches and runtime-bounded loops are in control.py, buffers, global
+declarations and arrays in resources.py (mixins).
 Every binary and unary expression is parenthesized, so no precedence table
 is needed and every target reads the same.
 """
@@ -13,13 +13,13 @@ from __future__ import annotations
 import math
 import struct
 
-from ..lang import ir
-from ..lang.intrinsics import CONSTANTS
-from ..lang.types import BUILTIN_TYPES, Type
+from ...lang import ir
+from ...lang.intrinsics import CONSTANTS
+from ...lang.types import BUILTIN_TYPES, Type
 from . import reserved
-from .base import Emitted
-from .clike_control import ControlMixin, wrap  # noqa: F401  (wrap: re-exported)
-from .clike_resources import ResourceMixin
+from ..base import Emitted
+from .control import ControlMixin, wrap  # noqa: F401  (wrap: re-exported)
+from .resources import ResourceMixin
 
 INDENT = "    "
 HALF_MAX = 65504.0  # the largest finite fp16 value
@@ -111,7 +111,7 @@ class CLikeTarget(ControlMixin, ResourceMixin):
 
     @property
     def half(self) -> bool:
-        """True for the fp16 variant of a language (generator.targets.get_target(name, "fp16"))."""
+        """True for the fp16 variant of a language (generator.backends.get_target(name, "fp16"))."""
         return self.precision == "fp16"
 
     def convert(self, t: Type, x: str) -> str:
@@ -187,7 +187,7 @@ class CLikeTarget(ControlMixin, ResourceMixin):
 
     def full(self) -> "CLikeTarget":
         """The fp32 target of this language (spells the 32-bit side of every conversion)."""
-        from . import get_target
+        from .. import get_target
         return get_target(self.name)
 
     def sampler_name(self, texture: str) -> str:

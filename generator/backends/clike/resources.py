@@ -23,10 +23,10 @@ declaration brings `uint _len_NAME()`. Generated names (_blk_, _len_) start with
 """
 from __future__ import annotations
 
-from ..lang import ir
-from ..lang.types import Type, buffer_layout_error
+from ...lang import ir
+from ...lang.types import Type, buffer_layout_error
 from . import reserved
-from .base import Target
+from ..base import Target
 
 
 class ResourceMixin(Target):
@@ -69,7 +69,7 @@ class ResourceMixin(Target):
             raise ValueError(f"uniform buffer '{name}' needs a capacity of at least 1, got {capacity!r}")
         spelled = self.type_name(elem)
         if getattr(self, "half", False):  # fp16: the buffer holds the 32-bit twin of its element struct
-            from .clike import MIRROR_PREFIX
+            from .walk import MIRROR_PREFIX
             spelled = MIRROR_PREFIX + elem.name
         return self.buffer_decl(self.ident(name), spelled, int(set), int(binding), kind, capacity)
 

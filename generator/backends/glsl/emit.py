@@ -4,13 +4,13 @@ Textures are a `texture2D` (or `textureCube`) and a `sampler` (Vulkan GLSL), joi
 at the call as `sampler2D(t, s)` (`samplerCube(t, s)`), so the descriptor layout is the
 same as HLSL's and WGSL's: image at binding B, sampler at B+1. A texture2d_shadow is a
 `texture2D` and a `samplerShadow`, joined as `sampler2DShadow(t, s)`. Buffers are interface
-blocks with one member `data` (clike_resources.py).
+blocks with one member `data` (clike/resources.py).
 """
 from __future__ import annotations
 
-from ..lang import ir
-from ..lang.types import Type
-from .clike import CLikeTarget
+from ...lang import ir
+from ...lang.types import Type
+from ..clike.walk import CLikeTarget
 
 
 class GlslTarget(CLikeTarget):

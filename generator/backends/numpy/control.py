@@ -1,4 +1,4 @@
-"""Switches and runtime-bounded loops in the numpy target (a mixin of numpy.py's _FunctionEmitter).
+"""Switches and runtime-bounded loops in the numpy target (a mixin of emit.py's _FunctionEmitter).
 
 Both run under masks, like `if`: a switch evaluates its selector once, computes one
 mask per case (and the default's, the lanes no case takes) and runs every body for
@@ -7,7 +7,7 @@ the lanes (0 if none is positive) with the body masked to `i < n`.
 """
 from __future__ import annotations
 
-from ..lang import ir
+from ...lang import ir
 
 
 class ControlEmitter:

@@ -1,6 +1,6 @@
 """OpenGL GLSL: 4.50 core and ES 3.10, the `gl` platform's dialects of the GLSL target.
 
-The same IR walk as Vulkan GLSL (glsl.py: this is a subclass, no text is rewritten), spelled for
+The same IR walk as Vulkan GLSL (glsl/emit.py: this is a subclass, no text is rewritten), spelled for
 OpenGL's binding model (GLSL 4.50 spec §4.4.5 "Uniform and Shader Storage Block Layout Qualifiers",
 §4.4.6 "Opaque-Uniform Layout Qualifiers"; ESSL 3.10 §4.4.5-4.4.6):
 
@@ -23,8 +23,8 @@ extension is the Vulkan path's).
 """
 from __future__ import annotations
 
-from ..lang.types import Type
-from .glsl import GlslTarget
+from ...lang.types import Type
+from ..glsl.emit import GlslTarget
 
 
 def gl_bindings(blocks, textures) -> dict[str, dict[tuple[int, int], int]]:

@@ -6,14 +6,14 @@ products become mul(), and column i of m is read as transpose(m)[i] (written
 component by component, m[r][i]). Structs get a `_make_S(...)` constructor
 function, since HLSL has no struct constructor expression; an array value is an
 initializer list `{a, b, c}`, valid only where the IR puts it (a declaration).
-Buffers: StructuredBuffer (t register) and cbuffer (b register), clike_resources.py.
+Buffers: StructuredBuffer (t register) and cbuffer (b register), clike/resources.py.
 """
 from __future__ import annotations
 
-from ..lang import ir
-from ..lang.types import Type
-from . import reserved
-from .clike import SAMPLING, CLikeTarget, Writer
+from ...lang import ir
+from ...lang.types import Type
+from ..clike import reserved
+from ..clike.walk import SAMPLING, CLikeTarget, Writer
 
 _COMPONENT = {"x": 0, "y": 1, "z": 2, "w": 3}
 
