@@ -230,8 +230,7 @@ def test_output_brick_must_take_color(tmp_path):
 
 
 def test_one_name_two_types_or_disjoint_ranges_is_an_error_naming_both_bricks(tmp_path):
-    from generator.spec.permutation import parse_brdf
-    from generator.spec.params import spec_params
+    from generator.spec.resolve import resolve_brdf
 
     base = load_library()
     d = tmp_path / "b"
@@ -244,11 +243,11 @@ def test_one_name_two_types_or_disjoint_ranges_is_an_error_naming_both_bricks(tm
     lib = load_library([d])
     for spec, what in [("odd+microfacet", "is float here but vec3 in"), ("far+microfacet", "disjoint from [2.0, 3.0]")]:
         with pytest.raises(SourceError) as e:
-            spec_params(parse_brdf(spec, lib))
+            resolve_brdf(spec, lib)
         msg = str(e.value)
         assert what in msg, msg
         assert "microfacet.py" in msg and ("odd.py" in msg or "far.py" in msg), msg
-    assert spec_params(parse_brdf("lambert+microfacet", base))["alpha"].range == (0.0, 1.0)
+    assert resolve_brdf("lambert+microfacet", base).params["alpha"].range == (0.0, 1.0)
 
 
 # ------------------------------------------------------------------ a light loop over a storage buffer

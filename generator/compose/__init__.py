@@ -17,7 +17,7 @@ import jinja2
 from .. import __version__
 from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
-from ..link import EvalProgram, Interface, Slot, eval_program, link_permutation
+from ..link import EvalProgram, Interface, LinkedPermutation, Slot, eval_program, link_permutation
 from ..spec.permutation import Permutation
 from ..backends import LANGUAGES, get_target
 from ..backends.base import Emitted
@@ -199,10 +199,13 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
     return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
 
 
-def compose_permutation(perm: Permutation, lib: Library, languages=LANGUAGES, dialects=()) -> Composed:
+def compose_permutation(perm: Permutation | LinkedPermutation, lib: Library, languages=LANGUAGES,
+                        dialects=()) -> Composed:
     """Vertex and fragment shaders of one permutation in each language, and in each platform dialect of
-    `dialects` ("gl": GLSL 4.50 core for OpenGL, "essl": GLSL ES 3.10; backends/gl/emit.py) into .dialects."""
-    lp = link_permutation(perm, lib)
+    `dialects` ("gl": GLSL 4.50 core for OpenGL, "essl": GLSL ES 3.10; backends/gl/emit.py) into .dialects.
+    `perm` linked already (link.link_permutation of its spec.resolve value) is composed as it is."""
+    lp = perm if isinstance(perm, LinkedPermutation) else link_permutation(perm, lib)
+    perm = lp.perm
     iface = lp.interface
     bricks = {p: b.module.source_hash for p, b in lp.program.bricks.items()}
     templates = {}

@@ -420,23 +420,24 @@ def gpu_fp16() -> tuple[bool, str]:
 
 def declared_params(spec: str, lib) -> dict:
     """{name: (type, default, range)} of a BRDF spec's parameters, from the bricks' metadata."""
-    from ..spec.permutation import parse_brdf
+    from ..spec.resolve import resolve_brdf
     from ..reference import brdf_parameters
-    return brdf_parameters(parse_brdf(spec, lib))
+    return brdf_parameters(resolve_brdf(spec, lib))
 
 
 def spec_tolerance(spec: str, lib, tol: float) -> float:
     """The hemisphere tolerance a spec is judged at: tol, or the largest `tolerance` its bricks declare for
     their approximation (a baked table, a fit), whichever is larger."""
     from ..lang import SourceError
-    from ..spec.permutation import SpecError, parse_brdf
+    from ..spec.permutation import SpecError
+    from ..spec.resolve import resolve_brdf
     if lib is None:
         return tol
     try:
-        nodes = parse_brdf(spec, lib)
+        rb = resolve_brdf(spec, lib)
     except (SpecError, SourceError):  # not a spec of this library: judged at tol (its own errors come elsewhere)
         return tol
-    return max([tol] + [n.brick.tolerance for top in nodes for n in top.walk()])
+    return max([tol] + [n.brick.tolerance for top in rb.nodes for n in top.tree])
 
 
 def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:

@@ -29,7 +29,6 @@ from ..library.bricks import library_or_builtin
 from ..compose import compose_eval
 from ..link import EvalProgram, eval_program
 from ..lang.errors import UserError
-from ..spec.params import flat
 
 
 class EvalError(UserError, ValueError):
@@ -213,7 +212,7 @@ def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int, texels=()
         T = vecs[3].astype(f)
         with np.errstate(all="ignore"):
             args += [T, np.cross(args[2], T).astype(f)]  # B = cross(N, T), as in the eval kernels
-    args += [_numpy_arg(ty, values[n], f) for n, _, _, ty, _ in flat(ep.specs)]
+    args += [_numpy_arg(ty, values[n], f) for n, _, _, ty, _ in ep.specs.flat]
     args += [_numpy_texels(x, bool(d.get("srgb"))).astype(f) for x, (_, _, d) in zip(texels, ep.textures)]
     out = _numpy_brdf(ep, lib, dtype)(*args)
     return np.broadcast_to(np.asarray(out, np.float64), (n, 3)).copy()

@@ -13,7 +13,6 @@ import numpy as np
 
 from .. import DTYPES, GPU_TARGETS
 from ..library.bricks import library_or_builtin
-from ..spec.params import flat
 from ..link import EvalProgram, switch_program
 from .evaluate import EvalError, _numpy_arg, _numpy_texels, _param_block, _vectors, resolve_params, resolve_textures
 
@@ -68,7 +67,7 @@ def evaluate_switch(specs: list[str], ids, L, V, N, T=None, params: dict | None 
     args = [ids.astype(np.int32)] + [v.astype(f) for v in vecs[:3]]
     if ep.tangent:
         args += [vecs[3].astype(f), np.cross(args[3], vecs[3].astype(f)).astype(f)]
-    args += [_numpy_arg(ty, values[n], f) for n, _, _, ty, _ in flat(ep.specs)]
+    args += [_numpy_arg(ty, values[n], f) for n, _, _, ty, _ in ep.specs.flat]
     args += [_numpy_texels(x, bool(d.get("srgb"))).astype(f) for x, (_, _, d) in zip(texels, ep.textures)]
     key = ("numpy_switch", ep.spec, np.dtype(f).name)
     if key not in lib.memo:

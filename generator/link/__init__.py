@@ -11,11 +11,12 @@ from __future__ import annotations
 import hashlib
 from dataclasses import dataclass
 
-from ..lang import SourceError
 from ..lang.types import Type
 from ..library.bricks import Library
-from ..spec.params import ParamSpec, flat
-from ..spec.permutation import Node, Permutation, check_packing, parse_brdf, resolve
+from ..spec.params import Params
+from ..spec.permutation import Node, Permutation
+from ..spec.resolve import Resolved, ResolvedBrdf, resolve, resolve_brdf
+from ..spec.where import KeyProblem, spec_where, within
 from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue, switch_params, switch_textures
 from .interface import (FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
                         vec4_array_block)
@@ -34,7 +35,7 @@ class EvalProgram:
     spec: str  # canonical spec ('|'-joined for a switch over several BRDFs)
     nodes: list[Node]
     program: Program
-    specs: dict[str, ParamSpec]  # the one parameter policy (spec/params.py)
+    specs: Params  # the one parameter policy's group (spec/params.py)
     signature: list[tuple[str, Type]]  # the entry's parameters
     slots: list[Slot]  # params in the vec4 parameter array
     param_vec4s: int
@@ -60,8 +61,9 @@ class EvalProgram:
         return {k: p.range for k, p in self.specs.items()}
 
 
-def _eval_interface(specs: dict[str, ParamSpec], reads: list[str], textures) -> tuple[list[Slot], int, Interface]:
-    slots, count = layout([(n, k, e, ty, p, None) for n, k, e, ty, p in flat(specs)])
+def _eval_interface(specs: Params, reads: list[str], textures,
+                    brdfs: list[ResolvedBrdf]) -> tuple[list[Slot], int, Interface]:
+    slots, count = layout([(n, k, e, ty, p, None) for n, k, e, ty, p in specs.flat])
     params = vec4_array_block("Params", 0, 2, slots, max(count, 1), header=[EVAL_INFO])
     samples = Block("Samples", 0, 0, "storage", [{"name": "data", "type": "vec4[]", "offset": 0, "size": 0,
                                                   "array_stride": 16}])
@@ -69,9 +71,10 @@ def _eval_interface(specs: dict[str, ParamSpec], reads: list[str], textures) -> 
                                                 "array_stride": 16}], readonly=False)
     shadow = [n for n, ty, _ in textures if ty.compare]
     if shadow:  # the eval kernel binds every texture with the bilinear sampler (runtime/eval_kernel.py)
-        raise SourceError("<eval>", 1, 1, f"the BRDF reads '{shadow[0]}' as a texture2d_shadow, a depth texture "
-                          "that only a comparison sampler reads, and an eval kernel binds colour textures",
-                          "declare it texture2d: texture2d_shadow is for shadow filters")
+        raise _declaring(brdfs, shadow[0]).error(
+            f"the BRDF reads '{shadow[0]}' as a texture2d_shadow, a depth texture that only a comparison sampler "
+            "reads, and an eval kernel binds colour textures", "declare it texture2d: texture2d_shadow is for shadow "
+            "filters")
     texs = [Texture(n, n, "material", bool(d.get("srgb")), ty.dim) for n, ty, d in textures]
     assign_bindings(texs, {"material": 3})
     for t in texs:
@@ -81,30 +84,41 @@ def _eval_interface(specs: dict[str, ParamSpec], reads: list[str], textures) -> 
     return slots, count, iface
 
 
-def eval_program(spec: str, lib: Library) -> EvalProgram:
-    """Link a BRDF spec into the program its eval kernel runs (every target emits this IR)."""
-    nodes = parse_brdf(spec, lib)
-    canon = "+".join(n.canonical() for n in nodes)
+def _declaring(brdfs: list[ResolvedBrdf], texture: str):
+    """Where an error about a BRDF's texture points: the scene key that asked for the BRDF, else the column of the
+    brick declaring it in the spec string."""
+    for rb in brdfs:
+        for top in rb.nodes:
+            for x in top.tree:
+                if texture in x.brick.textures:
+                    return rb.where or spec_where(rb.text, x.col or top.col or 1)
+    return rb.where or spec_where(rb.text)
+
+
+def eval_program(spec: str | ResolvedBrdf, lib: Library) -> EvalProgram:
+    """Link a BRDF spec (or a resolved one) into the program its eval kernel runs (every target emits this IR)."""
+    rb = spec if isinstance(spec, ResolvedBrdf) else resolve_brdf(spec, lib)
+    nodes = list(rb.nodes)
     prog = Program(lib_memo=lib.memo)
-    g: BrdfGlue = brdf_glue(prog, nodes)
-    slots, count, iface = _eval_interface(g.params, g.reads, g.textures)
-    return EvalProgram(canon, nodes, prog, g.params, g.signature, slots, count, g.tangent, iface,
+    g: BrdfGlue = brdf_glue(prog, nodes, rb.params)
+    slots, count, iface = _eval_interface(g.params, g.reads, g.textures, [rb])
+    return EvalProgram(rb.key, nodes, prog, g.params, g.signature, slots, count, g.tangent, iface,
                        textures=tuple(g.textures))
 
 
 def switch_program(specs: list[str], lib: Library) -> EvalProgram:
     """Several BRDFs in one program behind `brdf_switch(id, ...)`: id k evaluates specs[k]."""
-    brdfs = [parse_brdf(s, lib) for s in specs]
-    canon = [("+".join(n.canonical() for n in nodes)) for nodes in brdfs]
+    brdfs = [s if isinstance(s, ResolvedBrdf) else resolve_brdf(s, lib) for s in specs]
+    canon = [rb.key for rb in brdfs]
     prog = Program(lib_memo=lib.memo)
     f, glues = brdf_switch(prog, brdfs)
     union = switch_params(glues)
     tangent = any(g.tangent for g in glues)
     reads = list(dict.fromkeys(r for g in glues for r in g.reads))
     textures = switch_textures(glues)
-    slots, count, iface = _eval_interface(union, reads, textures)
+    slots, count, iface = _eval_interface(union, reads, textures, brdfs)
     sig = [(p.name, p.ty) for p in f.params]
-    return EvalProgram("|".join(canon), [n for nodes in brdfs for n in nodes], prog, union, sig, slots, count,
+    return EvalProgram("|".join(canon), [n for rb in brdfs for n in rb.nodes], prog, union, sig, slots, count,
                        tangent, iface, entry="brdf_switch", textures=tuple(textures), specs_of=tuple(canon),
                        own=tuple(tuple(g.params) for g in glues))
 
@@ -114,6 +128,7 @@ class LinkedPermutation:
     """A permutation's program (brick functions + shade glue) and its interface."""
 
     perm: Permutation
+    resolved: Resolved
     program: Program
     glue: ShadeGlue
     interface: Interface
@@ -124,25 +139,31 @@ class LinkedPermutation:
 SHADE_KERNEL = {"Info": 2, "Lights": 3, "Material": 4, "buffers": 5}  # set 0 bindings of a shade kernel
 
 
-def link_permutation(perm: Permutation, lib: Library, kernel: bool = False) -> LinkedPermutation:
-    """Link the bricks of a permutation and lay out what its fragment shader reads.
+def link_permutation(perm: Permutation | Resolved, lib: Library, kernel: bool = False) -> LinkedPermutation:
+    """Link the bricks of a permutation (resolved, or resolved here) and lay out what its fragment shader reads.
 
     kernel: lay it out for a shade kernel instead (compose.compose_shade_kernel): shade() in a
     compute shader, every block in set 0 (SHADE_KERNEL), no textures and no Frame.
+    Errors about the key are located where the permutation was asked for (spec/where.py).
     """
-    r = resolve(perm, lib)
-    problem, todo = check_packing(r)
-    if problem:
-        raise SourceError("<key>", 1, 1, problem, todo)
+    r = perm if isinstance(perm, Resolved) else resolve(perm, lib)
+    with within(r.origin, r.key):
+        return _link(r, lib, kernel)
+
+
+def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
+    if r.problems:
+        raise KeyProblem(*r.problems[0])
     prog = Program(lib_memo=lib.memo)
     g = shade_glue(prog, r)
     if kernel and g.textures:
         t0 = g.textures[0]
-        raise SourceError("<key>", 1, 1, f"a shade kernel binds no textures, and {perm.canonical()} samples "
-                          f"'{t0.param}'", "run texture-sampling permutations as fragment shaders")
-    if kernel and perm.surface.vertex_color:
-        raise SourceError("<key>", 1, 1, f"a shade kernel has no vertex colours, and {perm.canonical()} reads "
-                          "COLOR_0", "run vertex-colour permutations as fragment shaders")
+        raise KeyProblem("brdf" if t0.param in {t for n in r.brdf for x in n.tree for t in x.brick.textures}
+                         else "packing", f"a shade kernel binds no textures, and {r.key} samples '{t0.param}'",
+                         "run texture-sampling permutations as fragment shaders")
+    if kernel and r.surface.vertex_color:
+        raise KeyProblem("vertex_color", f"a shade kernel has no vertex colours, and {r.key} reads COLOR_0",
+                         "run vertex-colour permutations as fragment shaders")
     assign_bindings(g.textures, {"light": 2, "material": 1})
     mat_slots, mat_count = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.material])
     light_slots, light_count = layout([(n, p, e, t, s, i) for i, vals in enumerate(g.lights) for n, p, e, t, s in vals])
@@ -165,12 +186,11 @@ def link_permutation(perm: Permutation, lib: Library, kernel: bool = False) -> L
         blocks.append(Block(f"LightBuffer{elem.name[len('LightData'):]}", gl.set, gl.binding, "storage",
                             [{"name": "data", "type": f"{elem.name}[]", "offset": 0, "size": 0,
                               "array_stride": 16 * len(fields), "members": fields}]))
-    from ..spec.params import spec_params
     params = {"material": {p: s for _, p, _, _, s in g.material}}
-    for i, (lb, sh) in enumerate(r.lights):
-        params[f"light{i}"] = spec_params([Node(lb, ()), sh])
+    for i, lt in enumerate(r.lights):
+        params[f"light{i}"] = lt.params
     stages = {"comp": "main"} if kernel else {"vert": "main", "frag": "main"}
     iface = Interface(stages, g.brdf.reads, g.surface, blocks, g.textures,
                       [Location(0, "out_color", "vec4")], params=params)
     lights = [[s for s in light_slots if s.light == i] for i in range(len(r.lights))]
-    return LinkedPermutation(perm, prog, g, iface, mat_slots, lights)
+    return LinkedPermutation(r.perm, r, prog, g, iface, mat_slots, lights)

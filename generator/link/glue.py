@@ -18,19 +18,20 @@ from dataclasses import dataclass, field
 from ..lang import SourceError, ir
 from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, storage_buffer, struct
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
-from ..spec.params import ParamSpec, flat, spec_params
-from ..spec.permutation import Node, Resolved
+from ..spec.params import Params
+from ..spec.permutation import Node
+from ..spec.resolve import LightPart, Resolved, ResolvedBrdf
 from ..spec.surface import EMISSIVE_MAP
 from .interface import Texture, texture_type
 from .irgen import Builder
 from .program import Program
 
+
 def _texture_decl(nodes, name: str) -> dict:
+    """The declaration of texture `name` by the first of `nodes` whose bricks declare it (Node.textures)."""
     for top in nodes:
-        for n in (top.walk() if hasattr(top, "walk") else [top]):
-            b = getattr(n, "brick", n)
-            if name in b.textures:
-                return b.textures[name]
+        if name in top.textures:
+            return top.textures[name]
     return {}
 
 
@@ -41,7 +42,7 @@ class BrdfGlue:
     lit: ir.Function
     guarded: ir.Function | None
     frame: list[tuple[str, Type]]  # L, V, N[, T, B]
-    params: dict[str, ParamSpec]  # material parameters, in spec order
+    params: Params  # material parameters, in spec order (the resolved BRDF's)
     textures: list[tuple[str, Type, dict]]  # (name, type, declaration) of textures the terms read
     reads: list[str]  # shading inputs read (frame rows included)
 
@@ -51,17 +52,17 @@ class BrdfGlue:
 
     @property
     def signature(self) -> list[tuple[str, Type]]:
-        return self.frame + [(n, t) for n, _, _, t, _ in flat(self.params)] + [(n, t) for n, t, _ in self.textures]
+        return self.frame + [(n, t) for n, _, _, t, _ in self.params.flat] + [(n, t) for n, t, _ in self.textures]
 
 
-def brdf_glue(prog: Program, nodes: list[Node], suffix: str = "", guarded: bool = True,
+def brdf_glue(prog: Program, nodes, params: Params, suffix: str = "", guarded: bool = True,
               b: Builder | None = None) -> BrdfGlue:
-    """Link a BRDF's terms into `prog` and add brdf_lit<suffix> (and brdf<suffix> when `guarded`)."""
+    """Link a BRDF's terms into `prog` and add brdf_lit<suffix> (and brdf<suffix> when `guarded`); `params`
+    the resolved BRDF's parameters (spec/resolve.py)."""
     b = b or Builder()
     for n in nodes:
         prog.link(n)
     entries = [prog.entry(n, n.brick.entries[0].name) for n in nodes]
-    params = spec_params(nodes)
     reads = sorted({p.name for f in entries for p in f.params if p.name in SHADING},
                    key=lambda k: list(BY_NAME).index(k))
     textures = []
@@ -69,7 +70,7 @@ def brdf_glue(prog: Program, nodes: list[Node], suffix: str = "", guarded: bool 
         for p in f.params:
             if p.ty.kind == "texture" and p.name not in {t[0] for t in textures}:
                 textures.append((p.name, p.ty, _texture_decl(nodes, p.name)))
-    counts = {f"{a}_count": c for top in nodes for n in top.walk() for a, c in n.counts}
+    counts = {f"{a}_count": c for top in nodes for n in top.tree for a, c in n.counts}
     unknown = [p for f in entries for p in f.params
                if p.name not in SHADING and p.name not in params and p.ty.kind != "texture" and p.name not in counts]
     if unknown:
@@ -78,7 +79,7 @@ def brdf_glue(prog: Program, nodes: list[Node], suffix: str = "", guarded: bool 
                           "name a shading input, a declared parameter or a texture")
     tangent = any(BY_NAME[r].tangent for r in reads)
     frame = [(n, BY_NAME[n].ty) for n in FRAME + (TANGENT_FRAME if tangent else ())]
-    sig = frame + [(n, t) for n, _, _, t, _ in flat(params)] + [(n, t) for n, t, _ in textures]
+    sig = frame + [(n, t) for n, _, _, t, _ in params.flat] + [(n, t) for n, t, _ in textures]
 
     def arg(p, env):
         if p.name in counts:  # an array's element count: a constant of the permutation key
@@ -172,20 +173,17 @@ class _Binder:
 def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     """Link a permutation's bricks into `prog` and add the brdf_lit() and shade() glue."""
     b = Builder()
-    bg = brdf_glue(prog, r.brdf, guarded=False, b=b)
-    normal = dict(r.packing.fillers)["normal"]
+    bg = brdf_glue(prog, r.brdf, r.brdf_params, guarded=False, b=b)
+    normal = r.normal
     prog.link(r.packing)
-    for lb, sh in r.lights:
-        prog.link(Node(lb, ()))
-        prog.link(sh)
-    out_node = Node(r.output, ())
+    for lt in r.lights:
+        prog.link(lt.node)
+        prog.link(lt.shadow)
+    out_node = r.output_node
     prog.link(out_node)
     bind = _Binder(b)
     dynamic_lights: list[ir.Global] = []
     provided: dict[str, ir.Expr] = {}
-    spec_params(list(r.brdf) + [r.packing, out_node])  # one policy across the material's bricks (raises)
-    packing_params = {k: s for k, s in spec_params([r.packing]).items() if k not in bg.params}
-    output_params = spec_params([out_node])
     lights = []
 
     def body():
@@ -200,14 +198,13 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         stmts.extend(b.decl(n, e) for n, e in shading_tangent(prog, b, bind, normal, bg.tangent))
         stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
         locals_ = {"N": VEC3}
-        for n, k, _, ty, _ in flat(bg.params):
+        for n, k, _, ty, _ in bg.params.flat:
             if k not in provided:
                 bind.params[f"m_{n}"] = ty
-        for i, (lb, sh) in enumerate(r.lights):
+        for i, lt in enumerate(r.lights):
             pre = f"l{i}_"
-            ln = Node(lb, ())
-            dyn = i < len(r.dynamic) and r.dynamic[i]
-            values = _light_buffer(prog, b, i, lb, sh, dynamic_lights) if dyn else None
+            ln, sh, dyn = lt.node, lt.shadow, lt.dynamic
+            values = _light_buffer(prog, b, i, lt, dynamic_lights) if dyn else None
             Li = f"L{i}"
             body_i = [b.decl(Li, bind.call(prog, ln, "light_dir", pre, "light", i, locals_, values))]
             cos = b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var(Li, VEC3))
@@ -253,21 +250,15 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         + (["uv"] if "uv" in bind.surface else []) + (["color"] if r.surface.vertex_color else [])
     sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")] \
         + ([(VERTEX_COLOR, VEC4)] if r.surface.vertex_color else [])
-    material = [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in flat(bg.params)
+    material = [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in bg.params.flat
                 if k not in provided or f"m_{n}" in bind.params]
-    material += [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in flat(packing_params)]
-    material += [(f"o_{n}", k, e, ty, p) for n, k, e, ty, p in flat(output_params)]
-    state = r.surface.params()
-    clash = [n for n in state if n in {k for _, k, _, _, _ in material}]
-    if clash:
-        raise SourceError("<key>", 1, 1, f"parameter '{clash[0]}' of the surface state ({r.surface.canonical()[1:]}) "
-                          "is also a brick parameter of this material", "rename the brick's parameter")
-    material += [(f"m_{n}", n, None, sp.ty, sp) for n, sp in state.items()]
+    material += [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in r.packing_params.flat]
+    material += [(f"o_{n}", k, e, ty, p) for n, k, e, ty, p in r.output_params.flat]
+    # the surface state's names never clash with the bricks' (a verdict of spec/resolve.py, raised by link)
+    material += [(f"m_{n}", n, None, sp.ty, sp) for n, sp in r.surface_params.items()]
     light_values = []
-    for i, (lb, sh) in enumerate(r.lights):
-        lp = spec_params([Node(lb, ()), sh])
-        dyn = i < len(r.dynamic) and r.dynamic[i]
-        light_values.append([] if dyn else [(f"l{i}_{n}", k, e, ty, p) for n, k, e, ty, p in flat(lp)])
+    for i, lt in enumerate(r.lights):
+        light_values.append([] if lt.dynamic else [(f"l{i}_{n}", k, e, ty, p) for n, k, e, ty, p in lt.params.flat])
     values = [(n, t) for n, _, _, t, _ in material] + [(n, t) for vals in light_values for n, _, _, t, _ in vals]
     missing = [n for n in bind.params if n not in dict(values)]
     assert not missing, f"shade() binds {missing}, which no brick declares"
@@ -285,12 +276,10 @@ VERTEX_COLOR = "vertex_color"  # shade()'s parameter: COLOR_0, interpolated (the
 
 def surface_inputs(b: Builder, bind: _Binder, r: Resolved, bg: BrdfGlue, provided: dict) -> list[ir.Stmt]:
     """With vertex colours (spec/surface.py): rho_d · COLOR_0.rgb, declared as `vc_rho_d` and given to the BRDF
-    in place of the packing's (or the material's) rho_d. Nothing otherwise."""
+    in place of the packing's (or the material's) rho_d. Nothing otherwise. (A BRDF without rho_d is a verdict
+    of spec/resolve.py: link refuses the permutation before the glue is built.)"""
     if not r.surface.vertex_color:
         return []
-    if "rho_d" not in bg.params:
-        raise SourceError("<key>", 1, 1, "vertex_color multiplies rho_d, and this BRDF has no rho_d",
-                          "use a BRDF with a diffuse term (lambert, …) or drop vertex_color")
     rho = b.copy(provided["rho_d"]) if "rho_d" in provided else b.var("m_rho_d", VEC3, "param")
     if "rho_d" not in provided:
         bind.params["m_rho_d"] = VEC3
@@ -367,19 +356,19 @@ def shading_tangent(prog: Program, b: Builder, bind: _Binder, normal: Node, need
     return [("Ts", T), ("Bs", b.intrinsic("cross", VEC3, b.var("N", VEC3), b.var("Ts", VEC3)))]
 
 
-def _light_buffer(prog: Program, b: Builder, i: int, lb, sh, out: list) -> dict[str, ir.Expr]:
+def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list) -> dict[str, ir.Expr]:
     """The storage buffer of dynamic light i and, per parameter, the expression reading it for element k<i>.
 
     The element struct LightData<i> holds one vec4 per parameter (a scalar in .x, a vec3 in .xyz)
     and four per mat4 (its columns): the layout rule of types.buffer_layout_error, so GLSL std430,
     HLSL structured buffers and WGSL storage agree byte for byte.
     """
-    params = spec_params([Node(lb, ()), sh])
-    owners = [(n.brick, x) for n in [Node(lb, ()), *sh.walk()] for x in n.brick.textures]
+    params = lt.params
+    owners = [(n.brick, x) for n in [lt.node, *lt.shadow.tree] for x in n.brick.textures]
     if owners:
         brick, tex = owners[0]
         loc = brick.module.meta_loc
-        raise SourceError(brick.display_path, loc.line, loc.col, f"a loop over a buffer of '{lb.id}' lights cannot "
+        raise SourceError(brick.display_path, loc.line, loc.col, f"a loop over a buffer of '{lt.brick.id}' lights cannot "
                           f"bind texture '{tex}' of {brick.kind} '{brick.id}' per light",
                           "use a shadow filter without a texture (shadow none) for buffer lights")
     fields = []
@@ -417,14 +406,14 @@ def bind_texture(bind: _Binder, name: str, ty: Type, nodes) -> ir.Var:
 # ------------------------------------------------------------------ several BRDFs in one program
 
 
-def switch_params(glues: list[BrdfGlue]) -> dict[str, ParamSpec]:
+def switch_params(glues: list[BrdfGlue]) -> Params:
     """The parameters of a switch: BRDF k's parameter `name` is `b<k>_<name>`, so each BRDF keeps
     its own values, type, range and default (unrelated BRDFs may share a name)."""
     out = {}
     for k, g in enumerate(glues):
         for name, spec in g.params.items():
             out[f"b{k}_{name}"] = dataclasses.replace(spec, name=f"b{k}_{name}")
-    return out
+    return Params(out)
 
 
 def switch_textures(glues: list[BrdfGlue]) -> list[tuple[str, Type, dict]]:
@@ -437,24 +426,25 @@ def switch_textures(glues: list[BrdfGlue]) -> list[tuple[str, Type, dict]]:
     return out
 
 
-def brdf_switch(prog: Program, brdfs: list[list[Node]], b: Builder | None = None) -> tuple[ir.Function, list[BrdfGlue]]:
+def brdf_switch(prog: Program, brdfs: list[ResolvedBrdf],
+                b: Builder | None = None) -> tuple[ir.Function, list[BrdfGlue]]:
     """`brdf_switch(id: int, L, V, N[, T, B], b0_params..., b1_params..., textures...) -> vec3`.
 
     id k evaluates brdf_<k> with its own parameters (switch_params); another id gives 0.
     """
     b = b or Builder()
-    glues = [brdf_glue(prog, nodes, suffix=f"_{k}", b=b) for k, nodes in enumerate(brdfs)]
+    glues = [brdf_glue(prog, rb.nodes, rb.params, suffix=f"_{k}", b=b) for k, rb in enumerate(brdfs)]
     tangent = any(g.tangent for g in glues)
     frame = [(n, BY_NAME[n].ty) for n in FRAME + (TANGENT_FRAME if tangent else ())]
     textures = switch_textures(glues)
-    sig = [("id", INT)] + frame + [(n, ty) for n, _, _, ty, _ in flat(switch_params(glues))] \
+    sig = [("id", INT)] + frame + [(n, ty) for n, _, _, ty, _ in switch_params(glues).flat] \
         + [(n, ty) for n, ty, _ in textures]
     env = dict(sig)
 
     def body():
         cases = []
         for k, g in enumerate(glues):
-            own = {n for n, _, _, _, _ in flat(g.params)}
+            own = {n for n, _, _, _, _ in g.params.flat}
             args = [b.var(f"b{k}_{n}" if n in own else n, env[f"b{k}_{n}" if n in own else n])
                     for n, _ in g.signature]
             cases.append(((k,), [b.ret(b.call(g.guarded, args))]))

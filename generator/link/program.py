@@ -29,7 +29,7 @@ def function_name(node: Node, fname: str) -> str:
     """The linked name of function `fname` of `node` (see the module docstring)."""
     if not node.fillers and not node.counts:
         return f"{node.brick.id}_{fname}"
-    digest = hashlib.sha256(node.canonical().encode()).hexdigest()[:6]
+    digest = hashlib.sha256(node.key.encode()).hexdigest()[:6]
     return f"{node.brick.id}_{digest}_{fname}"
 
 
@@ -74,21 +74,21 @@ class Program:
 
     def entry(self, node: Node, fname: str) -> ir.Function:
         """The linked function `fname` of `node` (link it first)."""
-        return self.by_name[self._linked[(node.brick.kind, node.canonical())][fname]]
+        return self.by_name[self._linked[(node.brick.kind, node.key)][fname]]
 
     def link(self, node: Node) -> None:
         """Add a brick with its fillers (once per canonical node)."""
         for _, filler in node.fillers:
             self.link(filler)
         b = node.brick
-        key = (b.kind, node.canonical())
+        key = (b.kind, node.key)
         if key in self._linked:
             return
         self.bricks[b.display_path] = b
         # A node links to the same functions in every program (names are keyed by canonical node), so the
         # library keeps them: the next program that links this node shares them (linked IR is never
         # mutated after link(); tests/test_link.py checks), instead of deep-copying the brick again.
-        memo_key = ("link", key, tuple(x.brick.module.source_hash for x in node.walk()))
+        memo_key = ("link", key, tuple(x.brick.module.source_hash for x in node.tree))
         hit = self.lib_memo.get(memo_key) if self.lib_memo is not None else None
         if hit is not None:
             functions, structs, rename = hit

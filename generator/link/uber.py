@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 from ..lang import SourceError, ir
 from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
 from ..library.inputs import SURFACE
-from ..spec.params import flat, spec_params
-from ..spec.permutation import Node, Permutation, parse_brdf, parse_spec
+from ..spec.permutation import Permutation
+from ..spec.resolve import Resolved, resolve
 from .glue import _Binder, brdf_glue, has_tangent, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture
 from .irgen import Builder
@@ -120,8 +120,10 @@ UBER_KERNEL = {"light_buffer": (0, 3), "material_buffer": (0, 4)}  # after sampl
 SPEC_VARIANT = 0  # SpecId of the material variant in the specialization-constant ubershader
 
 
-def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, specialized: bool = False) -> Uber:
-    """One program whose shade(P, Ng, V[, T, B][, uv], material, textures...) stands in for every permutation.
+def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = False,
+                    specialized: bool = False) -> Uber:
+    """One program whose shade(P, Ng, V[, T, B][, uv], material, textures...) stands in for every permutation
+    (resolved, or resolved here).
 
     Bindings: UBER_FRAGMENT for the fragment ubershader (set 0: Frame 0, light buffer 1, shadow maps 2+;
     set 1: Draw 0 (ivec4: x the material index), material buffer 1, material textures 2+), UBER_KERNEL
@@ -130,24 +132,32 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
     from . import link_permutation
 
     variants: list[Variant] = []
+    resolved: list[Resolved] = []  # per variant: its material without lights, as the matrix links it
     light_types: list[str] = []
     shadows: list[str] = []
+    lights, shadow_of = {}, {}  # light type -> its LightPart's params; shadow spec -> the filter's node, params
     shadowed = 0
-    for p in perms:
+    for r in [p if isinstance(p, Resolved) else resolve(p, lib) for p in perms]:
+        p = r.perm
         if (p.brdf, p.packing, p.output) not in [v.key for v in variants]:
-            probe = link_permutation(Permutation(p.brdf, (), p.packing, p.output, p.precision), lib)
-            variants.append(Variant(p.brdf, p.packing, p.output, probe.material))
-        for lk in p.lights:
-            light_types += [lk.light] if lk.light not in light_types else []
-            shadows += [lk.shadow] if lk.shadow not in shadows else []
-        shadowed = max(shadowed, sum(1 for lk in p.lights if _shadow_textures(lib, lk.shadow)))
+            probe = resolve(Permutation(p.brdf, (), p.packing, p.output, p.precision, origin=p.origin), lib)
+            variants.append(Variant(p.brdf, p.packing, p.output, link_permutation(probe, lib).material))
+            resolved.append(probe)
+        for lk, lt in zip(p.lights, r.lights):
+            if lk.light not in light_types:
+                light_types.append(lk.light)
+                lights[lk.light] = (lt.node, lt.light_params)
+            if lk.shadow not in shadows:
+                shadows.append(lk.shadow)
+                shadow_of[lk.shadow] = (lt.shadow, lt.shadow_params)
+        shadowed = max(shadowed, sum(1 for lt in r.lights if lt.textures))
     prog, b = Program(lib_memo=lib.memo), Builder()
     bind = _Binder(b)
     M = max([1] + [max([1] + [s.index + s.width for s in v.slots]) for v in variants])
-    lnodes = {t: Node(lib.get("light", t), ()) for t in light_types}
-    snodes = {s: parse_spec(s, lib, ("shadow",))[0] for s in shadows}
-    A = max([1] + [_vec4s(spec_params([n])) for n in lnodes.values()])
-    S = max([0] + [_vec4s(spec_params([n])) for n in snodes.values()])
+    lnodes = {t: lights[t][0] for t in light_types}
+    snodes = {s: shadow_of[s][0] for s in shadows}
+    A = max([1] + [_vec4s(lights[t][1]) for t in light_types])
+    S = max([0] + [_vec4s(shadow_of[s][1]) for s in shadows])
     K = A + max(S, 1)
     mat_data, light_data = array(VEC4, M), array(VEC4, K)
     MaterialEntry = struct("MaterialEntry", (("ids", IVEC4), ("data", mat_data)))
@@ -158,25 +168,23 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
     prog.globals += [mbuf] + ([lbuf] if lnodes else [])  # no lights: nothing reads a light buffer
 
     glues, packings, outputs = [], [], []
-    for k, v in enumerate(variants):
-        glues.append(brdf_glue(prog, parse_brdf(v.brdf, lib), suffix=f"_{k}", guarded=False, b=b))
-        pk = parse_spec(v.packing, lib, ("packing",))[0]
-        prog.link(pk)
-        packings.append(pk)
-        on = Node(lib.get("output", v.output), ())
-        prog.link(on)
-        outputs.append(on)
+    for k, v in enumerate(resolved):
+        glues.append(brdf_glue(prog, v.brdf, v.brdf_params, suffix=f"_{k}", guarded=False, b=b))
+        prog.link(v.packing)
+        packings.append(v.packing)
+        prog.link(v.output_node)
+        outputs.append(v.output_node)
     for n in list(lnodes.values()) + list(snodes.values()):
         prog.link(n)
     layouts = {}
-    for t, ln in lnodes.items():
-        for s, sn in snodes.items():
+    for t in lnodes:
+        for s in snodes:
             lay, i = {}, 0
-            for name, _, _, ty, _ in flat(spec_params([ln])):
+            for name, _, _, ty, _ in lights[t][1].flat:
                 lay[name] = (i, ty)
                 i += 4 if ty == MAT4 else 1
             i = A
-            for name, _, _, ty, _ in flat(spec_params([sn])):
+            for name, _, _, ty, _ in shadow_of[s][1].flat:
                 lay[name] = (i, ty)
                 i += 4 if ty == MAT4 else 1
             layouts[(t, s)] = lay
@@ -257,20 +265,15 @@ def link_ubershader(perms: list[Permutation], lib, kernel: bool = False, special
     return Uber(prog, variants, light_types, shadows, shadowed, M, A, K, layouts, bind.textures, sig, surface, reads)
 
 
-def _shadow_textures(lib, shadow: str) -> list[str]:
-    node = parse_spec(shadow, lib, ("shadow",))[0]
-    return [t for n in node.walk() for t in n.brick.textures]
-
-
 def _texture_types(node) -> dict[str, Type]:
     """The type of each texture a node's bricks sample, by name (as their functions declare it)."""
-    return {p.name: p.ty for n in node.walk() for f in n.brick.module.functions.values() for p in f.params
+    return {p.name: p.ty for n in node.tree for f in n.brick.module.functions.values() for p in f.params
             if p.ty.kind == "texture" and p.name in n.brick.textures}
 
 
-def _vec4s(specs) -> int:
-    """vec4s a parameter set occupies (four per mat4)."""
-    return sum(4 if ty == MAT4 else 1 for _, _, _, ty, _ in flat(specs))
+def _vec4s(params) -> int:
+    """vec4s a parameter group occupies (four per mat4)."""
+    return sum(4 if ty == MAT4 else 1 for _, _, _, ty, _ in params.flat)
 
 
 def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues, packings, provided,
@@ -300,7 +303,7 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
     first_light = next(iter(lnodes))
     shadow_cases = []
     for s, sn in snodes.items():
-        texnames = [x for n in sn.walk() for x in n.brick.textures]
+        texnames = [x for n in sn.tree for x in n.brick.textures]
         textype = _texture_types(sn)
         args = light_args(first_light, s)
         if not texnames:
@@ -357,7 +360,8 @@ def coverage(uber: Uber, perms: list[Permutation], lib) -> list[str]:
     """Every axis value the matrix uses that the ubershader cannot reach, as one line each."""
     problems = []
     keys = {v.key for v in uber.variants}
-    for p in perms:
+    for r in [resolve(p, lib) for p in perms]:
+        p = r.perm
         if (p.brdf, p.packing, p.output) not in keys:
             problems.append(f"material (brdf={p.brdf}, packing={p.packing}, output={p.output}) of {p.hash} "
                             "is no variant of the ubershader")
@@ -366,7 +370,7 @@ def coverage(uber: Uber, perms: list[Permutation], lib) -> list[str]:
                 problems.append(f"light type '{lk.light}' of {p.hash} is not in the ubershader's light switch")
             if lk.shadow not in uber.shadows:
                 problems.append(f"shadow filter '{lk.shadow}' of {p.hash} is not in the ubershader's shadow switch")
-        need = sum(1 for lk in p.lights if _shadow_textures(lib, lk.shadow))
+        need = sum(1 for lt in r.lights if lt.textures)
         if need > uber.shadow_maps:
             problems.append(f"{p.hash} samples {need} shadow maps; the ubershader binds {uber.shadow_maps}")
     return problems

@@ -42,7 +42,8 @@ from ..toolchain.scenes import compile_scene, job_key, source_jobs
 from ..compose import Composed, compose_eval, compose_permutation
 from ..analysis import Cost, entry_cost
 from ..lang import SourceError
-from ..spec.permutation import LightKey, Permutation, SpecError, parse_brdf, parse_spec
+from ..spec.permutation import LightKey, Permutation, SpecError
+from ..spec.resolve import resolve, resolve_brdf
 from ..scene.load import Scene
 from ..toolchain import CompileJob, compile_many
 
@@ -91,8 +92,9 @@ def course_models() -> tuple[list[CourseModel], str]:
 def course_figure(perm: Permutation, lib: Library) -> CourseFigure | None:
     """The course's figure for a permutation's BRDF (direct form), shift-variant when its packing reads textures."""
     try:
-        ids = {n.brick.id for top in parse_brdf(perm.brdf, lib) for n in top.walk()}
-        packing = parse_spec(perm.packing, lib, ("packing",))[0].brick
+        r = resolve(perm, lib)
+        ids = {n.brick.id for top in r.brdf for n in top.tree}
+        packing = r.packing.brick
     except (SpecError, SourceError):
         return None
     for m in course_models()[0]:
@@ -235,9 +237,12 @@ def _with_standin_slots(b: Brick, lib: Library, normal: str | None = None) -> st
 
 
 def _reads_tangent(spec: str, lib: Library) -> bool:
-    """Whether a BRDF spec reads a tangent-frame row of the inputs table (an anisotropic model)."""
-    from ..spec.constraints import reads_tangent
-    return bool(reads_tangent(parse_brdf(spec, lib)))
+    """Whether a BRDF spec reads a tangent-frame row of the inputs table (an anisotropic model); a spec whose
+    bricks break the parameter policy reads none (its plan fails when it is composed, with that error)."""
+    try:
+        return bool(resolve_brdf(spec, lib).tangent)
+    except SourceError:
+        return False
 
 
 @dataclass
@@ -279,8 +284,8 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -
         for b in (x for x in lib.of_kind(kind) if not is_standin(x)):
             if kind in BRDF_KINDS:  # a brick with slots is measured with its default fillers, named in full
                 try:
-                    subject = parse_brdf(b.id, lib)[0].canonical()
-                except SpecError as e:  # e.g. a slot whose default filler does not exist
+                    subject = resolve_brdf(b.id, lib).nodes[0].key
+                except (SpecError, SourceError) as e:  # e.g. a slot whose default filler does not exist
                     plans.append(_Plan("brick", b.id, kind, batch.fail(b.id, str(e)), batch.fail(b.id, str(e))))
                     continue
                 eval_plan("brick", subject, kind, pair(kind, b.id), pair(kind, sub.id))
@@ -312,7 +317,7 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -
         if not m.spec or not all(lib.find(r, KINDS) for r in m.requires):
             continue  # no brick for this model yet: the report shows the course's figures alone
         try:
-            kinds = [n.brick.kind for n in parse_brdf(m.spec, lib)]
+            kinds = [n.brick.kind for n in resolve_brdf(m.spec, lib).nodes]
         except (SpecError, SourceError):
             continue
         stand = "+".join(standin(lib, k).id for k in kinds)

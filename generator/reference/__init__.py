@@ -7,7 +7,7 @@ Whole BRDFs (models.py)
   reference_brdf(spec, L, V, N, T=None, params=None, lib=None) -> (N, 3) float64 f_r,
       under the NOTES.md shading policy (f_r = 0 for n·l <= 0, n·v clamped to [1e-4, 1]).
   REFERENCES[kind][brick_id], reference(kind, id) (decorator), lookup(kind, id),
-  missing_references(lib), brdf_parameters(nodes), ReferenceMissing.
+  missing_references(lib), brdf_parameters(resolved BRDF), ReferenceMissing.
 Geometry (geometry.py)
   shading_geometry(L, V, N, T=None) -> Geometry (NdotL, NdotV, NdotH, NxH2, VdotH, ...: the inputs table), NV_MIN.
 Exact quantities (exact.py); cosines in [0, 1], alpha = GGX α or Beckmann m

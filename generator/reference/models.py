@@ -148,10 +148,10 @@ def vis_smith_schlick(g: Geometry, alpha):
 
 # ------------------------------------------------------------------ whole BRDFs
 
-def brdf_parameters(nodes) -> dict:
-    """{name: (type, default, range)} of a parsed BRDF spec: the one parameter policy (spec/params.py)."""
-    from ..spec.params import spec_params
-    return {k: (p.ty, p.default, p.range) for k, p in spec_params(nodes).items()}
+def brdf_parameters(rb) -> dict:
+    """{name: (type, default, range)} of a resolved BRDF spec (spec/resolve.py resolve_brdf): the one parameter
+    policy's group."""
+    return {k: (p.ty, p.default, p.range) for k, p in rb.params.items()}
 
 
 def _param_values(declared: dict, given: dict | None, count: int) -> dict:
@@ -195,12 +195,12 @@ def reference_brdf(spec: str, L, V, N, T=None, params=None, lib=None) -> np.ndar
     ((N,) or (N, 3)). Missing parameters take the bricks' defaults.
     """
     from ..library.bricks import library_or_builtin
-    from ..spec.permutation import parse_brdf
-    nodes = parse_brdf(spec, library_or_builtin(lib))
+    from ..spec.resolve import resolve_brdf
+    rb = resolve_brdf(spec, library_or_builtin(lib))
     g = shading_geometry(L, V, N, T)
-    p = _param_values(brdf_parameters(nodes), params, g.count)
+    p = _param_values(brdf_parameters(rb), params, g.count)
     total = np.zeros((g.count, 3))
-    for node in nodes:
+    for node in rb.nodes:
         total = total + _term(node, g, p)
     return np.where(g.lit[:, None], total, 0.0)
 

@@ -137,7 +137,7 @@ def shadow_textures(lib, shadow: str) -> list[str]:
     from ..spec.permutation import parse_spec
 
     node = parse_spec(shadow, lib, ("shadow",))[0]
-    return [t for n in node.walk() for t in n.brick.textures]
+    return [t for n in node.tree for t in n.brick.textures]
 
 
 def shadow_matrix(light, values: dict, points) -> np.ndarray:
@@ -537,7 +537,6 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
 
 
 def _light_specs(lib, light) -> dict:
-    from ..spec.params import spec_params
-    from ..spec.permutation import Node, parse_spec
+    from ..spec.resolve import light_params
 
-    return spec_params([Node(lib.get("light", light.type), ()), parse_spec(light.shadow, lib, ("shadow",))[0]])
+    return light_params(lib, light.type, light.shadow)

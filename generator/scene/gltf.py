@@ -79,8 +79,8 @@ import numpy as np
 
 from ..lang import SourceError
 from ..library.bricks import Library
-from ..spec.params import spec_params
-from ..spec.permutation import LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf, parse_spec, resolve
+from ..spec.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
+from ..spec.resolve import check_packing, light_params, resolve
 from .load import Light, Material, Scene, surface_specs
 from ..spec.surface import EMISSIVE_MAP, Surface
 
@@ -789,20 +789,18 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list, col
         notes.append(f"material '{name}': emissiveTexture is not sampled (emissiveFactor is 0)")
     try:
         brdf = canonical(parse_brdf(BRDF, lib))
-        nodes = parse_brdf(brdf, lib)
-        pnodes = parse_spec(packing, lib, ("packing",))
-        packing = canonical(pnodes)
-        specs = spec_params(list(nodes) + pnodes + [lib.get("output", "linear")])
+        packing = canonical(parse_spec(packing, lib, ("packing",)))
+        r = resolve(Permutation(brdf, (), packing, "linear", surface=surface), lib)
     except (SpecError, SourceError) as e:
         raise rd.err(ptr, f"the bricks this material maps to are missing: {e}",
                      "use the standard brick library (or --bricks with lambert, microfacet, ggx, …)") from None
     # outside the try: its own located error (a GltfError is a SourceError) is not "missing bricks"
-    specs = surface_specs(specs, spec_params(nodes), surface, lambda key, msg, todo: rd.err(ptr, msg, todo))
+    specs = surface_specs(r, lambda key, msg, todo: rd.err(ptr, msg, todo))
     for k, v in params.items():
         problem = specs[k].check(v) if k in specs else f"no parameter '{k}'"
         if problem:
             raise rd.err(ptr, f"maps to parameter '{k}' = {v}: {problem}", "fix the material's factors")
-    problem, todo = check_packing(resolve(Permutation(brdf, (), packing, "linear"), lib))
+    problem, todo = check_packing(r)
     if problem:
         raise rd.err(ptr, problem, todo)
     return GltfMaterial(name, brdf, packing, params, surface, alpha_mode=alpha_mode, alpha_cutoff=cutoff,
@@ -859,7 +857,7 @@ def _light(rd: _Reader, lib: Library, L, ptr: str, name: str, world: np.ndarray)
     if lb is None or snode is None:
         raise rd.err(ptr, f"light brick '{brick}' (or shadow 'none') is missing from the library",
                      "use the standard bricks")
-    specs = spec_params([lb, snode])
+    specs = light_params(lib, brick, "none")
     for k, v in params.items():
         problem = specs[k].check(v) if k in specs else f"no parameter '{k}'"
         if problem:

@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..library.bricks import Library
-from ..spec.params import spec_params
 from ..lang import SourceError
 from ..lang.errors import read_text
-from ..spec.permutation import (PRECISIONS, LightKey, Permutation, SpecError, canonical, check_packing, parse_brdf,
-                          parse_spec, resolve)
+from ..spec.permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
+from ..spec.resolve import Resolved, check_packing, light_params, resolve
 from ..spec.surface import DEFAULT as DEFAULT_SURFACE, Surface
+from ..spec.where import Origin, Where
 
 
 class Locator:
@@ -179,6 +179,11 @@ def load_scene(path, lib: Library) -> Scene:
                         f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
     scene = Scene(path, head.get("name", path.stem), output, precision, {}, {}, {}, [], head_at=(loc.top("scene")[0], 1))
 
+    def at(*where) -> Where:
+        return Where(shown, *loc.find(*where))
+
+    # where each part of a permutation key was asked for (spec/where.py): errors resolving or linking it point there
+    parts: dict[str, tuple] = {}
     for name, m in _table(loc, data, "materials").items():
         where = loc.find(f"materials.{name}")
         if not isinstance(m, dict) or "brdf" not in m:
@@ -186,20 +191,23 @@ def load_scene(path, lib: Library) -> Scene:
         brdf = _spec(loc, f"materials.{name}", "brdf", m["brdf"], lambda s: canonical(parse_brdf(s, lib)))
         packing = _spec(loc, f"materials.{name}", "packing", m.get("packing", "constants"),
                         lambda s: canonical(_one(s, parse_spec(s, lib, ("packing",)), "packing")))
-        nodes = parse_brdf(brdf, lib)
+        surface = Surface(m.get("alpha", "opaque"), m.get("double_sided", False), m.get("vertex_color", False),
+                          m.get("emissive", "none"))
+        parts[name] = tuple((k, at(f"materials.{name}", k)) for k in ("brdf", "packing", *SURFACE_KEYS)) \
+            + (("output", at("scene", "output")),)
         try:
             # one policy over the BRDF, the packing and the output brick (whose parameters,
             # exposure say, are set per material: they live in the Material block)
-            specs = spec_params(list(nodes) + parse_spec(packing, lib, ("packing",)) + [lib.get("output", output)])
+            r = resolve(Permutation(brdf, (), packing, output, precision, surface, Origin(parts[name])), lib)
         except SourceError as e:
+            if e.path == shown:
+                raise
             raise loc.error(where, e.message, e.hint) from None
-        surface = Surface(m.get("alpha", "opaque"), m.get("double_sided", False), m.get("vertex_color", False),
-                          m.get("emissive", "none"))
-        specs = surface_specs(specs, spec_params(nodes), surface, lambda key, msg, todo: loc.error(
+        specs = surface_specs(r, lambda key, msg, todo: loc.error(
             loc.find(f"materials.{name}", key), f"material '{name}': {msg}", todo))
         params = m.get("params", {})
         _check_params(loc, f"materials.{name}", params, specs, f"BRDF '{brdf}'")
-        problem, todo = check_packing(resolve(Permutation(brdf, (), packing, output), lib))
+        problem, todo = check_packing(r)
         if problem:
             raise loc.error(loc.find(f"materials.{name}", "packing"), f"material '{name}': {problem}", todo)
         scene.materials[name] = Material(name, brdf, packing, params, surface)
@@ -214,9 +222,9 @@ def load_scene(path, lib: Library) -> Scene:
                             f"type is one of {', '.join(b.id for b in lib.of_kind('light'))}")
         shadow = _spec(loc, f"lights.{name}", "shadow", li.get("shadow", "none"),
                        lambda s: canonical(_one(s, parse_spec(s, lib, ("shadow",)), "shadow filter")))
-        snode = parse_spec(shadow, lib, ("shadow",))[0]
+        parts[f"light:{name}"] = at(f"lights.{name}", "type")
         try:
-            specs = spec_params([lb, snode])
+            specs = light_params(lib, ltype, shadow)
         except SourceError as e:
             raise loc.error(where, e.message, e.hint) from None
         params = li.get("params", {})
@@ -264,7 +272,8 @@ def load_scene(path, lib: Library) -> Scene:
                             f"object '{oname}' needs lights = a light set name", 'write lights = "outdoor"')
         m = scene.materials[mat]
         keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in names)
-        perm = Permutation(m.brdf, keys, m.packing, output, precision, m.surface)
+        origin = Origin(parts[mat] + tuple((f"light{k}", parts[f"light:{n}"]) for k, n in enumerate(names)))
+        perm = Permutation(m.brdf, keys, m.packing, output, precision, m.surface, origin)
         h = hashes.get(perm)
         if h is None:  # the first object of a permutation: where messages about it will point
             h = hashes[perm] = perm.hash
@@ -275,21 +284,18 @@ def load_scene(path, lib: Library) -> Scene:
     return scene
 
 
-def surface_specs(specs: dict, brdf: dict, surface: Surface, error) -> dict:
-    """The material's parameter specs with those its surface state reads (spec/surface.py); `brdf` the BRDF's
-    own specs (spec_params of its nodes); error(key, what, todo) makes the exception for a state the material's
-    bricks cannot take. Vertex colours scale the rho_d the BRDF shades with, so the BRDF must have one: the
-    rule of link/glue.py surface_inputs, checked here to point at the material's key (a packing's or output's
-    parameter named rho_d is not what the BRDF reads)."""
-    if surface.vertex_color and "rho_d" not in brdf:
-        raise error("vertex_color", "vertex_color multiplies rho_d, and this BRDF has no rho_d",
-                    "use a BRDF with a diffuse term (lambert, …) or drop vertex_color")
-    extra = surface.params()
-    clash = [k for k in extra if k in specs]
-    if clash:
-        raise error("alpha" if clash[0] != "emissive" else "emissive", f"the surface state's parameter "
-                    f"'{clash[0]}' is also a parameter of the material's bricks", "rename the brick's parameter")
-    return {**specs, **extra}
+SURFACE_KEYS = ("alpha", "double_sided", "vertex_color", "emissive")  # a material's surface state (spec/surface.py)
+
+
+def surface_specs(r: Resolved, error) -> dict:
+    """A resolved material's parameter specs: its bricks' as one group and those its surface state reads
+    (spec/surface.py); error(key, what, todo) makes the exception for a surface state the material's bricks
+    cannot take (the resolved verdict: vertex colours need the BRDF's own rho_d, the state's names are not
+    the bricks')."""
+    for part, what, todo in r.problems:
+        if part != "packing":
+            raise error(part, what, todo)
+    return {**r.material_params, **r.surface_params}
 
 
 def _table(loc: Locator, data: dict, key: str) -> dict:

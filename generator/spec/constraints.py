@@ -25,8 +25,7 @@ def _brdf_text(r) -> str:
 
 
 def _provides_unread(r) -> tuple[str, str]:
-    from .params import spec_params
-    params = spec_params(r.brdf)
+    params = r.brdf_params
     for f in r.packing.brick.entries:
         name = f.name[len("get_"):]
         if name not in params:
@@ -38,8 +37,7 @@ def _provides_unread(r) -> tuple[str, str]:
 
 
 def _provides_wrong_type(r) -> tuple[str, str]:
-    from .params import spec_params
-    params = spec_params(r.brdf)
+    params = r.brdf_params
     for f in r.packing.brick.entries:
         name = f.name[len("get_"):]
         if name in params and f.ret != params[name].ty:
@@ -56,9 +54,13 @@ def reads_tangent(nodes) -> list[str]:
                    if p.name in SHADING and BY_NAME[p.name].tangent})
 
 
+def supplies_tangent(packing) -> bool:
+    """Whether a packing's bricks (its normal filler's) read the vertex tangent T/B."""
+    return any(p.name in ("T", "B") for x in packing.walk() for f in x.brick.entries for p in f.params)
+
+
 def _tangent_frame(r) -> tuple[str, str]:
-    tangent = reads_tangent(r.brdf)
-    frame = any(p.name in ("T", "B") for x in r.packing.walk() for f in x.brick.entries for p in f.params)
+    tangent, frame = r.tangent, r.packing_tangent
     if tangent and not frame:
         return (f"BRDF '{_brdf_text(r)}' reads {', '.join(tangent)} (the tangent frame), but packing "
                 f"'{r.packing.canonical()}' supplies no tangent",

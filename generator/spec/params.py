@@ -1,10 +1,12 @@
-"""The one parameter policy: the parameters of a set of resolved bricks, computed once.
+"""The one parameter policy: the parameters of a permutation's bricks, computed once, in one place.
 
-Scene validation, `eval`, `accuracy`, the references and the link stage's layout all
-read `spec_params`. A name shared by several bricks of one spec (canonical names:
-`alpha`, `f0`, `n`, ...) is one parameter: its type must agree, its range is the
-intersection of the bricks' ranges (which must not be empty), its default is the
-first declaring brick's (callers first, in spec order) and must lie in that range.
+`spec_params` is the policy and `resolve` (spec/resolve.py) its only caller on a permutation's
+way to a shader: scene validation, `eval`, `accuracy`, the references, the link stage's layout
+and the ubershader read the groups it returns (Resolved.brdf_params, .light_params …). A name
+shared by several bricks of one group (canonical names: `alpha`, `f0`, `n`, ...) is one
+parameter: its type must agree, its range is the intersection of the bricks' ranges (which must
+not be empty), its default is the first declaring brick's (callers first, in spec order) and
+must lie in that range.
 """
 from __future__ import annotations
 
@@ -31,18 +33,45 @@ class ParamSpec:
         return check_value(self.ty, self.range, value)
 
 
+class Frozen(dict):
+    """A dict that refuses every change: the mappings held by a frozen resolved value (read like any dict)."""
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError("a resolved value is frozen: build a new one instead of changing it")
+
+    __setitem__ = __delitem__ = __ior__ = clear = pop = popitem = setdefault = update = _refuse
+
+    def __reduce__(self):  # pickled by value (build workers return what they composed)
+        return type(self), (dict(self),)
+
+
+class Params(Frozen):
+    """One parameter group ({name: ParamSpec}, in declaration order), with `flat`: what a shader receives
+    of it (flat(): one value per array element), computed once."""
+
+    def __init__(self, specs=()):
+        super().__init__(specs)
+        object.__setattr__(self, "flat", tuple(flat(self)))
+
+    def __setattr__(self, name, value):
+        self._refuse()
+
+    def __reduce__(self):
+        return type(self), (dict(self),)
+
+
 def _error(brick, message: str, hint: str) -> SourceError:
     loc = brick.module.meta_loc
     return SourceError(brick.display_path, loc.line, loc.col, message, hint)
 
 
-def spec_params(nodes) -> dict[str, ParamSpec]:
-    """{name: ParamSpec} over every brick below `nodes` (Nodes, or bricks with no fillers), in order."""
+def _merge(nodes) -> Params:
+    """The policy over every brick below `nodes` (spec Nodes, callers first), in order."""
     out: dict[str, ParamSpec] = {}
     first: dict[str, object] = {}
     for top in nodes:
-        for node in (top.walk() if hasattr(top, "walk") else [top]):
-            b = getattr(node, "brick", node)
+        for node in top.walk():
+            b = node.brick
             for name, p in b.params.items():
                 old = out.get(name)
                 if old is None:
@@ -54,7 +83,7 @@ def spec_params(nodes) -> dict[str, ParamSpec]:
                 if old.ty != p.ty:
                     raise _error(b, f"parameter '{name}' is {p.ty} here but {old.ty} in {old.owners[0]}, "
                                     "another brick of the same spec",
-                                 "one canonical name has one type (DESIGN.md): rename the parameter or fix its type")
+                                 "one canonical name has one type: rename the parameter or fix its type")
                 rng = old.range
                 if p.range is not None:
                     rng = p.range if rng is None else (max(rng[0], p.range[0]), min(rng[1], p.range[1]))
@@ -67,7 +96,39 @@ def spec_params(nodes) -> dict[str, ParamSpec]:
                     raise _error(first[name], f"default of '{name}' does not fit {b.display_path}'s range: {problem}",
                                  "move the default inside the range every brick of the spec allows")
                 out[name] = ParamSpec(name, old.ty, old.default, rng, old.doc or p.doc, old.owners + (b.display_path,))
-    return out
+    return Params(out)
+
+
+@dataclass(frozen=True)
+class LightPolicy:
+    """The groups of one light: its brick and shadow filter as one group (the light's block), each alone
+    (the ubershader lays light types and shadow filters out separately)."""
+
+    params: Params
+    light: Params
+    shadow: Params
+
+
+@dataclass(frozen=True)
+class Policy:
+    """Every parameter group of one permutation (or of a BRDF alone, or of one light)."""
+
+    brdf: Params  # the BRDF's terms and their fillers
+    packing: Params  # the packing's (its normal filler's too) that the BRDF does not declare
+    output: Params
+    material: Params  # BRDF, packing and output as one group: the names a scene's material may set
+    lights: tuple[LightPolicy, ...] = ()
+
+
+def spec_params(brdf=(), packing=None, output=None, lights=()) -> Policy:
+    """The one parameter policy of a permutation: brdf (its term Nodes), packing and output (a Node each, or
+    None), lights ((light Node, shadow Node) per light). Raises a SourceError at the brick that breaks it."""
+    own = _merge(brdf)
+    material = _merge([*brdf, *([packing] if packing is not None else []), *([output] if output is not None else [])])
+    packed = _merge([packing]) if packing is not None else Params()
+    out = _merge([output]) if output is not None else Params()
+    groups = tuple(LightPolicy(_merge([ln, sh]), _merge([ln]), _merge([sh])) for ln, sh in lights)
+    return Policy(own, Params({k: s for k, s in packed.items() if k not in own}), out, material, groups)
 
 
 def flat(specs: dict[str, ParamSpec]) -> list[tuple[str, str, int | None, Type, ParamSpec]]:

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..library.bricks import Brick, Library
 from ..library.kinds import BRDF_KINDS
-from ..lang import SourceError
 from ..lang.errors import UserError
+from .params import Frozen
 from .surface import DEFAULT as DEFAULT_SURFACE, Surface
+from .where import Origin
 
 _TOKEN = re.compile(r"\s*([A-Za-z][A-Za-z0-9_]*|[0-9]+|[()+=,])")
 PRECISIONS = ("fp32", "fp16")  # fp16: the BRDF and glue arithmetic in half (backends/*/emit.py, *Half*), the interface 32-bit
@@ -33,24 +34,39 @@ class SpecError(UserError, ValueError):
 
 @dataclass(frozen=True)
 class Node:
-    """One brick of a spec with its slot fillers (resolved)."""
+    """One brick of a spec with its slot fillers (resolved).
+
+    `key` (the canonical text), `tree` (this node and every filler below it, callers first) and `textures`
+    (each texture name the tree's bricks declare, first declaration first) are computed once, when the node
+    is made: the link stage reads them for every function it names and every texture it binds."""
 
     brick: Brick
     fillers: tuple  # ((slot, Node), ...) in the brick's slot order
     counts: tuple = ()  # ((array parameter, element count), ...) in the brick's parameter order
+    col: int = field(default=0, compare=False)  # the column of the brick's id in the spec string (0: a default)
+    key: str = field(init=False, compare=False, repr=False)
+    tree: tuple = field(init=False, compare=False, repr=False)
+    textures: dict = field(init=False, compare=False, repr=False)
+
+    def __post_init__(self):
+        parts = [f"{s}={n.key}" for s, n in self.fillers] + [f"{p}={c}" for p, c in self.counts]
+        object.__setattr__(self, "key", f"{self.brick.id}({','.join(parts)})" if parts else self.brick.id)
+        object.__setattr__(self, "tree", (self, *(x for _, n in self.fillers for x in n.tree)))
+        decls: dict = {}
+        for x in self.tree:
+            for name, d in x.brick.textures.items():
+                decls.setdefault(name, d)
+        object.__setattr__(self, "textures", Frozen(decls))
 
     def canonical(self) -> str:
-        parts = [f"{s}={n.canonical()}" for s, n in self.fillers] + [f"{p}={c}" for p, c in self.counts]
-        return f"{self.brick.id}({','.join(parts)})" if parts else self.brick.id
+        return self.key
 
     def count(self, param: str) -> int | None:
         return dict(self.counts).get(param)
 
     def walk(self):
         """This node and every filler below it, callers first."""
-        yield self
-        for _, n in self.fillers:
-            yield from n.walk()
+        return iter(self.tree)
 
 
 def _tokens(spec: str):
@@ -134,7 +150,7 @@ def parse_spec(spec: str, lib: Library, kinds) -> list[Node]:
                                     f"fill the slot explicitly: {brick.id}({sname}=...)")
                 node = Node(dflt, _default_fillers(dflt, lib, spec, col), _default_counts(dflt))
             fillers.append((sname, node))
-        return Node(brick, tuple(fillers), tuple((a, counts.get(a, n)) for a, n in arrays.items()))
+        return Node(brick, tuple(fillers), tuple((a, counts.get(a, n)) for a, n in arrays.items()), col)
 
     nodes = [term(kinds)]
     while toks[i][0] == "+":
@@ -201,6 +217,8 @@ class Permutation:
     output: str = "linear"
     precision: str = "fp32"
     surface: Surface = DEFAULT_SURFACE  # alpha mode, double-sided, vertex colours, emission (spec/surface.py)
+    # where it was asked for (spec/where.py): not part of the key, so equal keys from two places are one permutation
+    origin: Origin | None = field(default=None, compare=False, repr=False)
 
     def canonical(self) -> str:
         """The key as text; the surface state at its defaults writes nothing (earlier keys and hashes unchanged)."""
@@ -214,61 +232,9 @@ class Permutation:
         return hashlib.sha256(self.canonical().encode()).hexdigest()[:12]
 
 
-@dataclass
-class Resolved:
-    """A permutation's bricks, resolved from its key."""
-
-    brdf: list[Node]
-    packing: Node
-    lights: list[tuple[Brick, Node]]  # (light brick, shadow spec) per light, in order
-    output: Brick
-    dynamic: tuple[bool, ...] = ()  # per light: a loop over a storage buffer of such lights
-    surface: Surface = DEFAULT_SURFACE
-
-
-def resolve(perm: Permutation, lib: Library) -> Resolved:
-    """The bricks a permutation key names (errors name the key's part that is wrong)."""
-    brdf = parse_brdf(perm.brdf, lib)
-    packing = parse_spec(perm.packing, lib, ("packing",))
-    if len(packing) != 1:
-        raise SourceError("<key>", 1, 1, f"packing '{perm.packing}' names more than one brick", "name one packing")
-    lights = []
-    for lk in perm.lights:
-        lb = lib.get("light", lk.light)
-        if lb is None:
-            raise SourceError("<key>", 1, 1, f"unknown light brick '{lk.light}'",
-                              f"known: {', '.join(b.id for b in lib.of_kind('light'))}")
-        lights.append((lb, parse_spec(lk.shadow, lib, ("shadow",))[0]))
-    out = lib.get("output", perm.output)
-    if out is None:
-        raise SourceError("<key>", 1, 1, f"unknown output brick '{perm.output}'",
-                          f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
-    return Resolved(brdf, packing[0], lights, out, tuple(lk.dynamic for lk in perm.lights), perm.surface)
-
-
-def check_packing(r: Resolved) -> tuple[str, str]:
-    """('', '') when the packing fits the BRDF, else (what is wrong, what to do): the first rule of
-    spec/constraints.py the permutation breaks."""
-    from .constraints import first_problem
-    return first_problem(r)
-
-
-def fp16_warnings(perms, lib: Library) -> list[str]:
-    """One line per brick whose metadata says "fp16": "unsafe: why" and that fp16 permutations use, with how many
-    (`build` prints them as warnings; the permutations still build)."""
-    users: dict[tuple, list[str]] = {}
-    why: dict[tuple, tuple[str, str]] = {}
-    for perm in perms:
-        if perm.precision != "fp16":
-            continue
-        r = resolve(perm, lib)
-        nodes = [n for top in (*r.brdf, r.packing, *(s for _, s in r.lights)) for n in top.walk()]
-        for b in [n.brick for n in nodes] + [b for b, _ in r.lights] + [r.output]:
-            if b.fp16_unsafe:
-                key = (b.kind, b.id)
-                why[key] = (b.fp16_unsafe, b.display_path)
-                if perm.hash not in users.setdefault(key, []):
-                    users[key].append(perm.hash)
-    return [f"{len(hs)} fp16 permutation(s) ({', '.join(hs[:3])}{', …' if len(hs) > 3 else ''}) use {kind} brick "
-            f"'{bid}', unsafe in fp16: {why[(kind, bid)][0]} ({why[(kind, bid)][1]})"
-            for (kind, bid), hs in users.items()]
+def __getattr__(name: str):
+    """What spec/resolve.py defines, also importable from here (where it lived before it grew)."""
+    if name in ("Resolved", "resolve", "check_packing", "fp16_warnings"):
+        from . import resolve as _resolve
+        return getattr(_resolve, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
