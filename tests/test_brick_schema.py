@@ -202,7 +202,7 @@ def test_the_glue_and_templates_generate_only_the_names_bricks_are_kept_from():
         assert glue and all(GLUE_FUNCTIONS.fullmatch(n) for n in glue), glue
         made = {st.name for st in prog.structs} - brick_structs
         assert all(n in TEMPLATE_STRUCTS or _TEMPLATE_STRUCT_FAMILIES.fullmatch(n) for n in made), made
-    declared = {m[1] for t in (REPO / "templates").rglob("*.j2") for m in re.finditer(
+    declared = {m[1] for t in (REPO / "generator" / "backends").glob("*/templates/*.j2") for m in re.finditer(
         r"\b(?:struct|uniform|buffer|cbuffer)\s+([A-Z]\w*)", t.read_text())}
     assert declared and declared <= TEMPLATE_STRUCTS, declared - TEMPLATE_STRUCTS
 

@@ -54,10 +54,10 @@ def test_the_depfile_lists_the_scene_every_brick_and_every_template_read(tmp_pat
     assert "scenes/example.toml" in deps  # relative to the working directory, as the build system sees it
     bricks = {str(p.relative_to(REPO)) for p in (REPO / "bricks").rglob("*.py")}
     assert bricks <= set(deps)
-    templates = {d for d in deps if d.startswith("templates/")}
+    templates = {d for d in deps if d.endswith(".j2")}
     for lang in ("glsl", "hlsl", "wgsl"):  # what was composed with: vertex, fragment, the ubershader, macros
-        assert {f"templates/{lang}/vertex.{lang}.j2", f"templates/{lang}/fragment.{lang}.j2",
-                f"templates/{lang}/macros.{lang}.j2"} <= templates
+        assert {f"generator/backends/{lang}/templates/{stage}.{lang}.j2"
+                for stage in ("vertex", "fragment", "macros")} <= templates
     assert all(Path(REPO / d).is_file() for d in deps)
     again = _cli("build", EXAMPLE, "--out", tmp_path / "out", "--depfile", tmp_path / "again.d")
     assert "up to date" in again.stdout and (tmp_path / "again.d").read_text() == text  # composed nothing, same deps

@@ -135,7 +135,7 @@ def test_with_shadow_none_the_footprint_is_lit_like_the_rest_of_the_floor(device
     img, rep = _render(scene, lib, device, tmp_path / "none", "specialized")
     assert rep.shadow_maps == {}, "no shadowed light: no depth pass"
     # Without a shadow map nothing of this permutation's fragment shader reads the world position (Lambert, a
-    # directional light), but the vertex shader (templates/*/vertex) still writes v_position at location 0:
+    # directional light), but the vertex shader (backends/*/templates/vertex) still writes v_position at location 0:
     # valid Vulkan, a performance warning of the layer. Take exactly that warning, and only it.
     unread = [m for m in device.messages if m.id_name == "UNASSIGNED-CoreValidation-Shader-OutputNotConsumed"
               and "output location 0.0 which is not consumed" in m.text]

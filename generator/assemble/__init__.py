@@ -20,7 +20,7 @@ from ..io import atomic_write, content_key, sha256
 from ..analysis import cost_dict
 from ..spec.permutation import SpecError, parse_brdf, parse_spec
 from ..scene.load import Scene
-from ..backends import LANGUAGES
+from ..backends import LANGUAGES, template_file, template_name
 from ..lang import SourceError
 from ..link.uber import coverage
 from ..toolchain import CompileStats, tool_versions
@@ -30,8 +30,7 @@ from .outputs import clean_leftovers, collect_garbage, locked, shown, write_depf
 from .platforms import PLATFORMS, all_tools, dialects_of, platform_files, write_platforms
 from .reflection import scene_tables
 
-_PACKAGE = Path(__file__).resolve().parents[1]  # generator/
-_TEMPLATES = _PACKAGE.parent / "templates"
+_PACKAGE = Path(__file__).resolve().parents[1]  # generator/ (the templates too: backends/*/templates/)
 
 
 STATE = ".shadermatrix-state.json"  # the build's own record beside the manifest (deterministic: no times)
@@ -112,15 +111,16 @@ def _deps(scene: Scene, lib: Library, out: Path) -> list[str]:
     (this process's, and the last build's for what it kept)."""
     templates = _state(out).get("templates", [])
     return [shown(scene.path), *(shown(b.path) for b in lib.bricks.values()),
-            *(shown(_TEMPLATES / t) for t in sorted(templates))]
+            *(shown(template_file(t)) for t in sorted(templates))]
 
 
 def _templates_read(also=()) -> list[str]:
-    """The templates composed with, relative to templates/: this process's and `also` (workers' absolute paths)."""
+    """The names of the templates composed with ("glsl/fragment.glsl.j2"): this process's and `also` (workers'
+    file paths)."""
     import sys
     compose = sys.modules.get("generator.compose")
     read = set(also) | set(compose.loaded_templates() if compose is not None else ())
-    return sorted(str(Path(p).resolve().relative_to(_TEMPLATES)) for p in read)
+    return sorted(template_name(p) for p in read)
 
 
 def _build(scene: Scene, lib: Library, out: Path, languages, store, workers=None, executor=None,
@@ -325,7 +325,7 @@ def _up_to_date(out: Path, keys: dict, uber_key: str, scene_key: str) -> int | N
 def _own_sources() -> str:
     """sha256 of the generator's own code and templates (relative path and bytes of every file)."""
     h = hashlib.sha256()
-    for root in (_PACKAGE, _TEMPLATES):
+    for root in (_PACKAGE,):
         for p in sorted(root.rglob("*")):
             # the built-in bricks (package data inside generator/ when installed) are keyed per permutation
             if p.is_file() and p.suffix in (".py", ".j2", ".toml") and BUILTIN_BRICKS not in p.parents:

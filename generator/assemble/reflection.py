@@ -54,7 +54,7 @@ _WGPU_FORMAT = {"R32G32B32_SFLOAT": "float32x3", "R32G32B32A32_SFLOAT": "float32
 _DXGI_FORMAT = {"R32G32B32_SFLOAT": "DXGI_FORMAT_R32G32B32_FLOAT", "R32G32B32A32_SFLOAT": "DXGI_FORMAT_R32G32B32A32_FLOAT",
                 "R32G32_SFLOAT": "DXGI_FORMAT_R32G32_FLOAT"}
 _SEMANTIC = {"a_position": ("POSITION", 0), "a_normal": ("NORMAL", 0), "a_tangent": ("TANGENT", 0),
-             "a_uv": ("TEXCOORD", 0), "a_color": ("COLOR", 0)}  # templates/hlsl/vertex.hlsl.j2
+             "a_uv": ("TEXCOORD", 0), "a_color": ("COLOR", 0)}  # backends/hlsl/templates/vertex.hlsl.j2
 
 
 def _resources(iface):

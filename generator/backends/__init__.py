@@ -6,6 +6,9 @@ for, so the shader back ends need nothing beyond the standard library.
 """
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 from .base import Emitted, Target
 from .glsl.emit import GlslHalfTarget, GlslTarget
 from .hlsl.emit import HlslHalfTarget, HlslTarget
@@ -15,6 +18,35 @@ TARGETS: dict[str, Target] = {"glsl": GlslTarget(), "hlsl": HlslTarget(), "wgsl"
 # fp16 variants: the brick language's float is the language's 16-bit float (half arithmetic, not only storage)
 HALF_TARGETS: dict[str, Target] = {"glsl": GlslHalfTarget(), "hlsl": HlslHalfTarget(), "wgsl": WgslHalfTarget()}
 LANGUAGES: tuple[str, ...] = ("glsl", "hlsl", "wgsl")  # the shading languages, in output order
+# Template names start with a folder ("glsl/fragment.glsl.j2"): the back-end package whose templates/ holds the file.
+TEMPLATE_PACKAGES: dict[str, str] = {folder: f"{__name__}.{folder}" for folder in ("glsl", "hlsl", "wgsl", "gl")}
+
+
+def template_root(folder: str) -> Path:
+    """The templates/ directory of the back end owning template folder `folder`, wherever it is installed (the
+    directory jinja2.PackageLoader reads)."""
+    spec = importlib.util.find_spec(TEMPLATE_PACKAGES[folder])
+    return Path(next(iter(spec.submodule_search_locations))) / "templates"
+
+
+def template_file(name: str) -> Path:
+    """The file of template `name` ("glsl/fragment.glsl.j2")."""
+    folder, _, rest = name.partition("/")
+    if folder not in TEMPLATE_PACKAGES or not rest:
+        raise ValueError(f"no template '{name}': a template name is FOLDER/FILE, FOLDER one of "
+                         f"{', '.join(TEMPLATE_PACKAGES)}")
+    return template_root(folder) / rest
+
+
+def template_name(path) -> str:
+    """The name ("glsl/fragment.glsl.j2") of a template file: template_file()'s inverse."""
+    p = Path(path).resolve()
+    for folder in TEMPLATE_PACKAGES:
+        root = template_root(folder).resolve()
+        if p.is_relative_to(root):
+            return f"{folder}/{p.relative_to(root).as_posix()}"
+    raise ValueError(f"{path} is not a template of any back end (their templates/ folders: "
+                     f"{', '.join(TEMPLATE_PACKAGES)})")
 
 
 def parse_languages(text: str) -> list[str]:
@@ -43,5 +75,6 @@ def get_target(name: str, precision: str = "fp32") -> Target:
         raise ValueError(f"unknown target '{name}' (known: glsl, hlsl, numpy, wgsl)") from None
 
 
-__all__ = ["Emitted", "Target", "TARGETS", "HALF_TARGETS", "LANGUAGES", "get_target", "GlslTarget", "HlslTarget",
+__all__ = ["Emitted", "Target", "TARGETS", "HALF_TARGETS", "LANGUAGES", "TEMPLATE_PACKAGES", "get_target",
+           "template_file", "template_name", "GlslTarget", "HlslTarget",
            "WgslTarget", "GlslHalfTarget", "HlslHalfTarget", "WgslHalfTarget"]

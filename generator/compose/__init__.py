@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import jinja2
 
@@ -19,17 +18,20 @@ from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link import EvalProgram, Interface, LinkedPermutation, Slot, eval_program, link_permutation
 from ..spec.permutation import Permutation
-from ..backends import LANGUAGES, get_target
+from ..backends import LANGUAGES, TEMPLATE_PACKAGES, get_target, template_file
 from ..backends.base import Emitted
-
-TEMPLATES = Path(__file__).resolve().parents[2] / "templates"
-
 
 _LOADED: set[str] = set()  # every template file this process has read (for depfiles)
 
 
-class _RecordingLoader(jinja2.FileSystemLoader):
-    """A FileSystemLoader that remembers which files it read: a build's depfile lists what was loaded."""
+class _RecordingLoader(jinja2.PrefixLoader):
+    """Templates by name: "glsl/fragment.glsl.j2" is fragment.glsl.j2 in the templates/ folder of the back end
+    owning folder "glsl" (backends.TEMPLATE_PACKAGES), read by a jinja2.PackageLoader wherever the package is
+    installed. Remembers which files it read: a build's depfile lists what was loaded."""
+
+    # A template compiles under its full name, as it did from one folder (PrefixLoader.load would hand the
+    # package's loader the name without its folder): Jinja's messages name "glsl/fragment.glsl.j2".
+    load = jinja2.BaseLoader.load
 
     def get_source(self, environment, template):
         source, filename, uptodate = super().get_source(environment, template)
@@ -45,7 +47,8 @@ def loaded_templates() -> list[str]:
 def jinja_env() -> jinja2.Environment:
     """The one Jinja environment (StrictUndefined: a missing value is an error, not an empty string)."""
     return jinja2.Environment(
-        loader=_RecordingLoader(str(TEMPLATES)),
+        loader=_RecordingLoader({folder: jinja2.PackageLoader(package, "templates")
+                                 for folder, package in TEMPLATE_PACKAGES.items()}),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
         lstrip_blocks=True,
@@ -88,7 +91,7 @@ class Composed:
 
 
 def _template_hash(name: str) -> str:
-    return hashlib.sha256((TEMPLATES / name).read_bytes()).hexdigest()[:12]
+    return hashlib.sha256(template_file(name).read_bytes()).hexdigest()[:12]
 
 
 def _templates_used(lang: str, main: str) -> dict[str, str]:
@@ -216,7 +219,7 @@ def compose_permutation(perm: Permutation | LinkedPermutation, lib: Library, lan
     extra = []
     if dialects:
         from ..backends.gl.emit import DIALECTS, gl_bindings
-        for d in dialects:  # the platform dialects (templates/gl/, with the Vulkan GLSL's macros)
+        for d in dialects:  # the platform dialects (gl/templates/, with the Vulkan GLSL's macros)
             extra += _stage_sources(perm, lp, DIALECTS[d](gl_bindings(iface.blocks, iface.textures), perm.precision),
                                     "gl", d, f"permutation ({d})", get_target("glsl"), bricks, templates,
                                     also=("glsl/macros.glsl.j2",))
@@ -226,7 +229,7 @@ def compose_permutation(perm: Permutation | LinkedPermutation, lib: Library, lan
 
 def _stage_sources(perm, lp, target, tdir: str, ext: str, label: str, spelling, bricks, templates,
                    also=()) -> list[Source]:
-    """A permutation's vertex and fragment shaders from templates/<tdir>/<stage>.<tdir>.j2 through `target`
+    """A permutation's vertex and fragment shaders from template <tdir>/<stage>.<tdir>.j2 through `target`
     (sources named <hash>.<vert|frag>.<ext>); `also`: templates the skeletons import from other folders;
     `spelling`: the target whose type names the templates spell built-in types with."""
     prog, iface, h = lp.program, lp.interface, perm.hash

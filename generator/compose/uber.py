@@ -69,7 +69,7 @@ def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAG
 
 def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUAGES,
                         specialized: bool = False) -> tuple[Composed, Uber]:
-    """The ubershader's shade() in a compute kernel: the material index per sample in P.w (templates/*/shade).
+    """The ubershader's shade() in a compute kernel: the material index per sample in P.w (backends/*/templates/shade.*.j2).
 
     specialized: the variant comes from specialization constant 0 (link.uber.SPEC_VARIANT).
     """

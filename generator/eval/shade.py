@@ -119,7 +119,7 @@ def _surface(P, Ng, V, T=None, uv=None) -> dict:
 
 
 def _samples(rows, n: int) -> np.ndarray:
-    """The samples buffer of a shade kernel: one vec4 per row per sample (templates/*/shade)."""
+    """The samples buffer of a shade kernel: one vec4 per row per sample (backends/*/templates/shade.*.j2)."""
     sample = np.zeros((n, len(rows), 4), np.float32)
     for j, r in enumerate(rows):
         r = np.asarray(r)
@@ -241,6 +241,6 @@ def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "nu
     spec = None if variant is None else {SPEC_VARIANT: int(variant)}
     rows = [P, Ng, V] + ([T] if "T" in u.surface else []) + ([uv] if "uv" in u.surface else [])
     sample = _samples(rows, n)
-    sample[:, 0, 3] = material  # P.w: the material index (templates/*/shade with `uber`)
+    sample[:, 0, 3] = material  # P.w: the material index (backends/*/templates/shade.*.j2 with `uber`)
     blocks = [(STORAGE, entry_bytes(lts["ids"], lts["data"])), (STORAGE, entry_bytes(mat["ids"], mat["data"]))]
     return _run(c.sources[0], sample, blocks, spec, what="ubershader kernel")

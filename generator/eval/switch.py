@@ -2,7 +2,7 @@
 
 `evaluate_switch(specs, ids, L, V, N, ...)` runs `brdf_switch` (link.switch_program):
 sample i is evaluated with BRDF `specs[ids[i]]`. On GPU targets the id travels in the
-w component of the sample's L (templates/*/eval.*.j2), so the switch is on a value read
+w component of the sample's L (backends/*/templates/eval.*.j2), so the switch is on a value read
 from a storage buffer, divergent within a workgroup. Each BRDF keeps its own parameters
 (`b<k>_<name>` in the kernel): `params={"alpha": 0.3}` sets alpha of every BRDF that has
 one, `params={"b1_alpha": 0.5}` that of BRDF 1 only.

@@ -200,7 +200,7 @@ def _module_constant(path, node, name, value) -> ir.Const:
     raise _err(path, value, f"constant {name} must be a number literal", "write e.g. K = 0.5 or N = 4")
 
 
-# Struct and block names of the templates and the glue (templates/*/*.j2, link/glue.py LightData<i>, link/uber.py,
+# Struct and block names of the templates and the glue (backends/*/templates, link/glue.py LightData<i>, link/uber.py,
 # link/__init__.py): a brick's struct is emitted under its own name beside them, so it may be none of them.
 TEMPLATE_STRUCTS = frozenset({"Draw", "Frame", "Info", "LightEntry", "Lights", "Material", "MaterialBuffer",
                               "MaterialEntry", "Object", "PSIn", "Params", "Result", "Samples", "VSIn", "VSOut"})

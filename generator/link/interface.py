@@ -190,7 +190,7 @@ class Location:
         return d
 
 
-# The mesh attributes and interpolants of the fragment shaders (templates/*/vertex and fragment).
+# The mesh attributes and interpolants of the fragment shaders (backends/*/templates/vertex and fragment).
 VERTEX_INPUTS = {"P": Location(0, "a_position", "vec3", "R32G32B32_SFLOAT"),
                  "N": Location(1, "a_normal", "vec3", "R32G32B32_SFLOAT"),
                  "T": Location(2, "a_tangent", "vec4", "R32G32B32A32_SFLOAT"),

@@ -29,7 +29,7 @@ from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM, ComputePipeline
 from .device import Device, validation_requested  # noqa: F401
 from .images import Image, texels
 
-WORKGROUP = 64  # local_size_x of templates/*/eval.*.j2
+WORKGROUP = 64  # local_size_x of backends/*/templates/eval.*.j2
 TEXTURE_BINDING = 3  # texture k: image at TEXTURE_BINDING + 2k, its sampler at TEXTURE_BINDING + 2k + 1
 MAX_EXACT_ID = 1 << 24  # ids travel as float32 in L.w: exact for |id| <= 2^24
 TEXTURE_CACHE_BYTES = 256 << 20  # uploaded images one kernel keeps (least recently used go first)
