@@ -20,11 +20,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..lang import SourceError, ir
+from ..lang import ir
 from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
 from ..library.inputs import SURFACE
 from ..spec.permutation import Permutation
 from ..spec.resolve import Resolved, resolve
+from ..spec.where import KeyProblem, within
 from .glue import _Binder, brdf_glue, has_tangent, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture
 from .irgen import Builder
@@ -242,8 +243,9 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     stmts = body()
     leftover = [n for n in bind.params]
     if leftover:
-        raise SourceError("<ubershader>", 1, 1, f"the ubershader cannot bind {', '.join(leftover)}",
-                          "every parameter comes from the material or light entry")
+        with within(resolved[0].origin, resolved[0].key):  # where the scene asks for its first material
+            raise KeyProblem("brdf", f"the ubershader cannot bind {', '.join(leftover)}",
+                             "every parameter comes from the material or light entry")
     tangent = any(g.tangent for g in glues)
     surface = ["P", "N"] + (["T", "B"] if tangent or bind.surface & {"T", "B"} else []) \
         + (["uv"] if "uv" in bind.surface else [])
@@ -255,8 +257,12 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     mbuf.set, mbuf.binding = where["material_buffer"]
     lbuf.set, lbuf.binding = where["light_buffer"]
     if kernel and bind.textures:
-        raise SourceError("<ubershader>", 1, 1, f"an ubershader kernel binds no textures, and its bricks sample "
-                          f"'{bind.textures[0].param}'", "run texture-sampling materials in the fragment ubershader")
+        name = bind.textures[0].param
+        v = next((v for v in resolved if name in v.textures), resolved[0])  # the material whose bricks sample it
+        with within(v.origin, v.key):
+            raise KeyProblem("brdf" if any(name in n.textures for n in v.brdf) else "packing",
+                             f"an ubershader kernel binds no textures, and its bricks sample '{name}'",
+                             "run texture-sampling materials in the fragment ubershader")
     nxt = {"light": where.get("shadow_maps", (0, 0))[1], "material": where.get("material_textures", (1, 0))[1]}
     for tex in bind.textures:
         tex.set = 0 if tex.group == "light" else 1
