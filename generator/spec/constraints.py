@@ -2,8 +2,8 @@
 
 Each rule is a predicate over a permutation's resolved bricks that returns
 (what is wrong, what to do), ('', '') when it holds. Scene loading refuses a
-material that breaks one (permutation.check_packing: the first broken rule, located
-at the material's packing); `shadermatrix matrix --explain` lists every combination
+material that breaks one (resolve.check_packing: the first broken rule, located
+at the material's packing; spec/resolve.py keeps every broken rule as the permutation's verdict); `shadermatrix matrix --explain` lists every combination
 of a scene's axes that breaks one, and why. tests/test_explain.py holds the truth
 table: which permutations must and must not exist.
 """
@@ -21,7 +21,7 @@ class Constraint:
 
 
 def _brdf_text(r) -> str:
-    return "+".join(n.canonical() for n in r.brdf)
+    return r.brdf_key
 
 
 def _provides_unread(r) -> tuple[str, str]:
@@ -45,13 +45,6 @@ def _provides_wrong_type(r) -> tuple[str, str]:
                     f"{f.loc.line}), but BRDF '{_brdf_text(r)}' reads {name} as {params[name].ty}",
                     f"make get_{name} return {params[name].ty}")
     return "", ""
-
-
-def reads_tangent(nodes) -> list[str]:
-    """The tangent-frame rows of the inputs table (T, B, HdotT, ...) that BRDF nodes and their fillers read."""
-    from ..library.inputs import BY_NAME, SHADING
-    return sorted({p.name for n in nodes for x in n.walk() for f in x.brick.entries for p in f.params
-                   if p.name in SHADING and BY_NAME[p.name].tangent})
 
 
 def supplies_tangent(packing) -> bool:

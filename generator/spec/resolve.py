@@ -79,10 +79,6 @@ class Resolved:
     problems: tuple[tuple[str, str, str], ...]
     origin: Origin | None  # where it was asked for (Permutation.origin)
 
-    @property
-    def dynamic(self) -> tuple[bool, ...]:
-        return tuple(lt.dynamic for lt in self.lights)
-
 
 def _walk(*tops: Node):
     return [x for top in tops for x in top.tree]
