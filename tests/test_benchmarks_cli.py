@@ -1,4 +1,4 @@
-"""The benchmark scripts' command lines (issue 15): each answers --help, names the options README's table
+"""The benchmark scripts' command lines: each answers --help, names the options docs/benchmarks.md's table
 gives it, and refuses a bad value as a usage error (exit 2) before any work — their runs take minutes and
 belong to benchmarks/, not to the test suite."""
 from __future__ import annotations
@@ -13,7 +13,9 @@ import pytest
 
 REPO = Path(__file__).resolve().parent.parent
 SCRIPTS = sorted(p for p in (REPO / "benchmarks").glob("*.py") if p.name != "cliargs.py")
-README_COMMANDS = re.findall(r"`(\.venv/bin/python benchmarks/[^`]+)`", (REPO / "README.md").read_text())
+PAGES = [REPO / "docs" / "benchmarks.md", REPO / "docs" / "contributing" / "benchmarks.md"]
+DOC_COMMANDS = [c for page in PAGES if page.exists()
+                for c in re.findall(r"`(\.venv/bin/python benchmarks/[^`]+)`", page.read_text())]
 
 
 def _run(*args):
@@ -26,14 +28,14 @@ def test_every_script_answers_help(script):
     assert r.returncode == 0 and r.stdout.startswith("usage: "), r.stderr
 
 
-def test_readme_names_every_script_and_only_options_they_take():
-    named = {shlex.split(c)[1] for c in README_COMMANDS}
+def test_docs_name_every_script_and_only_options_they_take():
+    named = {shlex.split(c)[1] for c in DOC_COMMANDS}
     assert {f"benchmarks/{p.name}" for p in SCRIPTS} <= named
-    for cmd in README_COMMANDS:
+    for cmd in DOC_COMMANDS:
         argv = shlex.split(cmd)
         help_text = _run(REPO / argv[1], "--help").stdout
         for opt in (a for a in argv[2:] if a.startswith("--")):
-            assert opt in help_text, f"README shows {opt} for {argv[1]}, which does not take it"
+            assert opt in help_text, f"docs show {opt} for {argv[1]}, which does not take it"
 
 
 @pytest.mark.parametrize("args", [
