@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Install everything shadermatrix needs on Debian 12, as root. Idempotent; pinned.
-# Versions live here, in generator/toolchain/pins.toml (the tools) and requirements.lock; README says why.
+# Versions live here, in generator/toolchain/pins.toml (the tools) and requirements.lock; docs/guide/install.md says why.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,7 +26,7 @@ APT_PKGS=(
 # from its persisted cache (lavapipe's VkPipelineCache stays empty in both). The libdrm and
 # gallium versions are the ones this Mesa needs. bookworm-backports keeps only its latest upload:
 # when these versions are gone, set-up says so; bump them to what `apt-cache policy
-# mesa-vulkan-drivers` offers from bookworm-backports (mesa's in generator/toolchain/pins.toml; README).
+# mesa-vulkan-drivers` offers from bookworm-backports (mesa's in generator/toolchain/pins.toml; docs/guide/install.md).
 BPO_PKGS=(
   "mesa-vulkan-drivers=$MESA_V"            # lavapipe (software Vulkan 1.4) and RADV
   "mesa-libgallium=$MESA_V"                # the same Mesa source package

@@ -72,7 +72,7 @@ def test_check_usage_errors_and_selection(tmp_path):
                                ("d3d12", "wgsl", "checks nothing")):  # d3d12 is made from HLSL alone
         with pytest.raises(UsageError, match=what):
             selection(plats, langs)
-    # the languages narrow the platforms (README's plugin command names them): vulkan compiles those it is given
+    # the languages narrow the platforms (docs/guide/build.md's plugin command names them): vulkan compiles those it is given
     assert selection(None, "hlsl") == (["vulkan", "d3d12"], ["hlsl"])
     scene = load_scene(EXAMPLE, load_library([]))
     got = checks(scene, *selection("vulkan,gl", "glsl,hlsl"))

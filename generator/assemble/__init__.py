@@ -473,7 +473,7 @@ def _validate_dialects(pairs, store) -> dict[str, list[str]]:
 
 
 def _dxil_step():
-    """The DXC step of the d3d12 platform, or None when no dxc is on PATH (README: where to get one)."""
+    """The DXC step of the d3d12 platform, or None when no dxc is on PATH (docs/guide/install.md: where to get one)."""
     from ..toolchain import CompileJob, find_tool
     from ..toolchain.platforms import compile_dxil
     if find_tool("dxc") is None:

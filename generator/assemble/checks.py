@@ -143,7 +143,7 @@ def dxc_note() -> str | None:
     if find_tool("dxc") is not None:
         return None
     return ("no dxc on PATH: d3d12 checks validate the HLSL with glslang's HLSL front end only, no DXIL "
-            "(README: where to get dxc)")
+            "(docs/guide/install.md: where to get dxc)")
 
 
 def run_check(scene: Scene, lib: Library, check: Check, store=None) -> Outcome:

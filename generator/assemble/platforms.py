@@ -123,7 +123,7 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
                 d["stages"][stage] = item
             from ..toolchain.platforms import DX_PROFILES
             d.update(profiles={s: DX_PROFILES[(s, precision)] for s in stages},
-                     dxil="built" if dxil is not None else "no dxc on PATH: HLSL only (README: where to get dxc)",
+                     dxil="built" if dxil is not None else "no dxc on PATH: HLSL only (docs/guide/install.md: where to get dxc)",
                      cost={s: langs["hlsl"][s]["cost"] for s in stages}, cost_from="hlsl SPIR-V (glslang)")
         elif p == "gl":
             es_errors = [e for s in stages for e in dialect_errors.get(f"{name}.{s}.essl", [])]

@@ -1,6 +1,6 @@
 """Scene manifests (TOML) → the permutations a scene needs, and nothing more.
 
-Schema (README "Scene files"):
+Schema (docs/guide/scenes.md, every key):
     [scene]            name, output (default "linear"), precision (default "fp32")
     [materials.NAME]   brdf = spec, packing = spec (default "constants"), params = {...},
                        alpha = "opaque"|"mask"|"blend", double_sided, vertex_color = true|false,

@@ -143,7 +143,7 @@ def _located(e, loc):
         return loc.error(pos, f"{_where(path)} has no '{missing}'", f"add {missing} = …")
     if e.validator == "type":
         want = _TYPES.get(e.validator_value, e.validator_value)
-        example = _EXAMPLES.get(str(path[0]) if path else "", "see README, \"Scene files\"")
+        example = _EXAMPLES.get(str(path[0]) if path else "", "see docs/guide/scenes.md")
         return loc.error(pos, f"'{key}' must be {want}, not {_what(e.instance)}", f"write {example}"
                          if len(path) <= 1 else f"give {want}")
     if e.validator == "enum":
@@ -163,4 +163,4 @@ def _located(e, loc):
                       "minItems": ("is empty", "give at least one item"),
                       "maxItems": (f"has more than {limit} items", f"keep it to {limit}")}[e.validator]
         return loc.error(pos, f"'{key}' {what}", todo)
-    return loc.error(pos, f"'{key}': {e.message}", "see README, \"Scene files\"")
+    return loc.error(pos, f"'{key}': {e.message}", "see docs/guide/scenes.md")

@@ -31,7 +31,7 @@ def add_arguments(p) -> None:
                    help="worker processes composing, compiling and analysing (default: the core count; from 64 "
                         "permutations, else N tool processes); the output is the same for any N")
     p.add_argument("--executor", metavar="dask://HOST:PORT",
-                   help="compile on a Dask distributed cluster (its workers need the pinned tools: README)")
+                   help="compile on a Dask distributed cluster (its workers need the pinned tools: docs/guide/build.md)")
     p.add_argument("--keep-removed", action="store_true",
                    help="keep the outputs of permutations that left the scene, listed under the manifest's "
                         "\"removed\" (default: they are deleted)")
