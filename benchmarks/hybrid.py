@@ -230,7 +230,7 @@ def main() -> int:
           "\"persisted\" again into the same directory). Hits and misses are the driver's own count "
           "(MESA_SHADER_CACHE_SHOW_STATS). lavapipe compiles a pipeline's shaders at the first draw that "
           "uses it, so the compile is in the first frame, not in pipeline creation; its VkPipelineCache "
-          "holds only its header (NOTES.md, \"Pipeline cache\"), so the driver's creation feedback never "
+          "holds only its header (docs/design/runtime.md, \"The pipeline cache\"), so the driver's creation feedback never "
           "reports a hit.",
           "",
           "| mode | first frame, cold / persisted (ms) | pipeline creation, cold / persisted (median ms) "

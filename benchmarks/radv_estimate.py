@@ -10,7 +10,7 @@ and the worst misprediction; a scatter plot per family.
     .venv/bin/python benchmarks/radv_estimate.py
 
 writes benchmarks/results/radv_estimate.md, radv_estimate.json and radv_estimate.png, and the
-example scene's `shadermatrix costs --gpu` report as costs_example_gpu.md (the source of README's
+example scene's `shadermatrix costs --gpu` report as costs_example_gpu.md (the source of docs/benchmarks.md's
 ubershader table). Counts, not times: the figures are the same on every run.
 """
 from __future__ import annotations

@@ -27,7 +27,7 @@ def atomic_write(path: Path, data: bytes) -> bool:
     Atomic against the process dying at any instant (Ctrl-C, SIGTERM, kill -9): a reader sees the old
     file or the new one, never a part. Not fsync'ed: a power cut may leave a recent file empty, which
     the next build notices (a size or sha256 that is not the recorded one) and rebuilds; fsync per file
-    cost more than the rest of writing a 1,000-permutation build (NOTES.md, "Build").
+    cost more than the rest of writing a 1,000-permutation build (docs/design/build.md, "No fsync").
     """
     path = Path(path)
     try:

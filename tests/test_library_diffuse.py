@@ -247,7 +247,7 @@ def test_microfacet_diffuse_limits_and_convergence():
 
 
 def test_gotanda_fit_error_table(capsys):
-    # The figures for README (the lead's runtime-vs-error benchmark): see gotanda_fit_error_table.
+    # The figures for docs/benchmarks.md (the lead's runtime-vs-error benchmark): see gotanda_fit_error_table.
     rows = ref_diffuse.gotanda_fit_error_table()
     with capsys.disabled():
         print("\nGotanda 2014 eq. 8 against eq. 4 by quadrature (α = σ, f0 = 0.04):\n"

@@ -9,7 +9,7 @@ One texture `f0_map`:
   A    perceptual roughness r (linear: sRGB formats decode RGB only), times this packing's
        `roughness` factor; α = r² (Burley 2012, "Physically-Based Shading at Disney", §5.4;
        glTF 2.0 Appendix B).
-Provides f0 and alpha. No guards here: the NDFs floor α at 1e-4 (NOTES.md).
+Provides f0 and alpha. No guards here: the NDFs floor α at 1e-4 (docs/design/accuracy.md).
 """
 BRICK = {
     "kind": "packing",

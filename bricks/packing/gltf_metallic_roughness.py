@@ -19,7 +19,7 @@ Textures (an ORM texture, as glTF exporters pack occlusion with metallic-roughne
 Factors are this packing's parameters (base_color, metallic, roughness), defaults 1 as in glTF.
 Provides rho_d, f0 and alpha: it fits diffuse+microfacet BRDFs (lambert+microfacet(…)); for a
 specular-only microfacet(…) use `f0_roughness_texture`. No guards here: the NDFs floor α
-at 1e-4 themselves (NOTES.md, "one roughness floor").
+at 1e-4 themselves (docs/design/accuracy.md, "Roughness").
 """
 BRICK = {
     "kind": "packing",

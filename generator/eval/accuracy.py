@@ -483,7 +483,7 @@ def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12, params: dic
     return out
 
 
-DEFAULT_TOL = 1e-3  # float32 hemisphere max relative error a spec may have and pass (README's worst: ~5e-5)
+DEFAULT_TOL = 1e-3  # float32 hemisphere max relative error a spec may have and pass (the worst exact brick: 3.2e-4, docs/benchmarks.md)
 
 
 def run(specs, targets, dtypes, lib, hemisphere_k: int = 12, tol: float = DEFAULT_TOL,

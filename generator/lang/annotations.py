@@ -22,7 +22,7 @@ def node_error(path: str, node, message: str, hint: str = "") -> SourceError:
     return SourceError(path, getattr(node, "lineno", 1), getattr(node, "col_offset", 0) + 1, message, hint)
 
 
-MAX_IDENTIFIER = 64  # characters in a brick identifier: README, "The brick language"
+MAX_IDENTIFIER = 64  # characters in a brick identifier: docs/design/language.md
 # Generated names add at most a brick id, 6 hex digits and a few characters to one (`<id>_<6 hex>_<fn>`:
 # 64 + 8 + 64), far below the shader compilers' limits (glslang: 1024 characters, GLSL and HLSL alike).
 _ASCII_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")

@@ -6,7 +6,7 @@ references use, the guard the policy applies and why. The glue (link/), the
 float64 reference geometry (reference/geometry.py), the cost stand-ins and the
 stress sweeps all read this table; nothing else lists shading inputs.
 
-The policy (NOTES.md, "Shading conventions"): f_r is 0 for n·l <= 0; n·v is
+The policy (docs/design/accuracy.md, "Shading conventions"): f_r is 0 for n·l <= 0; n·v is
 clamped to [1e-4, 1] so a view below the horizon after normal mapping shades as
 grazing; cosines with h are clamped to [0, 1] before any pow; an undefined half
 vector (l = -v) is the zero vector. Tangent-frame quantities are signed and

@@ -130,14 +130,14 @@ def check(meta: dict, shown: str, loc, positions: dict) -> None:
                           "write a finite number of at most 3.4e38 in magnitude (parameters are float32 in shaders)")
     if e.validator == "type":
         raise SourceError(shown, line, col, f"{key} must be {_TYPES.get(e.validator_value, e.validator_value)}, "
-                          f"not {_what(e.instance)}", "see README, \"The brick language\"")
+                          f"not {_what(e.instance)}", "see docs/reference/language.md, \"BRICK metadata\"")
     if e.validator == "anyOf":
         raise SourceError(shown, line, col, f"{key} must be a number or a list of numbers, not {_what(e.instance)}",
                           "write e.g. 0.5 or [0.5, 0.5, 0.5]")
     if e.validator in ("minItems", "maxItems"):
         raise SourceError(shown, line, col, f"{key} has {len(e.instance)} items", "a range is [low, high]"
                           if path and path[-1] == "range" else "give fewer items")
-    raise SourceError(shown, line, col, f"{key}: {e.message}", "see README, \"The brick language\"")
+    raise SourceError(shown, line, col, f"{key}: {e.message}", "see docs/reference/language.md, \"BRICK metadata\"")
 
 
 def _past_float32(v):

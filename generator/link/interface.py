@@ -1,7 +1,7 @@
 """The typed Interface of a linked program: what a shader reads and where each value lives.
 
 Everything downstream reads it: compose (templates declare it), build (the manifest's
-reflection), the runtime (what to bind), measure (stand-ins). Layout (NOTES.md,
+reflection), the runtime (what to bind), measure (stand-ins). Layout (docs/design/link.md,
 "Uniform layout"): material and light parameters live in arrays of vec4, one vec4
 per scalar or vector and four per mat4 (column-major), identical in std140, HLSL
 cbuffers and WGSL uniforms, so one byte block serves all three languages. Set 0:

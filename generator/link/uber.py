@@ -5,7 +5,7 @@ all options"; the hybrid uses it as the fallback of the shader matrix. It is lin
 same bricks and the same glue pieces as the matrix (link/glue.py), so every permutation it
 stands in for computes the same code; `coverage()` proves every axis value reachable.
 
-Data (documented in NOTES.md, "Ubershader"; the manifest lists the tables):
+Data (documented in docs/design/link.md, "The ubershader's data"; the manifest lists the tables):
 - `material_buffer`: MaterialEntry { ids: ivec4; data: vec4[M] } per material. ids.x is the
   material *variant* — a (BRDF, packing, output) combination of the table `variants`; ids.y,
   ids.z and ids.w are reserved (0).

@@ -404,7 +404,7 @@ def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None,
                 row_of("permutation", h, perm.canonical(), stage, lang, h, course, tuple(scene.users.get(h, [])),
                        len(perm.lights), "; ".join(errors[h]) if h in errors else None)
     perms = [scene.permutations[h] for h in sorted(scene.permutations) if h not in errors]
-    if perms:  # the scene's ubershader: one shader for every permutation (NOTES.md, "Ubershader")
+    if perms:  # the scene's ubershader: one shader for every permutation (docs/design/link.md)
         try:
             uber, _ = compose_ubershader(perms, lib, languages)
             jobs = source_jobs("ubershader", uber.sources)

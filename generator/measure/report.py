@@ -184,7 +184,7 @@ def markdown(rows: list[Row], title: str, models: list[CourseModel] | None = Non
         out += ["", *_totals(perm)]
         uber = [(k, v) for k, v in groups.items() if k[0] == "ubershader"]
         if uber:
-            out += ["", "The scene's ubershader (every permutation in one shader; NOTES.md, \"Ubershader\"):", ""]
+            out += ["", "The scene's ubershader (every permutation in one shader; docs/design/link.md, \"The ubershader's data\"):", ""]
             out += _md_table(["shader", "stage", *head], [[f"`{k[1]}`", k[2], *_metric_cells(v)] for k, v in uber])
         out += ["", "Permutation keys:", ""]
         seen = []

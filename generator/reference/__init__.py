@@ -5,7 +5,7 @@ of the brick sources. Public names:
 
 Whole BRDFs (models.py)
   reference_brdf(spec, L, V, N, T=None, params=None, lib=None) -> (N, 3) float64 f_r,
-      under the NOTES.md shading policy (f_r = 0 for n·l <= 0, n·v clamped to [1e-4, 1]).
+      under the shading policy of docs/design/accuracy.md (f_r = 0 for n·l <= 0, n·v clamped to [1e-4, 1]).
   REFERENCES[kind][brick_id], reference(kind, id) (decorator), lookup(kind, id),
   missing_references(lib), brdf_parameters(resolved BRDF), ReferenceMissing.
 Geometry (geometry.py)

@@ -4,7 +4,7 @@ exact and spherical-Gaussian Fresnel, the Smith and approximate visibility terms
 Registered in models.REFERENCES (imported at the end of models.py). Signatures per kind
 (models.py): ndf f(cos_h, sin2_h, alpha[, *, g, p]) -> D; fresnel f(f0, cos_d[, *, p]) -> F;
 visibility f(g, alpha[, *, p]) -> G (the geometry factor, not V = G / (4 n·l n·v)).
-Each is computed from its paper's formula in float64 under the shading policy of NOTES.md
+Each is computed from its paper's formula in float64 under the shading policy of docs/design/accuracy.md
 (generator/reference/geometry.py); brick guards (roughness floors, cosine floors) are not
 reproduced. Where an exact helper exists in exact.py (Smith Λ with erfc, exact Fresnel)
 it is used: the bricks' algebra (cancellation-free rewrites, the erfc fit) is theirs alone.

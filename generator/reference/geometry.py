@@ -1,7 +1,7 @@
-"""Shading geometry in float64, under the shading policy of NOTES.md.
+"""Shading geometry in float64, under the shading policy of docs/design/accuracy.md.
 
 The references evaluate the BRDF on the same quantity the bricks compute, so
-they apply the same documented policy (NOTES.md, "Shading conventions"):
+they apply the same documented policy (docs/design/accuracy.md, "Shading conventions"):
 
 - f_r = 0 where n·l <= 0 (no light from below the horizon);
 - n·v is clamped to [1e-4, 1]: a view below the horizon (normal mapping) shades
@@ -72,7 +72,7 @@ class Geometry:
 
 
 def shading_geometry(L, V, N, T=None) -> Geometry:
-    """The shading inputs of a BRDF in float64, from the inputs table's formulas (NOTES.md policy)."""
+    """The shading inputs of a BRDF in float64, from the inputs table's formulas (docs/design/accuracy.md's policy)."""
     n = max(np.shape(x)[0] if np.ndim(x) == 2 else 1 for x in (L, V, N))
     L, V, N = _rows(L, "L", n), _rows(V, "V", n), _rows(N, "N", n)
     T = None if T is None else _rows(T, "T", n)

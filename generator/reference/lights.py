@@ -5,7 +5,7 @@ Hoffman & Baker 2006, "Physically-Based Reflectance for Games": the light loop a
 Each function takes surface points P (n, 3) and the light's parameters (by the bricks'
 names, as the scene gives them) and returns (l, c): l the unit vector from P toward the
 light (n, 3) and c_light (n, 3). Written from the sources cited per function, independent
-of the brick code; the bricks' guards (d² floors, …) are not reproduced (NOTES.md,
+of the brick code; the bricks' guards (d² floors, …) are not reproduced (docs/design/accuracy.md,
 "Accuracy"), so compare away from the light's position (d ≫ 1 cm).
 
 LIGHTS maps a light brick id to its function.

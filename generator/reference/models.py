@@ -2,7 +2,7 @@
 
 A reference computes the model the brick claims to implement, exactly, from
 the paper's formula (cited per function) — never from the brick source — under
-the shading policy of NOTES.md (geometry.py). Guards that a brick applies for
+the shading policy of docs/design/accuracy.md (geometry.py). Guards that a brick applies for
 float32 (roughness floors, cosine floors) are *not* reproduced: their cost is
 what `shadermatrix accuracy` measures.
 
@@ -189,7 +189,7 @@ def _term(node, g: Geometry, p: dict) -> np.ndarray:
 
 
 def reference_brdf(spec: str, L, V, N, T=None, params=None, lib=None) -> np.ndarray:
-    """f_r of a BRDF spec in float64, (N, 3), from the papers' formulas under the NOTES.md shading policy.
+    """f_r of a BRDF spec in float64, (N, 3), from the papers' formulas under the shading policy of docs/design/accuracy.md.
 
     params: {name: value}; a value is a scalar, an RGB triple, or one per sample
     ((N,) or (N, 3)). Missing parameters take the bricks' defaults.

@@ -1,6 +1,6 @@
 """Eval kernels on the device: a BRDF spec's compute kernel in one language, fed samples, read back.
 
-Buffer layout (NOTES.md, "Eval kernel"): binding 0 the samples, 3 vec4s per
+Buffer layout (docs/design/runtime.md, "Eval kernels"): binding 0 the samples, 3 vec4s per
 sample (L, V, N) or 4 with T (xyz; w unused); binding 1 the result, one vec4
 per sample (f_r in xyz); binding 2 a uniform block: uvec4 info (x = sample
 count) then one vec4 per parameter (four per mat4); for kernels that sample

@@ -8,7 +8,7 @@ Hoffman & Baker 2006: "use Ubershader as fallback, shader matrix as a cache". Mo
   requested frames the queue is drained and one more frame is drawn (`steady`): it uses no
   ubershader.
 
-Placement (documented in NOTES.md, "Renderer"): read from the placement file beside the scene,
+Placement (documented in docs/design/scenes.md, "Placement"): read from the placement file beside the scene,
 SCENE.placement.toml (:func:`placement_path`, schema in :func:`load_placement`: per object a mesh,
 translate, scale, rotate_y; an optional camera); without one, each object is a unit UV sphere,
 the objects stand in a row along x, 2.5 apart, in scene order, and the camera looks at the row's
@@ -290,7 +290,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         mesh_of = [meshes[k] for k in key_of]
         # One bilinear sampler for every texture, shadow maps included: the one tap of the shadow brick then
         # compares against depth averaged over 2×2 texels, which with one bias is what keeps a point
-        # light's perspective map free of acne here (a nearest sampler acnes: NOTES.md, "Renderer").
+        # light's perspective map free of acne here (a nearest sampler acnes: docs/design/runtime.md, "The renderer").
         textures, sampler = _textures(device, lib), device.sampler()
         owned += [textures, sampler]
         vk = device.vk
@@ -311,7 +311,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     frag = spv[(f"{tag}{variant}", "frag")]
                 else:
                     spec = {SPEC_VARIANT: variant}
-            sf = perms[tag].surface if tag in perms else None  # the ubershader: no surface state (NOTES.md)
+            sf = perms[tag].surface if tag in perms else None  # the ubershader: no surface state (docs/design/runtime.md)
             p = gx.GraphicsPipeline(device, target, spv[(tag, "vert")], frag, iface.vertex_inputs,
                                     gx.layouts_from_interface(iface), cache=cache, specialization=spec,
                                     cull_back=tag in single_sided, blend=sf is not None and sf.alpha == "blend")
@@ -462,7 +462,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, sampler_of(t)
             draws.append((h, spec, ub, mesh_of[i]))
 
-        # blended surfaces after the opaque ones, in scene order otherwise (no sorting by depth: NOTES.md)
+        # blended surfaces after the opaque ones, in scene order otherwise (no sorting by depth: docs/design/runtime.md)
         draws.sort(key=lambda d: perms[d[0]].surface.alpha == "blend")
         specialized: dict[str, object] = {}
         order = list(dict.fromkeys(h for h, _, _, _ in draws))  # first use

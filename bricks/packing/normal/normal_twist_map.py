@@ -22,7 +22,7 @@ through squares or through products symmetric under T → −T (Ward 1992 eq. 5a
 half-plane so that filtering does not cancel them.
 
 Isotropic BRDFs: `tangent` is called only when the BRDF reads the tangent frame (T, B, HdotT, …);
-otherwise the twist channels are not read and the permutation equals `normal_map_xy`'s (NOTES.md
+otherwise the twist channels are not read and the permutation equals `normal_map_xy`'s (docs/design/library.md
 "Tangent frame").
 
 Guards (`tangent`):

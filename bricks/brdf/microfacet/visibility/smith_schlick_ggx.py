@@ -4,7 +4,7 @@ G = (n.l / ((n.l)(1 - k) + k)) (n.v / ((n.v)(1 - k) + k)) (Schlick 1994; RTR3 eq
 k = alpha / 2 (Karis 2013, "Real Shading in Unreal Engine 4", the Schlick G1 fitted to Smith GGX
 for alpha the GGX roughness; ACCURACY-FACTS §4.11). Divided by 4 (n.l)(n.v), the cosines cancel:
 V = 1 / (4 ((n.l)(1-k)+k) ((n.v)(1-k)+k)).
-The project's smith_schlick keeps k = alpha sqrt(2/pi) (Schlick's Beckmann fit; NOTES.md).
+The project's smith_schlick keeps k = alpha sqrt(2/pi) (Schlick's Beckmann fit; docs/design/accuracy.md).
 Error against exact separable Smith GGX (smith_ggx_separable), measured in float64
 (tests/test_library_fillers.py): max |G1 - G1_exact| = 0.140 at alpha = 0.1 (at n.x = 0.104),
 0.100 at 0.3, 0.066 at 0.5, and 0 at alpha = 1 (k = 1/2 makes Schlick's G1 = 2c/(1 + c), the exact
