@@ -48,15 +48,13 @@ def packings(lib, brdf: str) -> list[str]:
     """The packings a material of this BRDF may have: constants and albedo_texture with every normal filler, kept
     where scene loading accepts them (spec/constraints.py): albedo_texture only for a BRDF that reads rho_d,
     and only normals that carry the tangent for a BRDF that reads the tangent frame. Each term is parsed once."""
-    from generator.spec.constraints import reads_tangent
-    from generator.spec.permutation import parse_brdf
-    from generator.spec.params import spec_params
+    from generator.spec.resolve import resolve_brdf
     normals = [b.id for b in sorted(lib.of_kind("normal"), key=lambda b: b.id)]
     tangent, params = False, set()
     for term in brdf.split("+"):  # a BRDF is diffuse + specular terms; fillers have no '+'
         if term not in _TERMS:
-            nodes = parse_brdf(term, lib)
-            _TERMS[term] = (bool(reads_tangent(nodes)), set(spec_params(nodes)))
+            r = resolve_brdf(term, lib)
+            _TERMS[term] = (bool(r.tangent), set(r.params))
         tangent, params = tangent or _TERMS[term][0], params | _TERMS[term][1]
     if tangent:
         normals = [n for n in normals if any(p.name in ("T", "B") for f in lib.get("normal", n).entries
