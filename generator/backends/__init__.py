@@ -1,8 +1,10 @@
-"""The back ends: one package per language (glsl/, hlsl/, wgsl/, gl/ for the GL dialects, numpy/), each an
-emitter behind generator.backends.base.Target, and the registry of them (TARGETS, get_target, LANGUAGES).
+"""The back ends: one package per language (glsl/, hlsl/, wgsl/, gl/ for the GL dialects, numpy/), each with
+its emitter (behind generator.backends.base.Target), its keyword table, its Jinja templates and its part of the
+template context (context.py: a generator.backends.language.Language), and the registry of them here.
 
 GLSL, HLSL and WGSL share the tree walk in clike/; the NumPy back end is imported only when asked
-for, so the shader back ends need nothing beyond the standard library.
+for, so the shader back ends need nothing beyond the standard library. A shading language is added
+by adding its package and its line in _SHADING below.
 """
 from __future__ import annotations
 
@@ -10,16 +12,29 @@ import importlib.util
 from pathlib import Path
 
 from .base import Emitted, Target
-from .glsl.emit import GlslHalfTarget, GlslTarget
-from .hlsl.emit import HlslHalfTarget, HlslTarget
-from .wgsl.emit import WgslHalfTarget, WgslTarget
+from .gl.context import DIALECTS as _DIALECTS
+from .glsl.context import LANGUAGE as _GLSL
+from .hlsl.context import LANGUAGE as _HLSL
+from .language import Language
+from .wgsl.context import LANGUAGE as _WGSL
 
-TARGETS: dict[str, Target] = {"glsl": GlslTarget(), "hlsl": HlslTarget(), "wgsl": WgslTarget()}
+_SHADING: tuple[Language, ...] = (_GLSL, _HLSL, _WGSL)  # in output order
+LANGUAGES: tuple[str, ...] = tuple(lang.name for lang in _SHADING)  # the shading languages
+# the platform dialects composed beside them ("gl": GLSL 4.50 core for OpenGL, "essl": GLSL ES 3.10)
+DIALECTS: dict[str, Language] = dict(_DIALECTS)
+TARGETS: dict[str, Target] = {lang.name: lang.full for lang in _SHADING}
 # fp16 variants: the brick language's float is the language's 16-bit float (half arithmetic, not only storage)
-HALF_TARGETS: dict[str, Target] = {"glsl": GlslHalfTarget(), "hlsl": HlslHalfTarget(), "wgsl": WgslHalfTarget()}
-LANGUAGES: tuple[str, ...] = ("glsl", "hlsl", "wgsl")  # the shading languages, in output order
+HALF_TARGETS: dict[str, Target] = {lang.name: lang.half for lang in _SHADING}
 # Template names start with a folder ("glsl/fragment.glsl.j2"): the back-end package whose templates/ holds the file.
-TEMPLATE_PACKAGES: dict[str, str] = {folder: f"{__name__}.{folder}" for folder in ("glsl", "hlsl", "wgsl", "gl")}
+TEMPLATE_PACKAGES: dict[str, str] = {lang.folder: lang.package for lang in (*_SHADING, *DIALECTS.values())}
+
+
+def language(name: str) -> Language:
+    """The templates and template context of shading language or platform dialect `name`."""
+    found = next((lang for lang in _SHADING if lang.name == name), None) or DIALECTS.get(name)
+    if found is None:
+        raise ValueError(f"unknown language '{name}' (known: {', '.join([*LANGUAGES, *DIALECTS])})")
+    return found
 
 
 def template_root(folder: str) -> Path:
@@ -72,9 +87,8 @@ def get_target(name: str, precision: str = "fp32") -> Target:
     try:
         return TARGETS[name]
     except KeyError:
-        raise ValueError(f"unknown target '{name}' (known: glsl, hlsl, numpy, wgsl)") from None
+        raise ValueError(f"unknown target '{name}' (known: {', '.join(sorted({*TARGETS, 'numpy'}))})") from None
 
 
-__all__ = ["Emitted", "Target", "TARGETS", "HALF_TARGETS", "LANGUAGES", "TEMPLATE_PACKAGES", "get_target",
-           "template_file", "template_name", "GlslTarget", "HlslTarget",
-           "WgslTarget", "GlslHalfTarget", "HlslHalfTarget", "WgslHalfTarget"]
+__all__ = ["DIALECTS", "Emitted", "HALF_TARGETS", "LANGUAGES", "Language", "TARGETS", "TEMPLATE_PACKAGES", "Target",
+           "get_target", "language", "parse_languages", "template_file", "template_name"]

@@ -14,11 +14,10 @@ from dataclasses import dataclass, field
 import jinja2
 
 from .. import __version__
-from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link import EvalProgram, Interface, LinkedPermutation, Slot, eval_program, link_permutation
 from ..spec.permutation import Permutation
-from ..backends import LANGUAGES, TEMPLATE_PACKAGES, get_target, template_file
+from ..backends import LANGUAGES, TEMPLATE_PACKAGES, Language, language, template_file
 from ..backends.base import Emitted
 
 _LOADED: set[str] = set()  # every template file this process has read (for depfiles)
@@ -94,10 +93,9 @@ def _template_hash(name: str) -> str:
     return hashlib.sha256(template_file(name).read_bytes()).hexdigest()[:12]
 
 
-def _templates_used(lang: str, main: str) -> dict[str, str]:
-    """The template and the macros it imports, with their hashes (for provenance and cache keys)."""
-    names = [main, f"{lang}/macros.{lang}.j2"]
-    return {n: _template_hash(n) for n in names}
+def _templates_used(lang: Language, main: str) -> dict[str, str]:
+    """The template and the templates it imports, with their hashes (for provenance and cache keys)."""
+    return {n: _template_hash(n) for n in (main, *lang.imports)}
 
 
 LINE_RESET = "//@line-reset"
@@ -143,18 +141,18 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram |
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates = {}
     sources = []
-    for lang in languages:
-        target = get_target(lang, precision)
+    for lang in map(language, languages):
+        target = lang.target(precision)
         emitted = target.emit(prog.structs, prog.functions)
         emitted, entry = target.entry32(emitted, _function(prog, ep.entry))  # fp16: a 32-bit wrapper
-        tname = f"{lang}/eval.{lang}.j2"
+        tname = lang.template("eval")
         used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance("eval", canon, h, bricks, used),
                "params": ep.slots, "param_vec4s": max(ep.param_vec4s, 1), "tangent": ep.tangent,
                "brdf": entry, "switch": ep.entry == "brdf_switch",
                "textures": ep.interface.textures}
-        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
+        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
     return Composed(canon, h, sources, bricks, templates, ep.interface)
 
 
@@ -187,18 +185,18 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
     surface = iface.surface
     layout_ = ["P", "Ng", "V"] + (["T"] if "T" in surface else []) + (["uv"] if "uv" in surface else [])
     templates, sources = {}, []
-    for lang in languages:
-        target = get_target(lang, perm.precision)
+    for lang in map(language, languages):
+        target = lang.target(perm.precision)
         emitted = target.emit(prog.structs, prog.functions, prog.globals)
         emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
-        tname = f"{lang}/shade.{lang}.j2"
+        tname = lang.template("shade")
         used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance("shade kernel", perm.canonical(), h, bricks, used),
                "inputs": surface, "samples": layout_, "call_args": _call_args(lp), "shade": shade,
                "material_vec4s": iface.block("Material").members[-1]["size"] // 16,
                "light_vec4s": iface.block("Lights").members[-1]["size"] // 16, "uber": False}
-        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
+        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
     return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
 
 
@@ -214,39 +212,33 @@ def compose_permutation(perm: Permutation | LinkedPermutation, lib: Library, lan
     templates = {}
     sources = []
     for lang in languages:
-        sources += _stage_sources(perm, lp, get_target(lang, perm.precision), lang, lang, "permutation",
-                                  get_target(lang), bricks, templates)
+        sources += _stage_sources(perm, lp, language(lang), "permutation", bricks, templates)
     extra = []
-    if dialects:
-        from ..backends.gl.emit import DIALECTS, gl_bindings
-        for d in dialects:  # the platform dialects (gl/templates/, with the Vulkan GLSL's macros)
-            extra += _stage_sources(perm, lp, DIALECTS[d](gl_bindings(iface.blocks, iface.textures), perm.precision),
-                                    "gl", d, f"permutation ({d})", get_target("glsl"), bricks, templates,
-                                    also=("glsl/macros.glsl.j2",))
+    for d in dialects:  # the platform dialects (GL's: gl/templates/, with the Vulkan GLSL's macros)
+        extra += _stage_sources(perm, lp, language(d), f"permutation ({d})", bricks, templates)
     return Composed(perm.canonical(), perm.hash, sources, bricks, templates, iface, material=lp.material,
                     lights=lp.lights, dialects=extra)
 
 
-def _stage_sources(perm, lp, target, tdir: str, ext: str, label: str, spelling, bricks, templates,
-                   also=()) -> list[Source]:
-    """A permutation's vertex and fragment shaders from template <tdir>/<stage>.<tdir>.j2 through `target`
-    (sources named <hash>.<vert|frag>.<ext>); `also`: templates the skeletons import from other folders;
-    `spelling`: the target whose type names the templates spell built-in types with."""
+def _stage_sources(perm, lp, lang: Language, label: str, bricks, templates) -> list[Source]:
+    """A permutation's vertex and fragment shaders in language or dialect `lang` (sources named
+    <hash>.<vert|frag>.<lang.name>); the templates used and their hashes go into `templates`."""
     prog, iface, h = lp.program, lp.interface, perm.hash
     mat, lights = iface.block("Material"), iface.block("Lights")
+    target = lang.target(perm.precision, iface)
     emitted = target.emit(prog.structs, prog.functions, prog.globals)
     emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
     call_args = _call_args(lp)
     out = []
     for stage in ("vertex", "fragment"):
-        tname = f"{tdir}/{stage}.{tdir}.j2"
-        used = {**_templates_used(tdir, tname), **{t: _template_hash(t) for t in also}}
+        tname = lang.template(stage)
+        used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance(label, perm.canonical(), h, bricks, used),
                "inputs": iface.surface, "material_vec4s": mat.members[-1]["size"] // 16 if mat else 0,
                "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
                "textures": iface.textures, "call_args": call_args, "shade": shade, "surface": perm.surface,
-               "iface": iface, "spell": lambda name, _t=spelling: _t.type_name(BUILTIN_TYPES[name])}
+               "iface": iface, **lang.context()}
         out.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
-                           f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{ext}"))
+                           f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang.name}"))
     return out

@@ -3,15 +3,12 @@ from __future__ import annotations
 
 import hashlib
 
-from ..lang.types import BUILTIN_TYPES
 from ..library.bricks import Library
 from ..link.uber import Uber, link_ubershader
 from ..spec.permutation import Permutation
-from ..backends import LANGUAGES, get_target
+from ..backends import LANGUAGES, language
 from ..backends.base import Emitted
 from . import Composed, _function, _provenance, _render, _templates_used
-
-MATERIAL_INDEX = {"glsl": "draw.material.x", "hlsl": "draw_material.x", "wgsl": "draw.material.x"}
 
 
 def uber_key(perms: list[Permutation]) -> str:
@@ -51,19 +48,18 @@ def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAG
     bricks = {p: b.module.source_hash for p, b in prog.bricks.items()}
     templates, sources = {}, []
     precision = _precision(perms)
-    for lang in languages:
-        target = get_target(lang, precision)
+    for lang in map(language, languages):
+        target = lang.target(precision)
         emitted = target.emit(prog.structs, prog.functions, prog.globals)
         emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
-        for stage, tname in (("vertex", f"{lang}/vertex.{lang}.j2"), ("fragment", f"{lang}/ubershader.{lang}.j2")):
+        for stage, tname in (("vertex", lang.template("vertex")), ("fragment", lang.template("ubershader"))):
             used = _templates_used(lang, tname)
             templates.update(used)
             ctx = {"provenance": _provenance("ubershader", f"{len(perms)} permutations", h, bricks, used),
                    "inputs": iface.surface, "textures": iface.textures, "shade": shade,
-                   "call_args": _call_args(u, MATERIAL_INDEX[lang]), "iface": iface,
-                   "spell": lambda name, _t=get_target(lang): _t.type_name(BUILTIN_TYPES[name])}
+                   "call_args": _call_args(u, lang.material_index), "iface": iface, **lang.context()}
             sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
-                                   f"ubershader.{'frag' if stage == 'fragment' else 'vert'}.{lang}"))
+                                   f"ubershader.{'frag' if stage == 'fragment' else 'vert'}.{lang.name}"))
     return Composed(key, h, sources, bricks, templates, iface), u
 
 
@@ -82,15 +78,15 @@ def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUA
     layout_ = ["P", "Ng", "V"] + (["T"] if "T" in u.surface else []) + (["uv"] if "uv" in u.surface else [])
     templates, sources = {}, []
     precision = _precision(perms)
-    for lang in languages:
-        target = get_target(lang, precision)
+    for lang in map(language, languages):
+        target = lang.target(precision)
         emitted = target.emit(prog.structs, prog.functions, prog.globals)
         emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
-        tname = f"{lang}/shade.{lang}.j2"
+        tname = lang.template("shade")
         used = _templates_used(lang, tname)
         templates.update(used)
         ctx = {"provenance": _provenance("ubershader kernel", f"{len(perms)} permutations", h, bricks, used),
                "inputs": u.surface, "samples": layout_, "call_args": _call_args(u, None), "shade": shade,
                "material_vec4s": 1, "light_vec4s": 1, "uber": True}
-        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang}"))
+        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
     return Composed(key, h, sources, bricks, templates, iface), u
