@@ -9,6 +9,7 @@ against the tools themselves.
 """
 from __future__ import annotations
 
+import dataclasses
 import re
 import subprocess
 from pathlib import Path
@@ -265,6 +266,23 @@ def test_wgsl_line_map_covers_functions_and_statements(module):
         n = next(i for i, line in enumerate(lines, 1) if needle in line)
         assert mapped(emitted.line_map, n) == (BRICK, brick_line(brick_text)), needle
     assert [gen for gen, _, _ in emitted.line_map] == sorted(gen for gen, _, _ in emitted.line_map)
+
+
+def test_emitters_keep_their_records_of_functions_not_the_ir(module):
+    """A C-like emitter replays a function it emitted before (linked functions are shared by every program of
+    a library) from its own records: the IR functions hold only their fields, and the replay is the same text."""
+    from generator.backends.clike.walk import CLikeTarget
+    functions = list(module.functions.values())
+    for lang in LANGS:
+        first = emit(module, lang)
+        again = emit(module, lang)
+        assert (again.text, again.line_map) == (first.text, first.line_map)
+    fields = {f.name for f in dataclasses.fields(ir.Function)}
+    for f in functions:
+        assert set(vars(f)) == fields, sorted(set(vars(f)) - fields)
+    assert all(CLikeTarget.records.of(f) for f in functions)  # each function was recorded, by the emitters
+    copy = ir.clone(functions[0])
+    assert not CLikeTarget.records.of(copy)  # a copy is another function: it has no record of its own yet
 
 
 def test_reserved_words_are_renamed_identically_in_every_target(module):

@@ -310,8 +310,7 @@ def clone(node):
     these trees, about 4× faster (the link stage copies every brick function it links)."""
     if isinstance(node, (Expr, Stmt, Function, Param)):
         new = object.__new__(type(node))
-        # an emitter's record of a function (backends/clike/walk.py) is of that function, not of its copies
-        new.__dict__.update({k: clone(v) for k, v in node.__dict__.items() if k != "_emitted"})
+        new.__dict__.update({k: clone(v) for k, v in node.__dict__.items()})
         return new
     if isinstance(node, list):
         return [clone(x) for x in node]

@@ -19,6 +19,7 @@ from ...lang.types import BUILTIN_TYPES, Type
 from . import reserved
 from ..base import Emitted
 from .control import ControlMixin, wrap  # noqa: F401  (wrap: re-exported)
+from .records import FunctionRecords
 from .resources import ResourceMixin
 
 INDENT = "    "
@@ -82,6 +83,10 @@ class CLikeTarget(ControlMixin, ResourceMixin):
     # *Half subclasses); what crosses the interface (uniforms, buffers, samples, textures, stage
     # inputs and outputs) stays 32-bit and is converted where brick code meets it (from32/to32).
     precision = "fp32"
+    # What every C-like emitter emitted for each linked function (records.py), keyed by emitter class and writer
+    # state: one store for all of them, so a dialect emitter made per program replays what an earlier one of its
+    # class emitted.
+    records = FunctionRecords()
 
     # ---- tables a subclass fills in
     SCALARS: dict[str, str] = {}    # brick scalar -> spelling
@@ -257,11 +262,11 @@ class CLikeTarget(ControlMixin, ResourceMixin):
         return Emitted(w.text(), w.line_map)
 
     def _function_cached(self, w: Writer, f: ir.Function) -> None:
-        """self.function(w, f), replayed from the function's own record when this target has emitted it
-        before from the same writer state (linked brick functions are shared by every program of a library,
-        and never change: link/program.py); the bytes are the same, the walk is skipped."""
+        """self.function(w, f), replayed from this emitter class's record of `f` when it has emitted it before
+        from the same writer state (linked brick functions are shared by every program of a library, and never
+        change: link/program.py); the bytes are the same, the walk is skipped."""
         key = (type(self), w.directives, w._next, w.depth)
-        memo = f.__dict__.setdefault("_emitted", {})
+        memo = self.records.of(f)
         hit = memo.get(key)
         if hit is not None:
             lines, mapped, end = hit
