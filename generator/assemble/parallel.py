@@ -6,24 +6,20 @@ per worker) and its SPIR-V analysed in a worker process; the building process wr
 chunk order, as they come back. So N processes do the Python work that one did before, and a build is
 no longer limited by the building process (benchmarks/results/build.md).
 
-Workers are started by a forkserver (never a fork of this process, which has threads), with this
-process's environment, and receive the Library pickled: every worker composes from exactly the bricks
+The workers (assemble/workers.py: a pool the build can end at once, on Ctrl-C, SIGTERM or a dead worker) are
+started by a forkserver (never a fork of this process, which has threads), with this process's environment,
+and receive the Library pickled: every worker composes from exactly the bricks
 this build parsed, not from files that may have changed since. Results are pure functions of their
 inputs, so the output is byte-identical for any N (tested), and the build's counts are the same: a
 shader is counted distinct, cached or compiled where it first appears in chunk order.
 """
 from __future__ import annotations
 
-import multiprocessing
-from concurrent.futures import ProcessPoolExecutor
-from concurrent.futures.process import BrokenProcessPool
 import os
 import pickle
 import shutil
 import sys
 import tempfile
-import threading
-import time
 
 from ..io import Store, sha256, show_progress
 from ..lang import SourceError
@@ -31,10 +27,11 @@ from ..lang.errors import EnvironmentMissing, UserError
 from ..library import bricks as _bricks
 from ..toolchain import CompileStats, cache_key, compile_many
 from ..toolchain.scenes import source_jobs
+from .workers import Workers
 
 MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than it saves (measured: ~1.4 s at 36)
-# multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted: the pool's
-# queues, which it then removes itself. Noise to whoever pressed Ctrl-C: its process starts with this filter.
+# multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted (the progress
+# bar's lock), which it then removes itself. Noise to whoever pressed Ctrl-C: its process starts with this filter.
 _QUIET_TRACKER = "ignore::UserWarning:multiprocessing.resource_tracker"
 _PRELOAD = ["generator.assemble.parallel", "generator.compose", "generator.analysis", "jinja2"]
 _WORKER: dict = {}  # this worker's library, store and languages (set by _start)
@@ -45,42 +42,13 @@ def chunk_size(permutations: int, workers: int) -> int:
     return max(4, min(64, -(-permutations // (workers * 8))))
 
 
-def _start(build: int, lib_bytes: bytes, env: dict, store_root: str | None, languages: tuple,
-           dialects: tuple = ()) -> None:
-    import signal
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole process group: the build ends the workers
-    _watch(build)
+def _start(lib_bytes: bytes, env: dict, store_root: str | None, languages: tuple, dialects: tuple = ()) -> None:
     os.environ.clear()
     os.environ.update(env)
     lib = pickle.loads(lib_bytes)
     lib.memo, lib.serial = {}, next(_bricks._SERIALS)  # this process's own caches
     _WORKER.update(lib=lib, store=Store(store_root) if store_root else None, languages=languages,
                    dialects=dialects)
-
-
-def _watch(build: int) -> None:
-    """End this worker as soon as the build that started it is gone (killed with -9: nobody will read what the
-    worker computes, and it would print a broken pipe when it tried to send it)."""
-    def gone() -> bool:
-        try:
-            with open(f"/proc/{build}/stat", "rb") as f:  # a zombie (killed, not yet reaped) is gone too
-                return f.read().rsplit(b")", 1)[1].split()[0] == b"Z"
-        except FileNotFoundError:
-            return True
-        except OSError:  # no /proc: ask the kernel whether the pid exists
-            try:
-                os.kill(build, 0)
-            except ProcessLookupError:
-                return True
-            except PermissionError:
-                pass
-            return False
-
-    def loop() -> None:
-        while not gone():
-            time.sleep(0.25)
-        os._exit(1)
-    threading.Thread(target=loop, name="watch-build", daemon=True).start()
 
 
 def _task(items: list, extra: list) -> tuple:
@@ -113,17 +81,6 @@ def _task(items: list, extra: list) -> tuple:
     return composed, errors, results, costs, keys, stats.fresh, loaded_templates()
 
 
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """End the workers now: done, failed or interrupted, no queued chunk runs (shutdown alone would let the running
-    ones finish, and an error or Ctrl-C should not wait for them)."""
-    workers = list(getattr(pool, "_processes", {}).values())  # the executor keeps no public handle on them
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in workers:
-        p.terminate()
-    for p in workers:
-        p.join()
-
-
 def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=(), workers: int = 2,
                            on_done=None, costs: dict | None = None, templates: set | None = None, dialects=()):
     """toolchain.scenes.compile_scene's contract, in `workers` processes; also fills `costs` (SPIR-V sha256 ->
@@ -140,12 +97,8 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     seen: set[str] = set()  # the cache keys of every job
     fresh: set[str] = set()  # those some worker compiled (the others came from the cache)
 
-    def take(task) -> dict:
-        try:
-            c, errs, part, cost, keys, compiled, read = task.result()
-        except BrokenProcessPool:
-            raise UserError("a worker process of the build died (killed, or out of memory) — build again, or with "
-                            "fewer jobs (-j)") from None
+    def take(value) -> dict:
+        c, errs, part, cost, keys, compiled, read = value
         composed.update(c)
         errors.update(errs)
         results.update(part)
@@ -163,27 +116,27 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     lib_bytes = pickle.dumps(type(lib)(bricks=lib.bricks, errors=lib.errors))  # no memo: workers link their own
     if _QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its resource tracker
         sys.warnoptions.append(_QUIET_TRACKER)
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(_PRELOAD)  # imported once, by the forkserver: each worker starts as a fork of it
-    # an executor, so that a worker that dies fails the build (BrokenProcessPool) instead of losing its task
-    pool = ProcessPoolExecutor(
-        workers, mp_context=context, initializer=_start,
-        initargs=(os.getpid(), lib_bytes, dict(os.environ), str(store.root) if store else private, tuple(languages),
-                  tuple(dialects)))
+    init = (lib_bytes, dict(os.environ), str(store.root) if store else private, tuple(languages), tuple(dialects))
+    # the ubershader's large shaders first, one task each: they spread over the workers
+    tasks = [([], [job]) for job in extra] + [(chunk, []) for chunk in chunks]
+    done: dict[int, tuple] = {}  # chunks back before an earlier one: written when it is
+    following = 0  # the next chunk to write
     try:
-        with tqdm(total=len(items), disable=not show_progress(), unit="permutation", leave=False) as bar:
-            # the ubershader's large shaders first, one task each: they spread over the workers
-            uber = [pool.submit(_task, [], [job]) for job in extra]
-            tasks = [pool.submit(_task, chunk, []) for chunk in chunks]
-            for chunk, task in zip(chunks, tasks):  # written in chunk order, each as soon as it is back
-                part = take(task)
-                if on_done is not None:
-                    on_done([(h, composed[h]) for h, _ in chunk if h in composed], part)
-                bar.update(len(chunk))
-            for task in uber:
-                take(task)
+        with Workers(workers, _start, init, _task, _PRELOAD) as pool, \
+                tqdm(total=len(items), disable=not show_progress(), unit="permutation", leave=False) as bar:
+            for k, value in pool.unordered(tasks):
+                if k < len(extra):
+                    take(value)
+                    continue
+                done[k - len(extra)] = value
+                while following in done:  # written in chunk order, each as soon as it and those before are back
+                    part = take(done.pop(following))
+                    chunk = chunks[following]
+                    if on_done is not None:
+                        on_done([(h, composed[h]) for h, _ in chunk if h in composed], part)
+                    bar.update(len(chunk))
+                    following += 1
     finally:
-        _stop(pool)
         if private is not None:
             shutil.rmtree(private, ignore_errors=True)
     # counted once per distinct shader, whichever worker got it first: the same counts for any N and any timing
