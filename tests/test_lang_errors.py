@@ -97,8 +97,9 @@ def test_valid_constructs_type_check():
 
 def test_a_long_call_chain_is_one_error_and_recursion_still_is_named():
     """A 3,000-deep chain of helpers overflowed Python's stack in the recursion check (a traceback); chains are
-    limited to MAX_CALL_DEPTH, checked without recursion, and recursion is still named with its cycle."""
-    from generator.lang.parse import MAX_CALL_DEPTH
+    limited to MAX_CALL_DEPTH, checked without recursion, and recursion is still named with its cycle. (A brick
+    holds at most MAX_STATEMENTS statements now, two per helper here: the longest chain it can hold is tried.)"""
+    from generator.lang.parse import MAX_CALL_DEPTH, MAX_STATEMENTS
 
     def chain(n: int) -> str:
         src = 'BRICK = {"kind": "test"}\n'
@@ -108,7 +109,7 @@ def test_a_long_call_chain_is_one_error_and_recursion_still_is_named():
     parse_module(chain(MAX_CALL_DEPTH), "ok.py")
     with pytest.raises(SourceError, match=rf"long\.py:\d+:1: function 'f\d+' starts a chain of {MAX_CALL_DEPTH + 1} "
                                           rf"nested calls, more than the {MAX_CALL_DEPTH} allowed — "):
-        parse_module(chain(3000), "long.py")
+        parse_module(chain(MAX_STATEMENTS // 2 - 1), "long.py")
     cyc = 'BRICK = {"kind": "test"}\ndef a(x: float) -> float:\n    return b(x)\n' \
           'def b(x: float) -> float:\n    return a(x)\n'
     with pytest.raises(SourceError, match=r"recursion: a -> b -> a — "):

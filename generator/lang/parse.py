@@ -14,7 +14,7 @@ import re
 from dataclasses import dataclass
 
 from . import ir
-from .errors import SourceError
+from .errors import SourceError, position
 from .intrinsics import CONSTANTS
 from .annotations import check_identifier, parse_type
 from .typecheck import Checker
@@ -38,37 +38,96 @@ def _err(path, node, message, hint=""):
     return SourceError(loc.path, loc.line, loc.col, message, hint)
 
 
-MAX_DEPTH = 100  # syntax nesting (expressions and statements) a brick may have: README, "The brick language"
+# Bounds on a brick's syntax, each far above any real brick (measured over bricks/ and the test bricks): the
+# type checker, the link stage and the emitters walk trees recursively, and the time to link, emit and compile a
+# brick grows with its size (a brick of 100,000 statements kept `build` busy past 60 s; one of 1,000 short
+# statements builds in about 6 s). docs/design/language.md lists them.
+MAX_DEPTH = 100  # syntax nesting, expressions and statements: the deepest shipped brick is 13 (gotanda_fitted)
+MAX_STATEMENTS = 1000  # statements in a brick: the longest shipped brick has 27 (conductor_exact), test bricks 133
+MAX_NODES = 20000  # syntax nodes in a brick: the largest shipped brick has 612 (gotanda_fitted), test bricks 1,946
+MAX_BRICK_BYTES = 1 << 20  # a brick file: the largest shipped one is 5,954 bytes; Python's parser needs ~1 s per MiB
+WHY_DEPTH = "a limit far above any real brick, which keeps the tree walks of this tool and the compilers bounded"
+WHY_SIZE = "a limit far above any real brick, which bounds the time to link, emit and compile it"
 
 
-def _check_depth(tree: ast.AST, path: str) -> None:
-    """A brick nested deeper than MAX_DEPTH is one located error (the type checker, the link stage and the
-    emitters walk trees recursively; a 500-term sum would exhaust Python's stack)."""
+def _check_size(tree: ast.AST, path: str) -> None:
+    """A brick nested deeper than MAX_DEPTH, or with more than MAX_STATEMENTS statements or MAX_NODES syntax
+    nodes, is one located error. `a and b and c` is one node in Python's tree but a chain of binary operations in
+    the IR (each operand one level deeper), so a BoolOp of n operands counts n - 1 levels. An explicit stack: the
+    check itself has no depth limit."""
     stack = [(tree, 0, 1, 1)]
+    statements = nodes = 0
     while stack:
         node, depth, line, col = stack.pop()
         line, col = getattr(node, "lineno", line), getattr(node, "col_offset", col - 1) + 1  # operators: the parent's
-        if depth > MAX_DEPTH:
-            raise SourceError(path, line, col, f"this expression is nested more than {MAX_DEPTH} deep",
-                              "split it into locals (a sum of many terms: add them a few at a time)")
-        stack.extend((child, depth + 1, line, col) for child in ast.iter_child_nodes(node))
+        nodes += 1
+        if isinstance(node, ast.stmt):
+            statements += 1
+            if statements > MAX_STATEMENTS:
+                raise SourceError(path, line, col, f"the brick has more than {MAX_STATEMENTS} statements ({WHY_SIZE})",
+                                  "split it into several bricks, or compute in loops")
+        if nodes > MAX_NODES:
+            raise SourceError(path, line, col, f"the brick has more than {MAX_NODES} syntax nodes ({WHY_SIZE})",
+                              "split it into several bricks, or compute in loops")
+        step = depth + 1 + (len(node.values) - 1 if isinstance(node, ast.BoolOp) else 0)
+        below = list(ast.iter_child_nodes(node))
+        if below and step > MAX_DEPTH:  # at the node whose operands are one level too deep (a BoolOp: its start)
+            raise SourceError(path, line, col, f"this expression or statement is nested more than {MAX_DEPTH} deep "
+                              f"({WHY_DEPTH})", "split it into locals (a sum of many terms, a chain of and/or: "
+                              "combine a few at a time)")
+        stack.extend((child, step, line, col) for child in below)
+
+
+# What Python's parser cannot take: a NUL (3.11.2 raises ValueError, later 3.11 releases SyntaxError) and a lone
+# surrogate (a str handed in, not read from a file: UTF-8 decoding refuses those).
+_UNPARSABLE = re.compile("[\x00\ud800-\udfff]")
+
+
+def _densest_line(text: str) -> tuple[int, int]:
+    """Where Python's parser most likely gave up: the start of the logical line holding the most tokens."""
+    import io
+    import tokenize
+    best, most, count, start = (1, 0), 0, 0, None
+    try:
+        for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+            if start is None and tok.type not in (tokenize.INDENT, tokenize.DEDENT, tokenize.NL, tokenize.COMMENT):
+                start = tok.start
+            count += 1
+            if tok.type in (tokenize.NEWLINE, tokenize.ENDMARKER):
+                if count > most and start is not None:
+                    best, most = start, count
+                count, start = 0, None
+    except (tokenize.TokenError, SyntaxError, RecursionError, MemoryError):
+        pass
+    return best[0], best[1] + 1
 
 
 def _syntax_tree(text: str, path: str) -> ast.Module:
     import warnings
+    bad = _UNPARSABLE.search(text)
+    if bad:
+        line, col = position(text, bad.start())
+        if bad.group() == "\x00":
+            head = text[:200]  # every other byte NUL: UTF-16 text of ASCII characters
+            utf16 = len(head) >= 8 and head.count("\x00") * 3 >= len(head)
+            raise SourceError(path, line, col, "a NUL character" + (" (the file looks UTF-16)" if utf16 else ""),
+                              "save the brick as UTF-8 text" if utf16 else "remove it: a brick is UTF-8 text")
+        raise SourceError(path, line, col, f"a lone surrogate U+{ord(bad.group()):04X}", "a brick is UTF-8 text")
     try:
         with warnings.catch_warnings():  # Python's warnings about its own syntax (an invalid escape in a docstring)
             warnings.simplefilter("ignore", SyntaxWarning)
             warnings.simplefilter("ignore", DeprecationWarning)
             tree = ast.parse(text, filename=path)
-        _check_depth(tree, path)
-        return tree
-    except SyntaxError as e:
+    except SyntaxError as e:  # "too many nested parentheses" and indentation levels among them, located
         raise SourceError(path, e.lineno or 1, e.offset or 1, f"syntax error: {e.msg}",
                           "a brick is written in a small typed subset of Python syntax") from None
-    except (RecursionError, MemoryError):  # Python's own parser gives up on a 10,000-term expression
-        raise SourceError(path, 1, 1, "an expression is too long or too deeply nested to parse",
-                          "split it into locals of a few terms each") from None
+    except (RecursionError, MemoryError, ValueError) as e:  # the parser's own stack: a 10,000-term sum
+        line, col = _densest_line(text)
+        what = "an expression is too long or too deeply nested to parse" if not isinstance(e, ValueError) \
+            else f"Python cannot parse this text ({e})"
+        raise SourceError(path, line, col, what, "split it into locals of a few terms each") from None
+    _check_size(tree, path)
+    return tree
 
 
 def read_meta(text: str, path: str) -> tuple[dict, ir.Loc, str]:
@@ -256,7 +315,7 @@ def _signature(path, f: ast.FunctionDef, structs, constants) -> Signature:
     return Signature(tuple(params), ret)
 
 
-MAX_CALL_DEPTH = 32  # a brick's functions calling each other in a chain: README, "The brick language"
+MAX_CALL_DEPTH = 32  # a brick's functions calling each other in a chain: docs/design/language.md
 
 
 def _reject_recursion(path, functions: dict[str, ir.Function], fdefs) -> None:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..lang import Signature, SourceError, parse_module
-from ..lang.parse import read_meta_node
+from ..lang.parse import MAX_BRICK_BYTES, read_meta_node
 from ..lang.errors import read_text
 from ..lang import ir
 from ..lang.exprs import F32_MAX
@@ -208,7 +208,7 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
                           "control character)", "rename the file or its directory: the path is written into #line "
                           "directives and provenance comments")
     if text is None:
-        text = read_text(path, "brick")
+        text = read_text(path, "brick", MAX_BRICK_BYTES)
     meta, loc, doc, node = read_meta_node(text, shown)
     from .schema import check, key_positions
     check(meta, shown, loc, key_positions(node))  # the shape first (library/schema.py), then the meaning
