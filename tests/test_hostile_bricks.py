@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from generator.lang import SourceError
+from generator.lang import SourceError, ir
 from generator.lang.parse import MAX_BRICK_BYTES, MAX_DEPTH, MAX_NODES, MAX_STATEMENTS
 
 REPO = Path(__file__).resolve().parent.parent
@@ -353,3 +353,24 @@ def test_the_bounds_are_far_above_every_real_brick():
         assert sum(1 for _ in ast.walk(tree)) <= MAX_NODES // 4, p
         assert len(text.encode()) <= MAX_BRICK_BYTES // 16, p
 
+
+# ---------------------------------------------------------------- walks over IR of any depth
+
+def test_clone_and_walk_take_a_tree_of_any_depth():
+    """ir.clone and ir.walk use explicit stacks: a 100,000-deep tree (glue-built IR has no loader bound) is
+    copied and walked, the copy equal and made of new nodes, tuples (a switch's cases) kept tuples."""
+    from generator.lang.types import FLOAT, INT
+
+    loc = ir.Loc("t.py", 1, 1)
+    e = ir.Const(FLOAT, loc, 1.0)
+    for _ in range(100_000):
+        e = ir.Unary(FLOAT, loc, "-", e)
+    copy = ir.clone(e)  # (== on dataclasses recurses: compared node by node)
+    pairs = list(zip(ir.walk(copy), ir.walk(e), strict=True))
+    assert len(pairs) == 100_001 and all(a is not b and type(a) is type(b) for a, b in pairs)
+    assert pairs[-1][0].value == 1.0 and pairs[0][0].op == "-"
+    sw = ir.Switch(loc, ir.Const(INT, loc, 0), [((0, 1), [ir.Return(loc, e)])], [ir.Return(loc, copy)])
+    c = ir.clone(sw)
+    assert c.cases[0][0] == (0, 1) and type(c.cases[0]) is tuple and type(c.cases[0][0]) is tuple
+    assert c.cases[0][1][0] is not sw.cases[0][1][0] and c.cases[0][1][0].value is not e
+    assert [type(n) for n in ir.walk(sw)][:4] == [ir.Switch, ir.Const, ir.Return, ir.Unary]  # pre-order

@@ -293,10 +293,13 @@ def children(node) -> list:
 
 
 def walk(node):
-    """Pre-order walk over a node and everything below it."""
-    yield node
-    for c in children(node):
-        yield from walk(c)
+    """Pre-order walk over a node and everything below it (an explicit stack: no depth limit, and no chain of
+    nested generators that a recursive walk would resume once per level for every node it yields)."""
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        yield n
+        stack.extend(reversed(children(n)))
 
 
 def walk_body(stmts):
@@ -304,18 +307,38 @@ def walk_body(stmts):
         yield from walk(s)
 
 
+_NODES = (Expr, Stmt, Function, Param)
+_COPIED = (Expr, Stmt, Function, Param, list, tuple, dict)
+
+
 def clone(node):
     """A copy of an IR tree (expressions, statements, functions, parameters) in which every node is new and
     types, locations and constants are shared: they are values, never mutated. What copy.deepcopy gives for
-    these trees, about 4× faster (the link stage copies every brick function it links)."""
-    if isinstance(node, (Expr, Stmt, Function, Param)):
-        new = object.__new__(type(node))
-        new.__dict__.update({k: clone(v) for k, v in node.__dict__.items()})
-        return new
-    if isinstance(node, list):
-        return [clone(x) for x in node]
-    if isinstance(node, tuple):
-        return tuple(clone(x) for x in node)
-    if isinstance(node, dict):
-        return {k: clone(v) for k, v in node.items()}
-    return node
+    these trees, several times faster (the link stage copies every brick function it links), and with an
+    explicit stack: a tree of any depth is copied without recursion."""
+    if not isinstance(node, _COPIED):
+        return node
+    out = [None]
+    todo = [(node, out, 0)]  # (original, the container its copy goes into, the key there)
+    tuples = []  # (list of copied items, container, key): made tuples once every item is copied
+    while todo:
+        src, dst, key = todo.pop()
+        if isinstance(src, _NODES):
+            new = object.__new__(type(src))
+            fields = new.__dict__
+            for k, v in src.__dict__.items():
+                fields[k] = v
+                if isinstance(v, _COPIED):
+                    todo.append((v, fields, k))
+        elif isinstance(src, dict):
+            new = dict(src)
+            todo.extend((v, new, k) for k, v in src.items() if isinstance(v, _COPIED))
+        else:
+            new = list(src)
+            todo.extend((v, new, i) for i, v in enumerate(src) if isinstance(v, _COPIED))
+            if isinstance(src, tuple):
+                tuples.append((new, dst, key))
+        dst[key] = new
+    for items, dst, key in reversed(tuples):  # inner tuples were found after the ones holding them
+        dst[key] = tuple(items)
+    return out[0]
