@@ -354,6 +354,41 @@ def test_the_bounds_are_far_above_every_real_brick():
         assert len(text.encode()) <= MAX_BRICK_BYTES // 16, p
 
 
+# ---------------------------------------------------------------- names
+
+COLLISIONS = [  # (id, BRICK metadata, function, line, col, words)
+    ("param-L", '{"kind": "diffuse", "cite": "x", "params": {"L": {"type": "vec3", "default": [0.5, 0.5, 0.5]}}}',
+     "def diffuse(L: vec3) -> vec3:\n    return L\n", 2, 53, "parameter 'L' is named like one of the shading inputs"),
+    ("ndf-param-NdotV", '{"kind": "ndf", "cite": "x", "params": {"NdotV": {"type": "float", "default": 0.5}}}',
+     "def ndf(NdotH: float, NdotV: float) -> float:\n    return NdotH * NdotV\n", 2, 49, "parameter 'NdotV'"),
+    ("glue-intermediate", '{"kind": "diffuse", "cite": "x", "params": {"Hsum": {"type": "vec3", "default": [0.5, 0.5, '
+     '0.5]}}}', "def diffuse(Hsum: vec3) -> vec3:\n    return Hsum\n", 2, 53, "parameter 'Hsum'"),
+    ("texture-N", '{"kind": "diffuse", "cite": "x", "textures": {"N": {"srgb": False}}}',
+     "def diffuse(N: texture2d, NdotL: float) -> vec3:\n    return sample(N, vec2(NdotL)).xyz\n", 2, 55,
+     "texture 'N' is named like one of the shading inputs"),
+    ("light-param-P", '{"kind": "light", "cite": "x", "params": {"P": {"type": "vec3", "default": [0.0, 1.0, 0.0]}}}',
+     "def light_dir(P: vec3) -> vec3:\n    return normalize(P)\n\n\ndef light_radiance(P: vec3) -> vec3:\n"
+     "    return P\n", 2, 51, "parameter 'P' is named like one of the surface inputs"),
+]
+
+
+@pytest.mark.parametrize("case", COLLISIONS, ids=[c[0] for c in COLLISIONS])
+def test_a_parameter_or_texture_named_like_an_input_is_refused_at_its_key(case, tmp_path):
+    """Entries bind parameters by name: `L` as a material parameter was a redefinition in every compiler, a
+    texture `N` an AssertionError in link/irgen.py. Refused when loaded, at the key, naming the table."""
+    _, meta, fn, line, col, words = case
+    e = _error(tmp_path, f'"""Hostile."""\nBRICK = {meta}\n\n\n{fn}')
+    assert (e.line, e.col) == (line, col) and words in str(e), str(e)
+    assert "generator/library/inputs.py" in str(e) and "rename the" in e.hint, str(e)
+
+
+def test_a_parameter_named_L_is_one_line_from_build_not_a_compiler_error(tmp_path):
+    meta = '{"kind": "diffuse", "cite": "x", "params": {"L": {"type": "vec3", "default": [0.5, 0.5, 0.5]}}}'
+    line = _build_one_error(tmp_path, f'"""Hostile."""\nBRICK = {meta}\n\n\ndef diffuse(L: vec3) -> vec3:\n'
+                                      "    return L * INV_PI\n")
+    assert line.startswith("hz.py:2:53: parameter 'L' is named like one of the shading inputs"), line
+
+
 # ---------------------------------------------------------------- walks over IR of any depth
 
 def test_clone_and_walk_take_a_tree_of_any_depth():

@@ -17,7 +17,7 @@ from ..lang.errors import read_text
 from ..lang import ir
 from ..lang.exprs import F32_MAX
 from ..lang.types import BUILTIN_TYPES, INT, Type, array
-from .inputs import SHADING, SURFACE
+from .inputs import BY_NAME, SHADING, SURFACE
 from .kinds import KINDS
 
 BRDF_ARRAY_KINDS = ("diffuse", "specular", "ndf", "fresnel", "visibility")
@@ -211,7 +211,8 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         text = read_text(path, "brick", MAX_BRICK_BYTES)
     meta, loc, doc, node = read_meta_node(text, shown)
     from .schema import check, key_positions
-    check(meta, shown, loc, key_positions(node))  # the shape first (library/schema.py), then the meaning
+    positions = key_positions(node)
+    check(meta, shown, loc, positions)  # the shape first (library/schema.py), then the meaning
     unknown = set(meta) - META_KEYS
     if unknown:
         raise _meta_error(shown, loc, f"unknown BRICK key(s): {', '.join(sorted(unknown))}",
@@ -245,6 +246,7 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         if "table" in t and t.get("srgb"):
             raise _meta_error(shown, loc, f"table texture '{tname}' is marked sRGB",
                               "baked tables hold linear values: remove \"srgb\": True")
+    _refuse_input_names(shown, loc, positions, params, textures)
     externals = {}
     for sname, s in slots.items():
         k = KINDS[s["kind"]]
@@ -280,6 +282,24 @@ GLUE_FUNCTIONS = re.compile(r"(brdf|brdf_lit|shade|main)(_[0-9]+)?|brdf_switch")
 
 PARAM_KEYS = {"type", "range", "default", "doc", "count"}
 MAX_ARRAY = 16
+
+
+def _refuse_input_names(shown, loc, positions, params, textures) -> None:
+    """A parameter or texture may not be named like a row of the inputs tables (library/inputs.py: INPUTS, the
+    shading inputs with the glue's intermediates, and SURFACE_INPUTS): an entry binds its parameters by name,
+    so the glue would declare the name twice (`L` a material parameter and the light vector: a redefinition
+    in every compiler) or pass the input where the texture goes (an assertion in the link stage)."""
+    for group, names in (("params", params), ("textures", textures)):
+        for name in names:
+            table = ("shading", "INPUTS") if name in BY_NAME else ("surface", "SURFACE_INPUTS") \
+                if name in SURFACE else None
+            if table is None:
+                continue
+            line, col = positions.get((group, name), (loc.line, loc.col))
+            what = "parameter" if group == "params" else "texture"
+            raise SourceError(shown, line, col, f"{what} '{name}' is named like one of the {table[0]} inputs "
+                              f"({table[1]} in generator/library/inputs.py), which entries read by the same name",
+                              f"rename the {what}, e.g. to '{name}_{what}', here and where it is used")
 
 
 def _params(shown, loc, raw) -> dict[str, Param]:
