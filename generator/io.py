@@ -56,8 +56,7 @@ def atomic_write(path: Path, data: bytes) -> bool:
 
 def show_progress() -> bool:
     """Progress bars on a terminal, quiet in CI and in pipes."""
-    return (sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")
-            and not os.environ.get("SHADERMATRIX_QUIET"))
+    return sys.stderr.isatty() and os.environ.get("CI", "").lower() not in ("1", "true")
 
 
 # ------------------------------------------------------------------ the content-addressed store

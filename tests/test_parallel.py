@@ -26,7 +26,7 @@ def _cli(*args, env=None):
 
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory) -> Path:
-    from generator.assemble.parallel import MIN_PERMUTATIONS
+    from generator.assemble.loop import MIN_PERMUTATIONS
     path = tmp_path_factory.mktemp("gen") / "gen.toml"
     n = MIN_PERMUTATIONS + 4
     r = subprocess.run([sys.executable, "benchmarks/scenegen.py", str(n), str(path)], cwd=REPO, capture_output=True,

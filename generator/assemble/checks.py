@@ -87,7 +87,7 @@ def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> lis
     from ..lang import SourceError
     from ..toolchain import CompileJob, compile_many
     from ..toolchain.platforms import validate_dialects
-    from ..toolchain.scenes import job_key, source_jobs
+    from ..toolchain.jobs import job_key, source_jobs
 
     wanted: dict[str, tuple[set, set]] = {}  # hash -> (languages, dialects) its checks need
     for c in todo:
@@ -106,8 +106,8 @@ def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> lis
                                line_map=tuple(s.line_map)) for h, c in composed.items() for s in c.dialects]
     results = compile_many(list(jobs.values()), optimize=True, validate=True, store=store) if jobs else {}
     gl_errors = validate_dialects(dialect_jobs, store) if dialect_jobs else {}
-    from . import _dxil_step  # build's own DXC step (None without a dxc on PATH)
-    dxil = _dxil_step() if any(c.platform == "d3d12" and c.hash in composed for c in todo) else None
+    from .write import dxil_step  # build's own DXC step (None without a dxc on PATH)
+    dxil = dxil_step() if any(c.platform == "d3d12" and c.hash in composed for c in todo) else None
     return [Outcome(list(failed[c.hash])) if c.hash in failed
             else _outcome(c, composed[c.hash], results, gl_errors, dxil, scene.permutations[c.hash].precision)
             for c in todo]
@@ -115,7 +115,7 @@ def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> lis
 
 def _outcome(c: Check, comp, results, gl_errors, dxil, precision: str) -> Outcome:
     """One check's Outcome from the batch's results (job key -> CompileResult / GL errors)."""
-    from ..toolchain.scenes import job_key
+    from ..toolchain.jobs import job_key
     mine = [s for s in comp.sources if s.language in c.languages]
     compiled = [results[job_key(c.hash, s.stage, s.language)] for s in mine]
     errors = [line for r in compiled if not r.ok for line in r.errors()]

@@ -8,8 +8,8 @@ no longer limited by the building process (benchmarks/results/build.md).
 
 The workers (assemble/workers.py: a pool the build can end at once, on Ctrl-C, SIGTERM or a dead worker) are
 started by a forkserver (never a fork of this process, which has threads), with this process's environment,
-and receive the Library pickled: every worker composes from exactly the bricks
-this build parsed, not from files that may have changed since. Results are pure functions of their
+and receive the build's context pickled (BuildContext.for_workers, the Library in it): every worker composes
+from exactly the bricks this build parsed, not from files that may have changed since. Results are pure functions of their
 inputs, so the output is byte-identical for any N (tested), and the build's counts are the same: a
 shader is counted distinct, cached or compiled where it first appears in chunk order.
 """
@@ -20,21 +20,20 @@ import pickle
 import shutil
 import sys
 import tempfile
+from dataclasses import replace
 
-from ..io import Store, sha256, show_progress
-from ..lang import SourceError
+from ..io import Store, sha256
 from ..lang.errors import EnvironmentMissing, UserError
-from ..library import bricks as _bricks
 from ..toolchain import CompileStats, cache_key, compile_many
-from ..toolchain.scenes import source_jobs
+from .context import BuildContext
+from .loop import Compiled, compose_chunk
 from .workers import Workers
 
-MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than it saves (measured: ~1.4 s at 36)
 # multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted (the progress
 # bar's lock), which it then removes itself. Noise to whoever pressed Ctrl-C: its process starts with this filter.
 _QUIET_TRACKER = "ignore::UserWarning:multiprocessing.resource_tracker"
 _PRELOAD = ["generator.assemble.parallel", "generator.compose", "generator.analysis", "jinja2"]
-_WORKER: dict = {}  # this worker's library, store and languages (set by _start)
+_CONTEXT: list[BuildContext] = []  # in a worker: the build's context (set once, by _start)
 
 
 def chunk_size(permutations: int, workers: int) -> int:
@@ -42,68 +41,52 @@ def chunk_size(permutations: int, workers: int) -> int:
     return max(4, min(64, -(-permutations // (workers * 8))))
 
 
-def _start(lib_bytes: bytes, env: dict, store_root: str | None, languages: tuple, dialects: tuple = ()) -> None:
+def _start(ctx_bytes: bytes, env: dict, store_root: str | None) -> None:
     os.environ.clear()
-    os.environ.update(env)
-    lib = pickle.loads(lib_bytes)
-    lib.memo, lib.serial = {}, next(_bricks._SERIALS)  # this process's own caches
-    _WORKER.update(lib=lib, store=Store(store_root) if store_root else None, languages=languages,
-                   dialects=dialects)
+    os.environ.update(env)  # the build's (PATH and the settings its tools read), not the forkserver's
+    ctx = pickle.loads(ctx_bytes)
+    lib = type(ctx.library)(bricks=ctx.library.bricks, errors=ctx.library.errors)  # this process's own caches
+    _CONTEXT.append(replace(ctx, library=lib, store=Store(store_root) if store_root else None))
 
 
 def _task(items: list, extra: list) -> tuple:
     """One chunk, in a worker: (composed, compose errors, results, costs by SPIR-V sha256, cache key by job
-    key, cache keys compiled here, templates read) — every value picklable."""
+    key, cache keys compiled here) — every value picklable."""
     from ..analysis import cost_dict
-    from ..compose import compose_permutation, loaded_templates
 
-    lib, store, languages = _WORKER["lib"], _WORKER["store"], _WORKER["languages"]
-    composed, errors, jobs = {}, {}, list(extra)
+    ctx = _CONTEXT[0]
     try:
-        for h, perm in items:
-            try:
-                c = composed[h] = compose_permutation(perm, lib, languages, _WORKER["dialects"])
-            except SourceError as e:
-                errors[h] = [str(e)]
-                continue
-            jobs += source_jobs(h, c.sources)
+        composed, errors, jobs = compose_chunk(ctx, items)
+        jobs = list(extra) + jobs
         stats = CompileStats()
-        results = compile_many(jobs, optimize=True, validate=True, store=store, stats=stats, workers=1)
+        results = compile_many(jobs, optimize=True, validate=True, store=ctx.store, stats=stats, workers=1)
         costs = {}
         for r in results.values():
             if r.ok and r.spirv:
                 digest = sha256(r.spirv)
                 if digest not in costs:
-                    costs[digest] = cost_dict(r.spirv, store)
+                    costs[digest] = cost_dict(r.spirv, ctx.store)
     except UserError as e:  # a missing tool (exit 3) or another error: its class and message, as they pickle
         raise (EnvironmentMissing if isinstance(e, EnvironmentMissing) else UserError)(str(e)) from None
     keys = {j.key: cache_key(j, True, True) for j in jobs}
-    return composed, errors, results, costs, keys, stats.fresh, loaded_templates()
+    return composed, errors, results, costs, keys, stats.fresh
 
 
-def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=(), workers: int = 2,
-                           on_done=None, costs: dict | None = None, templates: set | None = None, dialects=()):
-    """toolchain.scenes.compile_scene's contract, in `workers` processes; also fills `costs` (SPIR-V sha256 ->
-    cost dict, for the writer) and `templates` (the template files the workers read)."""
+def compile_in_workers(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileStats, workers: int,
+                       out: Compiled) -> None:
+    """loop.compile_permutations in `workers` processes (items: sorted (hash, Permutation) pairs), into `out`."""
     from tqdm import tqdm
 
-    stats = stats if stats is not None else CompileStats()
-    costs = costs if costs is not None else {}
-    templates = templates if templates is not None else set()
-    items = sorted(scene.permutations.items())
     size = chunk_size(len(items), workers)
     chunks = [items[k:k + size] for k in range(0, len(items), size)]
-    composed, errors, results = {}, {}, {}
     seen: set[str] = set()  # the cache keys of every job
     fresh: set[str] = set()  # those some worker compiled (the others came from the cache)
 
     def take(value) -> dict:
-        c, errs, part, cost, keys, compiled, read = value
-        composed.update(c)
-        errors.update(errs)
-        results.update(part)
-        costs.update(cost)
-        templates.update(read)
+        composed, errors, part, costs, keys, compiled = value
+        out.add(composed, errors)
+        out.results.update(part)
+        out.costs.update(costs)
         stats.jobs += len(keys)
         seen.update(keys.values())
         fresh.update(compiled)
@@ -112,18 +95,17 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     # without a cache (--no-cache), the workers share a private one for this build alone, so that a shader is
     # compiled once whichever chunks have it (the in-process build's memo); named like the toolchain's temp dirs, a
     # killed build's is removed by the next
-    private = None if store is not None else tempfile.mkdtemp(prefix=f"shadermatrix-{os.getpid()}-build-")
-    lib_bytes = pickle.dumps(type(lib)(bricks=lib.bricks, errors=lib.errors))  # no memo: workers link their own
+    private = None if ctx.store is not None else tempfile.mkdtemp(prefix=f"shadermatrix-{os.getpid()}-build-")
     if _QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its resource tracker
         sys.warnoptions.append(_QUIET_TRACKER)
-    init = (lib_bytes, dict(os.environ), str(store.root) if store else private, tuple(languages), tuple(dialects))
+    init = (pickle.dumps(ctx.for_workers()), dict(os.environ), str(ctx.store.root) if ctx.store else private)
     # the ubershader's large shaders first, one task each: they spread over the workers
     tasks = [([], [job]) for job in extra] + [(chunk, []) for chunk in chunks]
     done: dict[int, tuple] = {}  # chunks back before an earlier one: written when it is
     following = 0  # the next chunk to write
     try:
         with Workers(workers, _start, init, _task, _PRELOAD) as pool, \
-                tqdm(total=len(items), disable=not show_progress(), unit="permutation", leave=False) as bar:
+                tqdm(total=len(items), disable=not ctx.progress, unit="permutation", leave=False) as bar:
             for k, value in pool.unordered(tasks):
                 if k < len(extra):
                     take(value)
@@ -133,7 +115,7 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
                     part = take(done.pop(following))
                     chunk = chunks[following]
                     if on_done is not None:
-                        on_done([(h, composed[h]) for h, _ in chunk if h in composed], part)
+                        on_done([(h, out.composed[h]) for h, _ in chunk if h in out.composed], part)
                     bar.update(len(chunk))
                     following += 1
     finally:
@@ -144,4 +126,3 @@ def compile_scene_parallel(scene, lib, languages, store=None, stats=None, extra=
     stats.distinct += len(seen)
     stats.compiled += len(seen & fresh)
     stats.cached += len(seen - fresh)
-    return composed, errors, results

@@ -38,7 +38,7 @@ from ..library.bricks import Brick, Library, load_brick, load_library
 from ..library.kinds import BRDF_KINDS, KINDS
 from .. import GPU_TARGETS
 from ..io import show_progress
-from ..toolchain.scenes import compile_scene, job_key, source_jobs
+from ..toolchain.jobs import job_key, source_jobs
 from ..compose import Composed, compose_eval, compose_permutation
 from ..analysis import Cost, entry_cost
 from ..lang import SourceError
@@ -367,13 +367,28 @@ def _attach_gpu(gpu, pairs) -> None:
 
 # ------------------------------------------------------------------ per permutation
 
+def _compile_scene(scene: Scene, lib: Library, languages, store) -> tuple[dict, dict, dict]:
+    """Every permutation composed, and all their shaders compiled in one batch: (Composed by hash, compose errors
+    by hash, results by job key). The build's loop (assemble/loop.py) also writes as it goes; a cost report
+    reads the results once they are all in."""
+    composed, errors, jobs = {}, {}, []
+    for h, perm in sorted(scene.permutations.items()):
+        try:
+            composed[h] = compose_permutation(perm, lib, languages)
+        except SourceError as e:
+            errors[h] = [str(e)]
+            continue
+        jobs += source_jobs(h, composed[h].sources)
+    return composed, errors, compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store)
+
+
 def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -> list[Row]:
     """Fragment and vertex shader cost of every permutation of a scene and of its ubershader, per language.
 
     gpu: a measure.gpu.GpuRequest, to add RADV's statistics to every row."""
     from ..compose.uber import compose_ubershader
 
-    composed, errors, results = compile_scene(scene, lib, languages, store=store)
+    composed, errors, results = _compile_scene(scene, lib, languages, store)
     rows, pairs = [], []
 
     materials: dict[str, list[str]] = {}

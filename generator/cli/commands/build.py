@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import json
-import os
 import sys
 from pathlib import Path
 
@@ -70,15 +69,12 @@ def summary(scene, res, out, seconds: float, pack: bool = False) -> dict:
 
 def run(args) -> int:
     from ...library.bricks import load_library
-    from ...assemble import build_scene
+    from ...assemble import BuildContext, build
     from ...scene.load import load_scene
     import time
 
-    from ...io import Store, default_cache_dir
+    from ...io import Store, default_cache_dir, show_progress
     started = time.perf_counter()
-    quiet_before = os.environ.get("SHADERMATRIX_QUIET")
-    if args.quiet:
-        os.environ["SHADERMATRIX_QUIET"] = "1"  # io.show_progress: no bar (restored when the build ends)
     if args.no_cache and args.cache_dir:
         raise UsageError("--no-cache and --cache-dir contradict each other — give one")
     if args.jobs is not None and args.jobs < 1:
@@ -117,14 +113,13 @@ def run(args) -> int:
     if args.executor:
         from ...toolchain.dask import DaskExecutor
         executor = DaskExecutor(args.executor)
+    ctx = BuildContext(lib, platforms=platforms, store=store, progress=show_progress() and not args.quiet,
+                       jobs=args.jobs, executor=executor)
     try:
-        res = build_scene(scene, lib, Path(args.out), store=store, depfile=args.depfile, workers=args.jobs,
-                          executor=executor, keep_removed=args.keep_removed, pack=args.pack, platforms=platforms)
+        res = build(scene, Path(args.out), ctx, depfile=args.depfile, keep_removed=args.keep_removed, pack=args.pack)
     finally:
         if executor is not None:
             executor.close()
-        if args.quiet and quiet_before is None:
-            os.environ.pop("SHADERMATRIX_QUIET", None)
     seconds = time.perf_counter() - started
     if args.json:
         print(json.dumps(summary(scene, res, args.out, seconds, args.pack), indent=2))

@@ -1,0 +1,109 @@
+"""The build's compile loop, in one place: the permutations to build composed and compiled in chunks, each chunk
+handed to the writer (`on_done`) as soon as it is compiled, in chunk order.
+
+One loop, run one of two ways (neither changes a byte of the output, nor the counts):
+
+- in worker processes (parallel.py), from MIN_PERMUTATIONS permutations when more than one job is allowed and
+  no executor is given: a worker composes, compiles and analyses a chunk; this process writes;
+- here otherwise: chunks of CHUNK permutations are composed on this thread and each is compiled on a thread of
+  its own (`jobs` tool processes, or on the executor) while the next is composed, so writing, composing and
+  the compilers overlap. Shaders identical across chunks are compiled once (an in-memory record beside the
+  store).
+
+Both compose a chunk with compose_chunk. The ubershader's shaders (`extra`) are compiled with the first
+chunk's, so that its large shaders start with the others instead of after them.
+"""
+from __future__ import annotations
+
+import os
+from collections import deque
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from ..lang import SourceError
+from ..toolchain import CompileJob, CompileResult, CompileStats, compile_many
+from ..toolchain.jobs import source_jobs
+from .context import BuildContext
+
+if TYPE_CHECKING:
+    from ..compose import Composed
+
+MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than it saves (measured: ~1.4 s at 36)
+CHUNK = 64  # permutations composed per compile batch in this process
+
+
+@dataclass
+class Compiled:
+    """What the loop made: composed units and compose errors by permutation hash, compile results by job key,
+    the costs the workers analysed (SPIR-V sha256 -> cost dict) and the templates composed with (by name)."""
+
+    composed: dict[str, Composed] = field(default_factory=dict)
+    errors: dict[str, list[str]] = field(default_factory=dict)
+    results: dict[str, CompileResult] = field(default_factory=dict)
+    costs: dict = field(default_factory=dict)
+    templates: set[str] = field(default_factory=set)
+
+    def add(self, composed: dict, errors: dict) -> None:
+        self.composed.update(composed)
+        self.errors.update(errors)
+        for c in composed.values():
+            self.templates.update(c.templates)
+
+
+def compose_chunk(ctx: BuildContext, items) -> tuple[dict[str, Composed], dict[str, list[str]], list[CompileJob]]:
+    """(Composed by hash, compose errors by hash, compile jobs) of a chunk of (hash, permutation) pairs."""
+    from ..compose import compose_permutation  # Jinja and the emitters load only when something is composed
+    composed, errors, jobs = {}, {}, []
+    for h, perm in items:
+        try:
+            c = composed[h] = compose_permutation(perm, ctx.library, ctx.languages, ctx.dialects)
+        except SourceError as e:
+            errors[h] = [str(e)]
+            continue
+        jobs += source_jobs(h, c.sources)
+    return composed, errors, jobs
+
+
+def compile_permutations(ctx: BuildContext, permutations: dict, extra=(), on_done=None,
+                         stats: CompileStats | None = None, costs: dict | None = None) -> Compiled:
+    """Compose and compile every permutation of `permutations` (hash -> Permutation), and the CompileJobs of
+    `extra`. on_done([(hash, Composed)], results by job key) is called on this thread for every compiled chunk,
+    in chunk order; stats (a CompileStats) is filled in; costs: the dict Compiled.costs is (the writer's, so
+    that what the workers analysed is there before it writes the chunk)."""
+    stats = stats if stats is not None else CompileStats()
+    out = Compiled(costs=costs if costs is not None else {})
+    items = sorted(permutations.items())
+    n = ctx.jobs or os.cpu_count() or 1
+    if ctx.executor is None and n > 1 and len(items) >= MIN_PERMUTATIONS:
+        from .parallel import compile_in_workers
+        compile_in_workers(ctx, items, list(extra), on_done, stats, n, out)
+    else:
+        _here(ctx, items, list(extra), on_done, stats, out)
+    return out
+
+
+def _here(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileStats, out: Compiled) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    size = CHUNK if on_done is not None else max(1, len(items))
+    chunks = [items[k:k + size] for k in range(0, len(items), size)] or [[]]
+    memo: dict = {}
+    waiting: deque = deque()  # (hashes, future) in chunk order: one compile thread, so they finish in order
+
+    def deliver(block: bool) -> None:
+        while waiting and (block or waiting[0][1].done()):
+            hashes, future = waiting.popleft()
+            part = future.result()  # a compile error is raised here, on the caller's thread
+            out.results.update(part)
+            if on_done is not None:
+                on_done([(h, out.composed[h]) for h in hashes], part)
+
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="compile") as pool:
+        for k, chunk in enumerate(chunks):
+            composed, errors, jobs = compose_chunk(ctx, chunk)
+            out.add(composed, errors)
+            waiting.append((list(composed), pool.submit(
+                compile_many, (extra if k == 0 else []) + jobs, optimize=True, validate=True, progress=ctx.progress,
+                store=ctx.store, stats=stats, workers=ctx.jobs, executor=ctx.executor, memo=memo)))
+            deliver(block=False)
+        deliver(block=True)
