@@ -6,7 +6,9 @@
 For each Python (default: this one and the second Python's venv, .venv-alt or .venv-deb, where present: Debian
 12's 3.11.2) and each way of ending a build, a `build -j 2 --no-cache` of a generated scene of N permutations
 (benchmarks/scenegen.py) is started in a session of its own; once its workers are composing (two worker
-processes alive, then 1.5 s more), or with --at writing once the first chunk's files appear, it is sent:
+processes alive, then 1.5 s more), or with --at writing once the first chunk's files appear, it is sent the
+signals below. Below 64 permutations a build stays in its own process (-j 2: two tool processes); then
+"busy" is a tool of its running, and there is no worker to kill.
 
 - SIGINT to its process group (what a terminal's Ctrl-C does);
 - SIGTERM to the build's own process (`kill PID`, a supervisor);
@@ -34,6 +36,8 @@ REPO = Path(__file__).resolve().parent.parent
 RESULTS = REPO / "benchmarks" / "results" / "interrupts.md"
 sys.path.insert(0, str(REPO / "benchmarks"))
 from cliargs import positive  # noqa: E402
+
+MIN_PERMUTATIONS = 64  # generator/assemble/loop.py: from here -j 2 is two worker processes
 
 CASES = {  # name: (signal, whom)
     "Ctrl-C (SIGINT to the group)": (signal.SIGINT, "group"),
@@ -74,14 +78,21 @@ def workers(build: int) -> list[int]:
     return sorted(out)
 
 
-def one(python: str, repo: Path, scene: Path, case: str, limit: float, at: str) -> dict:
+def busy(build: int, in_process: bool) -> bool:
+    """Its two workers are alive; or, for a build that stays in its own process, a tool it started is running."""
+    if not in_process:
+        return len(workers(build)) >= 2
+    return any(ppid == build and b"python" not in cmd.split(b"\0")[0] for ppid, cmd in session(build).values())
+
+
+def one(python: str, repo: Path, scene: Path, case: str, limit: float, at: str, in_process: bool) -> dict:
     sig, whom = CASES[case]
     with tempfile.TemporaryDirectory(prefix="interrupts-", ignore_cleanup_errors=True) as tmp:
         p = subprocess.Popen([python, "-m", "generator.cli", "build", str(scene), "--out", f"{tmp}/out",
                               "--no-cache", "-j", "2", "-q"], cwd=repo, stdout=subprocess.DEVNULL,
                              stderr=subprocess.PIPE, start_new_session=True)
         deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and p.poll() is None and len(workers(p.pid)) < 2:
+        while time.monotonic() < deadline and p.poll() is None and not busy(p.pid, in_process):
             time.sleep(0.05)
         if at == "composing":
             time.sleep(1.5)
@@ -148,11 +159,15 @@ def main() -> int:
         subprocess.run([sys.executable, "benchmarks/scenegen.py", str(args.n), str(scene)], cwd=args.repo, check=True,
                        capture_output=True)
         rows = []
+        in_process = args.n < MIN_PERMUTATIONS  # -j 2 then means two tool processes, no worker processes
         for python in pythons:
             version = subprocess.run([python, "-c", "import platform; print(platform.python_version())"],
                                      capture_output=True, text=True, check=True).stdout.strip()
             for case in args.case or CASES:
-                runs = [one(python, args.repo.resolve(), scene, case, args.limit, args.at) for _ in range(args.repeat)]
+                if in_process and CASES[case][1] == "worker":
+                    continue  # no worker to kill
+                runs = [one(python, args.repo.resolve(), scene, case, args.limit, args.at, in_process)
+                        for _ in range(args.repeat)]
                 odd = sorted({r["stderr"] for r in runs if not r["right"]})
                 rows.append((version, case, fmt([r["exit_s"] for r in runs]), fmt([r["gone_s"] for r in runs], "never, or killed with the hung build"),
                              ", ".join(sorted({str(r["rc"]) for r in runs})),

@@ -24,15 +24,25 @@ def _cli(*args, env=None):
                           text=True, timeout=600, env=env)
 
 
-@pytest.fixture(scope="module")
-def scene(tmp_path_factory) -> Path:
-    from generator.assemble.loop import MIN_PERMUTATIONS
+def _generated(tmp_path_factory, n: int) -> Path:
     path = tmp_path_factory.mktemp("gen") / "gen.toml"
-    n = MIN_PERMUTATIONS + 4
     r = subprocess.run([sys.executable, "benchmarks/scenegen.py", str(n), str(path)], cwd=REPO, capture_output=True,
                        text=True)
     assert r.returncode == 0, r.stderr
     return path
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory) -> Path:
+    from generator.assemble.loop import MIN_PERMUTATIONS
+    return _generated(tmp_path_factory, MIN_PERMUTATIONS + 4)
+
+
+@pytest.fixture(scope="module")
+def small_scene(tmp_path_factory) -> Path:
+    """Too few permutations for worker processes: `-j 2` is two tool processes of the building process."""
+    from generator.assemble.loop import MIN_PERMUTATIONS
+    return _generated(tmp_path_factory, MIN_PERMUTATIONS - 1)
 
 
 def test_worker_processes_build_what_one_process_builds(scene, tmp_path):
@@ -171,6 +181,41 @@ def test_sigterm_of_a_parallel_build_is_one_line_and_ends_the_workers(scene, tmp
     else:  # a CI job or a container being stopped
         os.killpg(p.pid, signal.SIGTERM)
     _ends(p, 130, "interrupted; earlier outputs are intact\n")  # the documented code of an interrupt
+
+
+def _compiling(sid: int) -> bool:
+    """A tool of session `sid` is compiling (not telling its version, as the build's start asks)."""
+    for pid in set(_session_pythons(sid, tools=True)) - set(_session_pythons(sid)):
+        try:
+            if b"--version" not in Path(f"/proc/{pid}/cmdline").read_bytes():
+                return True
+        except OSError:
+            pass
+    return False
+
+
+@pytest.mark.parametrize("whom", ["build", "group"])
+def test_an_in_process_build_ends_without_finishing_its_batch(small_scene, tmp_path, whom):
+    """Signalled while its compile thread runs its one batch (every shader of the scene and the ubershader's),
+    the build kills the tools and leaves at once: nothing of the batch is compiled after the signal, so the
+    compile cache stays empty. It used to finish the batch first (12-20 s here), filling the cache."""
+    import signal
+    import time
+
+    from generator.toolchain import COMPILE_NAMESPACE
+    cache = tmp_path / "cache"
+    p = subprocess.Popen([sys.executable, "-m", "generator.cli", "build", str(small_scene), "--out",
+                          str(tmp_path / "out"), "--cache-dir", str(cache), "-j", "2"], cwd=REPO,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and p.poll() is None and not _compiling(p.pid):
+        time.sleep(0.05)
+    time.sleep(1.0)
+    assert p.poll() is None, "the build ended before it could be interrupted"
+    assert not (cache / COMPILE_NAMESPACE).exists(), "the batch was done before the signal: make the scene larger"
+    (os.kill if whom == "build" else os.killpg)(p.pid, signal.SIGTERM if whom == "build" else signal.SIGINT)
+    _ends(p, 130, "interrupted; earlier outputs are intact\n")
+    assert not [f for f in (cache / COMPILE_NAMESPACE).rglob("*") if f.is_file()]
 
 
 def test_a_worker_that_dies_fails_the_build_instead_of_hanging_it(scene, tmp_path):

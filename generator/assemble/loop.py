@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from ..lang import SourceError
-from ..toolchain import CompileJob, CompileResult, CompileStats, compile_many
+from ..toolchain import CompileJob, CompileResult, CompileStats, compile_many, resume_tools, stop_tools
 from ..toolchain.jobs import source_jobs
 from .context import BuildContext
 
@@ -30,6 +30,7 @@ if TYPE_CHECKING:
 
 MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than it saves (measured: ~1.4 s at 36)
 CHUNK = 64  # permutations composed per compile batch in this process
+_POLL_S = 0.2  # the longest this thread waits on the compile thread without looking at signals
 
 
 @dataclass
@@ -82,6 +83,16 @@ def compile_permutations(ctx: BuildContext, permutations: dict, extra=(), on_don
     return out
 
 
+def _result(future):
+    """future.result(), waited for in short steps: a signal the kernel gave another thread (a tool's reader) is
+    handled by this one only when it runs Python again, and a wait without a timeout could last the whole batch."""
+    while True:
+        try:
+            return future.result(timeout=_POLL_S)
+        except TimeoutError:
+            continue
+
+
 def _here(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileStats, out: Compiled) -> None:
     from concurrent.futures import ThreadPoolExecutor
 
@@ -93,12 +104,14 @@ def _here(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileSt
     def deliver(block: bool) -> None:
         while waiting and (block or waiting[0][1].done()):
             hashes, future = waiting.popleft()
-            part = future.result()  # a compile error is raised here, on the caller's thread
+            part = _result(future)  # a compile error is raised here, on the caller's thread
             out.results.update(part)
             if on_done is not None:
                 on_done([(h, out.composed[h]) for h in hashes], part)
 
-    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="compile") as pool:
+    pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="compile")
+    resume_tools()
+    try:
         for k, chunk in enumerate(chunks):
             composed, errors, jobs = compose_chunk(ctx, chunk)
             out.add(composed, errors)
@@ -107,3 +120,10 @@ def _here(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileSt
                 store=ctx.store, stats=stats, workers=ctx.jobs, executor=ctx.executor, memo=memo)))
             deliver(block=False)
         deliver(block=True)
+    except BaseException:
+        # Ctrl-C, SIGTERM or a failure: the build ends now, not when the compile thread's batch is done (its
+        # running tools are killed and its queued ones never start; an executor's are cancelled when it closes)
+        stop_tools()
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)

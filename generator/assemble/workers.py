@@ -27,6 +27,7 @@ from multiprocessing.connection import wait
 
 from ..lang.errors import UserError
 
+_POLL_S = 0.2  # the longest the build waits on its workers without looking at signals
 _JOIN_S = 5.0  # how long ending the pool waits for a killed worker to be reaped (it takes milliseconds)
 
 
@@ -161,7 +162,10 @@ class Workers:
         for w in range(len(self._procs)):
             give(w)
         while busy:
-            ready = wait([*(self._conns[w] for w in busy), *sentinels])
+            # in short steps: a signal the kernel gave another thread is handled here only when Python runs again
+            ready = wait([*(self._conns[w] for w in busy), *sentinels], timeout=_POLL_S)
+            if not ready:
+                continue
             replies = [conns[r] for r in ready if r in conns]
             if not replies:  # only a sentinel: a worker ended with nothing to say
                 raise WorkerDied()

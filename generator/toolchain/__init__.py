@@ -62,6 +62,7 @@ import re
 import shutil
 import subprocess
 import tempfile
+import threading
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -153,11 +154,49 @@ def _need(name: str) -> str:
     return path
 
 
+class ToolsStopped(RuntimeError):
+    """A tool was to start after stop_tools(): the build that ran it is ending."""
+
+
+_RUNNING: set = set()  # the tool processes running now (any thread)
+_RUNNING_LOCK = threading.Lock()
+_STOPPED = threading.Event()
+
+
+def stop_tools() -> None:
+    """Kill every tool process this process is running, and start none until resume_tools(): an interrupted
+    build ends now, not after the batch its compile thread had under way (its queued tools would start)."""
+    _STOPPED.set()
+    with _RUNNING_LOCK:
+        running = list(_RUNNING)
+    for proc in running:
+        proc.kill()
+
+
+def resume_tools() -> None:
+    _STOPPED.clear()
+
+
 def _run(args: list[str], cwd: str | None = None, env: dict | None = None) -> tuple[int, str]:
     """Run a tool; return (exit status, stdout+stderr decoded with errors=replace)."""
-    proc = subprocess.run(args, cwd=cwd, env=env, stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-    return proc.returncode, proc.stdout.decode("utf-8", errors="replace")
+    if _STOPPED.is_set():
+        raise ToolsStopped(f"{args[0]}: not started, the build is ending")
+    proc = subprocess.Popen(args, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            stdin=subprocess.DEVNULL)
+    with _RUNNING_LOCK:
+        _RUNNING.add(proc)
+    try:
+        if _STOPPED.is_set():  # stopped while it started: stop_tools did not see it
+            proc.kill()
+        out, _ = proc.communicate()
+    except BaseException:  # Ctrl-C on the main thread (a --version): the tool goes too, as subprocess.run does
+        proc.kill()
+        proc.wait()
+        raise
+    finally:
+        with _RUNNING_LOCK:
+            _RUNNING.discard(proc)
+    return proc.returncode, out.decode("utf-8", errors="replace")
 
 
 def _version_of(name: str, parse) -> str:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import signal
 import sys
 from pathlib import Path
 
@@ -67,6 +68,14 @@ def summary(scene, res, out, seconds: float, pack: bool = False) -> dict:
             **({"packs": [p["path"] for p in res.manifest.get("packs", [])]} if pack else {})}
 
 
+def _interrupted(signum, frame):
+    """Ctrl-C or SIGTERM during a build: its tools are killed at once (whatever thread runs them: none waits for
+    a batch to finish), then the build unwinds like Ctrl-C (atomic writes remove their temporary files)."""
+    from ...toolchain import stop_tools
+    stop_tools()
+    raise KeyboardInterrupt
+
+
 def run(args) -> int:
     from ...library.bricks import load_library
     from ...assemble import BuildContext, build
@@ -115,11 +124,14 @@ def run(args) -> int:
         executor = DaskExecutor(args.executor)
     ctx = BuildContext(lib, platforms=platforms, store=store, progress=show_progress() and not args.quiet,
                        jobs=args.jobs, executor=executor)
+    handlers = {sig: signal.signal(sig, _interrupted) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         res = build(scene, Path(args.out), ctx, depfile=args.depfile, keep_removed=args.keep_removed, pack=args.pack)
     finally:
         if executor is not None:
             executor.close()
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
     seconds = time.perf_counter() - started
     if args.json:
         print(json.dumps(summary(scene, res, args.out, seconds, args.pack), indent=2))
