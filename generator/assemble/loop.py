@@ -16,6 +16,7 @@ chunk's, so that its large shaders start with the others instead of after them.
 from __future__ import annotations
 
 import os
+import threading
 from collections import deque
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -63,6 +64,11 @@ def compose_chunk(ctx: BuildContext, items) -> tuple[dict[str, Composed], dict[s
             continue
         jobs += source_jobs(h, c.sources)
     return composed, errors, jobs
+
+
+def _resume_after(pool) -> None:
+    pool.shutdown(wait=True)
+    resume_tools()
 
 
 def compile_permutations(ctx: BuildContext, permutations: dict, extra=(), on_done=None,
@@ -120,10 +126,17 @@ def _here(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileSt
                 store=ctx.store, stats=stats, workers=ctx.jobs, executor=ctx.executor, memo=memo)))
             deliver(block=False)
         deliver(block=True)
-    except BaseException:
+    except BaseException as e:
         # Ctrl-C, SIGTERM or a failure: the build ends now, not when the compile thread's batch is done (its
         # running tools are killed and its queued ones never start; an executor's are cancelled when it closes)
         stop_tools()
         pool.shutdown(wait=False, cancel_futures=True)
+        # Tools may start again once the compile thread has seen the stop: a process that goes on (a caller of
+        # the library after a failed build, a test) compiles again. After a failure wait for that thread (its
+        # tools are dead: it ends at once); an interrupted process is exiting, so it does not wait for it.
+        if isinstance(e, Exception):
+            _resume_after(pool)
+        else:
+            threading.Thread(target=_resume_after, args=(pool,), daemon=True).start()
         raise
     pool.shutdown(wait=True)
