@@ -12,8 +12,9 @@ demo: setup
 
 # The tests that differ between Python patch releases (the loader on odd bytes, interrupts of a worker pool):
 # run again on the second Python that scripts/setup.sh found (.venv-alt), whichever of the two is not .venv's.
-ALT_TESTS := tests/test_fuzz.py tests/test_fuzz_regressions.py tests/test_hostile_files.py tests/test_lang_errors.py \
-             tests/test_parallel.py
+ALT_TESTS := tests/lang/test_fuzz.py tests/lang/test_fuzz_regressions.py tests/io/test_hostile_files.py \
+             tests/lang/test_hostile_bricks.py tests/lang/test_lang_errors.py tests/lang/test_lang_ext_errors.py \
+             tests/library/test_brick_schema.py tests/assemble/test_parallel.py
 
 test: setup
 	$(VENV)/bin/ruff check .
@@ -30,7 +31,7 @@ goldens: setup
 	$(PY) -m tests.regen_goldens
 
 .PHONY: reference
-reference: setup  # docs/reference/ from the code; tests/test_docs_reference.py fails when it is stale
+reference: setup  # docs/reference/ from the code; tests/project/test_docs_reference.py fails when it is stale
 	$(PY) scripts/gen_reference.py docs/reference
 
 doctor: setup

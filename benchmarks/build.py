@@ -9,7 +9,7 @@ One run, on this machine, side by side (benchmarks/scenegen.py makes the scene o
   each allows and no Python of ours — glslc batched (256 files a process), naga, spirv-opt -O and
   spirv-val once per file, two at a time (xargs -P, the core count);
 - no-op rebuild (best of 3): time and files written;
-- one brick changed (ndf=beckmann's source hash, in process, as tests/test_incremental.py does): time and
+- one brick changed (ndf=beckmann's source hash, in process, as tests/assemble/test_incremental.py does): time and
   permutations rebuilt, against the permutations that read it;
 - scaling: cold builds without the cache at -j 1 and -j 2 (worker processes), -j 2 in-process (what -j 2 was
   before the workers: composition and analysis in the building process, pipelined with 2 tool processes), and on

@@ -5,7 +5,7 @@
 Every page is a pure function of the code it documents (the argparse parser of generator/cli/, what
 `shadermatrix bricks --json` prints, the tables of generator/lang/ and generator/library/, the manifest
 field descriptions of scripts/reference_manifest.py), so the output is deterministic: no times, no
-absolute paths, no terminal width. tests/test_docs_reference.py regenerates into a temporary directory and
+absolute paths, no terminal width. tests/project/test_docs_reference.py regenerates into a temporary directory and
 fails on any difference. Before the manifest page is written, scenes/example.toml is built (with --pack)
 into a temporary directory and every key of its manifest.json must be described (--no-build skips that
 check, which needs the pinned tools).
@@ -31,7 +31,7 @@ WIDTH = 100  # the usage lines' width: fixed, so the page does not depend on the
 
 def header(title: str, source: str) -> str:
     return (f"# {title}\n\n<!-- Generated from {source} by `{COMMAND}` (scripts/gen_reference.py); "
-            "do not edit: tests/test_docs_reference.py fails when it is stale. -->\n\n")
+            "do not edit: tests/project/test_docs_reference.py fails when it is stale. -->\n\n")
 
 
 def cell(text) -> str:

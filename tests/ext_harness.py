@@ -1,4 +1,4 @@
-"""Shaders around tests/bricks/ext_constructs.py for the toolchain tests of tests/test_lang_ext.py.
+"""Shaders around tests/bricks/lang/ext_constructs.py for the toolchain tests of tests/lang/test_lang_ext.py.
 
 The harness functions are built directly as IR (no brick text), as the link stage builds
 glue: they call every brick function and add a Switch and a runtime-bounded For of their
@@ -12,7 +12,7 @@ from generator.lang import ir, parse_module
 from generator.lang.types import FLOAT, INT, TEXTURECUBE, UINT, VEC3, VEC4, array
 
 ROOT = Path(__file__).resolve().parent.parent
-BRICK = "tests/bricks/ext_constructs.py"
+BRICK = "tests/bricks/lang/ext_constructs.py"
 L = ir.Loc("tests/ext_harness", 1, 1)
 
 

@@ -1,7 +1,7 @@
 """Golden files: what the generator links and emits for tests/golden/cases.toml.
 
 `python -m tests.regen_goldens` (or `make goldens`) rewrites tests/golden/; review the result with
-`git diff tests/golden`. tests/test_golden.py fails when the checked-in files drift.
+`git diff tests/golden`. tests/compose/test_golden.py fails when the checked-in files drift.
 
 Names (tests/golden/README.md has the table): a case is named for what it is, never by a hash —
   <lang>/eval/<spec slug>.comp.<lang>                  an eval kernel of cases.toml's `eval`
@@ -9,7 +9,7 @@ Names (tests/golden/README.md has the table): a case is named for what it is, ne
                                                        scene's [materials] order (__<light set>, then
                                                        __<hash>, appended only when two would share a name)
   <lang>/<scene>/ubershader.<vert|frag>.<lang>         the scene's ubershader
-  <lang>/link/<case slug>[.shade].<stage>.<lang>       the link-stage cases over tests/link_bricks
+  <lang>/link/<case slug>[.shade].<stage>.<lang>       the link-stage cases over tests/bricks/link
   ir/<dir>/<name>[.shade].ir                           the linked program of each case above
                                                        (generator/lang/dump.py), one for all languages
 

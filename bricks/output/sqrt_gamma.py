@@ -6,7 +6,7 @@ power function on most GPUs — not exactly the transfer function, but close eno
 For a UNORM (not sRGB) render target, which stores what is written.
 
 Error against the exact sRGB encoding (IEC 61966-2-1; the `srgb` brick), measured over
-10⁶ + 1 points of [0, 1] in float64 (tests/test_lights_packings_outputs.py): max
+10⁶ + 1 points of [0, 1] in float64 (tests/library/test_lights_packings_outputs.py): max
 |sqrt(x) − sRGB(x)| = 0.0374 at x = 0.213 (sqrt is darker there: 0.462 against 0.499),
 +0.0193 at x = 0.0015 on the other side; 9.5 codes of an 8-bit target (10 after rounding
 both to codes). The saturate is the course's: it keeps sqrt of a negative undefined value

@@ -5,7 +5,7 @@ per channel to saturate(color). For a UNORM render target: an _SRGB target encod
 hardware, and `linear` is the brick for it.
 
 Error against the float64 encoding (generator/reference/outputs.py), measured by
-tests/test_lights_packings_outputs.py: 0 by definition in float64; in float32 at most
+tests/library/test_lights_packings_outputs.py: 0 by definition in float64; in float32 at most
 1.5e-7 in NumPy (10⁶ + 1 points of [0, 1]) and 2.1e-7 on lavapipe in GLSL, HLSL and WGSL
 alike (4,600 points, denser below the threshold): about 2 ulp at 1, far below an 8-bit
 code (1/255 = 3.9e-3). For comparison, over [0, 1]: the course's `sqrt_gamma` is off by

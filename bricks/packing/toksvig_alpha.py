@@ -10,7 +10,7 @@ use), is
 
     α'² = α_lod² + 2 w σ²,    w = `toksvig_weight` (1: Toksvig's; 0: off).
 
-The 2 is measured, not assumed: tests/test_lod.py finds the GGX highlight's error at MIP levels 3–6
+The 2 is measured, not assumed: tests/library/test_lod.py finds the GGX highlight's error at MIP levels 3–6
 1.5–2.1 times larger with α² + σ² (a form also quoted). GGX is not Gaussian (heavier tails), so
 the variance sum is an approximation for it; the test's bound is measured on GGX.
 

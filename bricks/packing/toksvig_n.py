@@ -18,20 +18,20 @@ applied before Toksvig's variance. It needs the MIP level, and the brick languag
 screen-space derivatives or LOD query (generator/lang/intrinsics.py; WGSL has no textureQueryLod
 either, and eval kernels are compute shaders, without implicit derivatives), so `lod` is an explicit
 material parameter: the engine sets it per draw from the object's distance, as games apply the
-course's LOD hack per object. With both on, the reduction stacks on Toksvig's (tests/test_lod.py
+course's LOD hack per object. With both on, the reduction stacks on Toksvig's (tests/library/test_lod.py
 measures each alone: the course's alone is toksvig_weight = 0, mip_reduction = 0.3).
 
 Texture `normal_map`, linear RGB = (t + 1)/2, the one binding the normal slot's default filler
 `normal_map` samples too (it normalizes N_a for the shading normal). The length needs all three
 channels: `normal_map_xy` reconstructs z and loses it. Box-filtered MIP levels of unit normals
 keep |N_a| ≤ 1, but 8-bit texels are not unit: rounding each channel to 1/255 (t to 2/255) gives
-base-level lengths 1 ± 0.0054 (measured on tests/test_lod.py's bumpy map), and at n = 256 the
+base-level lengths 1 ± 0.0054 (measured on tests/library/test_lod.py's bumpy map), and at n = 256 the
 shortened ones lower n' to 108 at worst, 220 on average, on a level that should keep 256: store
 the map with 16 bits per channel (R16G16B16A16_UNORM), or accept a gloss ceiling of that order.
 
 Provides n, for BRDFs reading the Blinn-Phong exponent (blinn_phong_normalized, lambert+…).
 Float64 reference: generator/reference/lod.py (lod_exponent); the energy experiment across MIP
-levels: tests/test_lod.py.
+levels: tests/library/test_lod.py.
 """
 BRICK = {
     "kind": "packing",

@@ -28,7 +28,7 @@ tilted receiver, so the bias must cover the depth slope over that footprint. Mea
 of tests/scenes/shadow.toml (256² map, lavapipe), the least bias that leaves the lit floor unshadowed is
 0.006 at k = 1 and 0.01 at k = 3 (pcf: 0.003 and 0.006); the default 0.002 suits receivers facing the
 light. The edge band of that scene (98 floor pixels) holds 22 intermediate pixels at k = 1 and 65 at
-k = 3 (pcf: 0 and 43, bias 0.01; tests/test_shadow_compare.py).
+k = 3 (pcf: 0 and 43, bias 0.01; tests/backends/test_shadow_compare.py).
 """
 BRICK = {
     "kind": "shadow",

@@ -21,7 +21,7 @@ the filter region. With occluders at depths d_a < d_b both inside the region, a 
 them is lit by p_max > 0 although it is fully shadowed, the more the closer d_b is to t: e.g. a filter
 region half at d_a = 0.2, half at d_b = 0.5, receiver t = 0.6 -> E[d] = 0.35, σ² = 0.0225,
 p_max = 0.0225 / (0.0225 + 0.0625) = 0.265 — a quarter lit inside a full shadow (with the default
-vsm_bleed = 0.2: 0.081; tests/test_shadows_filtered.py computes both with this brick's formula).
+vsm_bleed = 0.2: 0.081; tests/runtime/test_shadows_filtered.py computes both with this brick's formula).
 A curved occluder does it alone: its depths vary across the filter region, so σ² > 0 over the
 whole umbra and the bound is never 0 there. Measured on lavapipe (tests/scenes/shadow.toml, a ball
 over a floor, 256² map, 5 × 5 moments box, 96 × 64 frame, linear output): with vsm_bleed = 0 the

@@ -40,7 +40,7 @@ What compares across GLSL (glslc), HLSL (glslc -x hlsl) and WGSL (naga)
 The build writes ``spirv-opt -O`` output. That keeps OpName and OpMemberName
 (``-O`` has no strip-debug pass), but removes a resource that no entry point
 uses, so a resource a template declares but no brick reads disappears. Found on
-the example scene's shaders (see tests/test_reflect.py):
+the example scene's shaders (see tests/analysis/test_reflect.py):
 
 - Reliable, equal in all three: set, binding, kind, count, image dim, arrayed,
   depth, multisampled, sampled type; block sizes; member offsets, type strings of

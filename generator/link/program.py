@@ -87,7 +87,7 @@ class Program:
         self.bricks[b.display_path] = b
         # A node links to the same functions in every program (names are keyed by canonical node), so the
         # library keeps them: the next program that links this node shares them (linked IR is never
-        # mutated after link(); tests/test_link.py checks), instead of deep-copying the brick again.
+        # mutated after link(); tests/link/test_link.py checks), instead of deep-copying the brick again.
         memo_key = ("link", key, tuple(x.brick.module.source_hash for x in node.tree))
         hit = self.lib_memo.get(memo_key) if self.lib_memo is not None else None
         if hit is not None:

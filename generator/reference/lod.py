@@ -25,7 +25,7 @@ Kaplanyan 2019):
 
     α'² = α² + 2 σ² = α² + 2 (1 − |N_a|) / |N_a|.
 
-The factor 2 is measured, not assumed (tests/test_lod.py): with α'² = α² + σ² (the form without it,
+The factor 2 is measured, not assumed (tests/library/test_lod.py): with α'² = α² + σ² (the form without it,
 sometimes quoted) the GGX highlight's patch error at MIP levels 3–6 is 1.5–2.1 times that with 2σ².
 
 The course's reduction for α goes through the same eq. 30: n(α) = 2/α² − 2 scaled by (1 − r)^lod,

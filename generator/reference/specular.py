@@ -3,7 +3,7 @@
 Phong (original and its plausibility steps), Blinn-Phong with R_F(alpha_h), Banks, Ward
 (isotropic, anisotropic), Ashikhmin-Shirley, Lafortune, Cook-Torrance. Each function cites
 the paper and equation it computes; where a model is printed in two formulations, both are
-here (the registered one and an alternative that tests/test_library_specular.py checks against
+here (the registered one and an alternative that tests/library/test_library_specular.py checks against
 it), computed from angles where the paper uses angles. Brick guards are not reproduced
 (models.py). Imported by models.py, which registers them.
 """
@@ -75,7 +75,7 @@ def banks(g: Geometry, p: dict, slots: dict) -> np.ndarray:
     """f = (k_s/π) max(0, v·r')^n for n·l > 0, else 0 (Banks 1994 with the course's cosine step), with
     v·r' = sqrt(1-(l·t)²) sqrt(1-(v·t)²) - (l·t)(v·t) (Heidrich & Seidel 1998; ACCURACY-FACTS §4.10):
     symmetric in l and v to the last bit, which the construction of banks_kernel() (checked against it
-    by tests/test_library_specular.py) is not."""
+    by tests/library/test_library_specular.py) is not."""
     lt, vt = g["LdotT"], g["VdotT"]
     # sin = sqrt(1 - cos²) of the unit vectors; inputs rounded to float32 are unit only to rounding
     sl, sv = np.sqrt(np.maximum(1.0 - lt * lt, 0.0)), np.sqrt(np.maximum(1.0 - vt * vt, 0.0))

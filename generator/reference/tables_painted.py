@@ -31,7 +31,7 @@ normalization. Why it is *reciprocal*: the term depends on h (and α_h) only, an
 symmetric in l and v. Why it is *energy-conserving*: the directional albedo is
 R(v) = R_F(0) ∫ D(h) (h·v) (n·l)⁺ dω_h (dω_l = 4 (h·v) dω_h), which at normal incidence is
 R_F(0) ∫ D cos θ_h (2cos²θ_h − 1)⁺ dω_h ≤ R_F(0); measured ≤ 1 for every view on the shipped maps, the
-cos^n family and rings of facets up to θ_h = 88° (tests/test_painted.py) — so ρ_d + R_F(0) ≤ 1 keeps
+cos^n family and rings of facets up to θ_h = 88° (tests/library/test_painted.py) — so ρ_d + R_F(0) ≤ 1 keeps
 the whole BRDF within 1, the notes' rule for the normalized Blinn-Phong.
 The integral is computed from the continuous painted function (the image linearly interpolated on
 its own axes, below), not from the table, by composite quadrature that resolves every painted

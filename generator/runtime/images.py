@@ -215,7 +215,7 @@ class Sampler:
     normalized coordinates (texel i's centre at (i + 0.5) / W), no anisotropy,
     no compare. generator/backends/numpy/resources.py computes the same bilinear
     clamp-to-edge fetch with exact float64 weights; a GPU rounds the weights to
-    its sub-texel precision (see tests/test_runtime_images.py for lavapipe's).
+    its sub-texel precision (see tests/runtime/test_runtime_images.py for lavapipe's).
     Cube views filter seamlessly across faces in Vulkan; the NumPy target clamps
     within a face, so they differ within half a texel of a face edge.
     Owned by its device: released by Device.close unless destroyed earlier.

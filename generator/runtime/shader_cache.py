@@ -14,7 +14,7 @@ so the render report can carry the driver's own count, not a guess of ours.
 
 One directory serves any number of devices: Mesa's keys include the driver's identity, so a
 foreign entry is a miss, never a wrong hit; its files carry their own checksums (a damaged
-entry is a miss too, measured in tests/test_render.py).
+entry is a miss too, measured in tests/runtime/test_render.py).
 """
 from __future__ import annotations
 

@@ -17,7 +17,7 @@ precision. Four counts:
 The constraints are data (spec/constraints.py): one Constraint per rule, each a
 predicate over a permutation's resolved bricks with the message and the fix it
 gives (Filament's variant filters, Unity's stripping log made readable);
-tests/test_explain.py holds their truth table.
+tests/scene/test_explain.py holds their truth table.
 """
 from __future__ import annotations
 

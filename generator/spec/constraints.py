@@ -4,7 +4,7 @@ Each rule is a predicate over a permutation's resolved bricks that returns
 (what is wrong, what to do), ('', '') when it holds. Scene loading refuses a
 material that breaks one (resolve.check_packing: the first broken rule, located
 at the material's packing; spec/resolve.py keeps every broken rule as the permutation's verdict); `shadermatrix matrix --explain` lists every combination
-of a scene's axes that breaks one, and why. tests/test_explain.py holds the truth
+of a scene's axes that breaks one, and why. tests/scene/test_explain.py holds the truth
 table: which permutations must and must not exist.
 """
 from __future__ import annotations

@@ -7,7 +7,7 @@ Schlick's Fresnel F(k.h) = R_s + (1 - R_s)(1 - k.h)^5 (eq. 5; R_s = R_F(0) = `f0
 Hoffman & Baker 2006 print it twice, with the exponent n_u cos^2 phi_h + n_v sin^2 phi_h
 and in the "implementation-friendly" dot-product form used here. The seed text of that
 second form divides by 1 + cos^2 theta_h: a typo, the paper's eq. 4 has 1 - (h.n)^2
-(= sin^2 theta_h; with it the two forms agree: tests/test_library_specular.py).
+(= sin^2 theta_h; with it the two forms agree: tests/library/test_library_specular.py).
 k is l or v (k.h = l.h = v.h). The normalization sqrt((n_u+1)(n_v+1))/(8 pi) makes the
 underlying Phong-type NDF integrate to 1 (ACCURACY-FACTS §4.9). Reciprocal.
 The diffuse term of the model (28 rho_d/(23 pi) ...) is not in this brick.

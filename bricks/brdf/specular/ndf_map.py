@@ -9,7 +9,7 @@ The generator bakes K_N p(θ_h) (generator/reference/tables_painted.py, table `n
 profile (the shipped example bricks/brdf/painted/ndf_map.png, or an engine's own image through
 tables_painted.bake_painted) scaled to D/4 with ∫ D cos θ_h dω_h = 1 — the microfacet normalization
 with the implicit visibility G = n·l n·v, so f = D R_F(0) / 4: reciprocal (a function of h only) and,
-measured, directional albedo ≤ R_F(0) (tests/test_painted.py). fp16: NDFs are HDR, and K_N p needs no
+measured, directional albedo ≤ R_F(0) (tests/library/test_painted.py). fp16: NDFs are HDR, and K_N p needs no
 constant in the shader. A coloured map is one NDF per channel, each normalized.
 
 Table: 64 × 1 fp16, the painting's own axis and size: u = √(1 − cos θ_h) (the profile is painted over

@@ -6,7 +6,7 @@ sin^2 phi_h / m_v)} and the "more implementation-friendly" exp{((cos alpha_u / m
 (cos alpha_v / m_v)^2) / cos^2 theta_h}, alpha_u, alpha_v the angles between h and t, b.
 Both as printed in the seed text lack the minus sign of the exponent, and the first divides
 by m_u, m_v where Ward 1992 eq. 5a has m_u^2, m_v^2 (cos alpha_u = sin theta_h cos phi_h,
-so with the sign and the squares restored the two agree: tests/test_library_specular.py).
+so with the sign and the squares restored the two agree: tests/library/test_library_specular.py).
 This brick uses the second (h.t, h.b, n.h: no angle, no tan). Normalization
 1/(cos theta_i cos theta_e) as in the course's isotropic Ward (see ward_isotropic.py).
 Specular albedo R_F(0) (`f0`, Ward's rho_s). Reciprocal. With m_u = m_v = m it equals

@@ -23,7 +23,7 @@ any `sample_level` lod read level 0 too). Weights are exact (float64); a GPU may
 them to its sub-texel precision (Vulkan requires ≥ 4 bits, subTexelPrecisionBits), so
 compare with a tolerance of that fraction of the texel differences. lavapipe filters
 float formats in float32: on R32G32B32A32_SFLOAT it agrees to ~1e-6
-(tests/test_lang_ext_textures.py).
+(tests/lang/test_lang_ext_textures.py).
 A texture2d_shadow is an array (H, W) (or (H, W, C), channel 0 read) of depths, read by
 sample_compare(t, uv, ref) as a linear comparison sampler with compareOp LESS_OR_EQUAL reads a
 depth image (Vulkan, "Depth Compare Operation" then "Texel Filtering"): each texel of the

@@ -20,7 +20,7 @@ common in renderers' conductor tables; f0 = (0.967, 0.802, 0.324)). The slot con
 f0, which this filler ignores: its normal-incidence reflectance is ((eta-1)^2 + k^2) /
 ((eta+1)^2 + k^2), set by eta and k.
 Measured in float32 within the microfacet host: 1.2e-6 on the hemisphere on every target; the
-Fresnel factor alone is within 3e-6 of float64 for gold, k = 0 and eta = 1 (tests/test_library_fillers.py).
+Fresnel factor alone is within 3e-6 of float64 for gold, k = 0 and eta = 1 (tests/library/test_library_fillers.py).
 """
 BRICK = {
     "kind": "fresnel",

@@ -5,7 +5,7 @@ Gotanda 2014, "Designing Reflectance Models for New Consoles", eq. 3 (seed 002),
 with cos theta = v.h. It is not an approximation of Schlick's (1 - c)^5 (max |difference|
 0.0388); it tracks the normalized exact dielectric curve (F - f0) / (1 - f0): max |error|
 0.0075 at eta = 1.5, 0.0130 at 2.0, 0.0230 at 1.33 (ACCURACY-FACTS §4.12, asserted in
-tests/test_library_fillers.py). Not to be confused with the UE4/Lagarde 2012 form
+tests/library/test_library_fillers.py). Not to be confused with the UE4/Lagarde 2012 form
 2^((-5.55473 c - 6.98316) c) (Gotanda's reference [8]).
 cos^8 is three squarings (no pow); exp2 of an argument in [-18.2, 0] never overflows.
 Measured in float32 within the microfacet host: 1.1e-6 on the hemisphere on every target.

@@ -13,7 +13,7 @@ Decisions:
   ndf=beckmann_anisotropic.
 - Normalization: Ward's D is a density in solid angle, integral of D d omega_h = 1, not in
   projected area: integral of D cos theta_h d omega_h = 1 - O(m^2) (quadrature: 0.99507 at
-  m = 0.1, 0.98109 at 0.2, 0.90535 at 0.5, 0.75787 at 1; tests/test_library_fillers.py), so
+  m = 0.1, 0.98109 at 0.2, 0.90535 at 0.5, 0.75787 at 1; tests/library/test_library_fillers.py), so
   it reflects less than a projected-area-normalized NDF (Beckmann) at the same m.
 - Seed typos: Hoffman & Baker 2006 (seed 000), "Ward - Anisotropic", print the exponent as
   e^{tan^2 theta_h (cos^2 phi / m_u + sin^2 phi / m_v)}: Ward 1992 eq. 5a has a minus sign

@@ -11,7 +11,7 @@ with no division by a, and the visibility term into (the cosines of G / (4 (n.l)
 V = 1 / (4 (n.l + (n.l) Lambda(l)) (n.v + (n.v) Lambda(v))),
 finite at n.l = 0 (n.l Lambda -> alpha / (2 sqrt(pi))). The fit's error bounds (cos) Lambda's absolute
 error by 7.5e-8 cos theta, so G1 has a relative error below 7.5e-8 (measured against the exact erfc
-form: V within 1.4e-7 in float64, 4.2e-7 in float32; tests/test_library_fillers.py), far below
+form: V within 1.4e-7 in float64, 4.2e-7 in float32; tests/library/test_library_fillers.py), far below
 Walter et al.'s own rational fit of G1 (eq. 27's (3.535 a + 2.181 a^2) / (1 + 2.276 a + 2.577 a^2),
 0.35 %: ACCURACY-FACTS, Mitsuba's).
 a >= 10 (Lambda < 1e-44) is evaluated at 10: Lambda underflows there in float32 either way.

@@ -6,7 +6,7 @@ for alpha the GGX roughness; ACCURACY-FACTS §4.11). Divided by 4 (n.l)(n.v), th
 V = 1 / (4 ((n.l)(1-k)+k) ((n.v)(1-k)+k)).
 The project's smith_schlick keeps k = alpha sqrt(2/pi) (Schlick's Beckmann fit; docs/design/accuracy.md).
 Error against exact separable Smith GGX (smith_ggx_separable), measured in float64
-(tests/test_library_fillers.py): max |G1 - G1_exact| = 0.140 at alpha = 0.1 (at n.x = 0.104),
+(tests/library/test_library_fillers.py): max |G1 - G1_exact| = 0.140 at alpha = 0.1 (at n.x = 0.104),
 0.100 at 0.3, 0.066 at 0.5, and 0 at alpha = 1 (k = 1/2 makes Schlick's G1 = 2c/(1 + c), the exact
 one). White furnace E(mu), F = 1, mu = 1 / 0.5 / 0.1: 0.9843 / 0.8897 / 0.6577 at alpha = 0.1 and
 0.6614 / 0.6077 / 0.6871 at 0.5, against 0.9883 / 0.9691 / 0.8728 and 0.6878 / 0.6860 / 0.7723 for

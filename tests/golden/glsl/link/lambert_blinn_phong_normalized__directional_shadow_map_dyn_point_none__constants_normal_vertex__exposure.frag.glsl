@@ -11,7 +11,7 @@
 // brick bricks/packing/normal/vertex.py sha256:<elided>
 // brick bricks/shadow/none.py sha256:<elided>
 // brick bricks/shadow/shadow_map.py sha256:<elided>
-// brick tests/link_bricks/output/exposure.py sha256:<elided>
+// brick tests/bricks/link/output/exposure.py sha256:<elided>
 // template glsl/fragment.glsl.j2 sha256:<elided>
 // template glsl/macros.glsl.j2 sha256:<elided>
 
@@ -88,7 +88,7 @@ float none_shadow(vec3 P) {
     return 1.0;
 }
 
-#line N "tests/link_bricks/output/exposure.py"
+#line N "tests/bricks/link/output/exposure.py"
 vec4 exposure_output(vec3 color, float ev) {
     return vec4((color * exp2(ev)), 1.0);
 }

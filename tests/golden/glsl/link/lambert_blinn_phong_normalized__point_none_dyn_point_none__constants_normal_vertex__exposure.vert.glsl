@@ -8,7 +8,7 @@
 // brick bricks/packing/constants.py sha256:<elided>
 // brick bricks/packing/normal/vertex.py sha256:<elided>
 // brick bricks/shadow/none.py sha256:<elided>
-// brick tests/link_bricks/output/exposure.py sha256:<elided>
+// brick tests/bricks/link/output/exposure.py sha256:<elided>
 // template glsl/macros.glsl.j2 sha256:<elided>
 // template glsl/vertex.glsl.j2 sha256:<elided>
 

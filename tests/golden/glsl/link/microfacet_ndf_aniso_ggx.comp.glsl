@@ -6,7 +6,7 @@
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:<elided>
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:<elided>
 // brick bricks/brdf/specular/microfacet.py sha256:<elided>
-// brick tests/link_bricks/ndf/aniso_ggx.py sha256:<elided>
+// brick tests/bricks/link/ndf/aniso_ggx.py sha256:<elided>
 // template glsl/eval.glsl.j2 sha256:<elided>
 // template glsl/macros.glsl.j2 sha256:<elided>
 
@@ -17,7 +17,7 @@ layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } sa
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
 layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[4]; } params;
 
-#line N "tests/link_bricks/ndf/aniso_ggx.py"
+#line N "tests/bricks/link/ndf/aniso_ggx.py"
 float aniso_ggx_ndf(float NdotH, float HdotT, float HdotB, float alpha_u, float alpha_v) {
     float x = (HdotT / alpha_u);
     float y = (HdotB / alpha_v);

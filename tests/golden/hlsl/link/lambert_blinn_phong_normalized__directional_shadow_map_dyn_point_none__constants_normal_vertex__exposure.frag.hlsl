@@ -9,7 +9,7 @@
 // brick bricks/packing/normal/vertex.py sha256:<elided>
 // brick bricks/shadow/none.py sha256:<elided>
 // brick bricks/shadow/shadow_map.py sha256:<elided>
-// brick tests/link_bricks/output/exposure.py sha256:<elided>
+// brick tests/bricks/link/output/exposure.py sha256:<elided>
 // template hlsl/fragment.hlsl.j2 sha256:<elided>
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 
@@ -95,7 +95,7 @@ float none_shadow(float3 P) {
     return 1.0;
 }
 
-#line N "tests/link_bricks/output/exposure.py"
+#line N "tests/bricks/link/output/exposure.py"
 float4 exposure_output(float3 color, float ev) {
     return float4((color * exp2(ev)), 1.0);
 }

@@ -4,7 +4,7 @@
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:<elided>
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:<elided>
 // brick bricks/brdf/specular/microfacet.py sha256:<elided>
-// brick tests/link_bricks/ndf/aniso_ggx.py sha256:<elided>
+// brick tests/bricks/link/ndf/aniso_ggx.py sha256:<elided>
 // template hlsl/eval.hlsl.j2 sha256:<elided>
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 
@@ -14,7 +14,7 @@ StructuredBuffer<float4> samples : register(t0, space0);
 RWStructuredBuffer<float4> result : register(u1, space0);
 cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[4]; };
 
-#line N "tests/link_bricks/ndf/aniso_ggx.py"
+#line N "tests/bricks/link/ndf/aniso_ggx.py"
 float aniso_ggx_ndf(float NdotH, float HdotT, float HdotB, float alpha_u, float alpha_v) {
     float x = (HdotT / alpha_u);
     float y = (HdotB / alpha_v);

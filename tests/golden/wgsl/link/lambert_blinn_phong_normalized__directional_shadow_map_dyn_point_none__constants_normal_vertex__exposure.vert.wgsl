@@ -9,7 +9,7 @@
 // brick bricks/packing/normal/vertex.py sha256:<elided>
 // brick bricks/shadow/none.py sha256:<elided>
 // brick bricks/shadow/shadow_map.py sha256:<elided>
-// brick tests/link_bricks/output/exposure.py sha256:<elided>
+// brick tests/bricks/link/output/exposure.py sha256:<elided>
 // template wgsl/macros.wgsl.j2 sha256:<elided>
 // template wgsl/vertex.wgsl.j2 sha256:<elided>
 

@@ -7,7 +7,7 @@
 // brick bricks/packing/constants.py sha256:<elided>
 // brick bricks/packing/normal/vertex.py sha256:<elided>
 // brick bricks/shadow/none.py sha256:<elided>
-// brick tests/link_bricks/output/exposure.py sha256:<elided>
+// brick tests/bricks/link/output/exposure.py sha256:<elided>
 // template wgsl/fragment.wgsl.j2 sha256:<elided>
 // template wgsl/macros.wgsl.j2 sha256:<elided>
 

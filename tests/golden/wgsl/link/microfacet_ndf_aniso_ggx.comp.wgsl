@@ -4,7 +4,7 @@
 // brick bricks/brdf/microfacet/fresnel/schlick.py sha256:<elided>
 // brick bricks/brdf/microfacet/visibility/smith_schlick.py sha256:<elided>
 // brick bricks/brdf/specular/microfacet.py sha256:<elided>
-// brick tests/link_bricks/ndf/aniso_ggx.py sha256:<elided>
+// brick tests/bricks/link/ndf/aniso_ggx.py sha256:<elided>
 // template wgsl/eval.wgsl.j2 sha256:<elided>
 // template wgsl/macros.wgsl.j2 sha256:<elided>
 
