@@ -55,10 +55,13 @@ class Compiled:
 def compose_chunk(ctx: BuildContext, items) -> tuple[dict[str, Composed], dict[str, list[str]], list[CompileJob]]:
     """(Composed by hash, compose errors by hash, compile jobs) of a chunk of (hash, permutation) pairs."""
     from ..compose import compose_permutation  # Jinja and the emitters load only when something is composed
+    from ..link import link_permutation
+    from ..spec.resolve import resolve
     composed, errors, jobs = {}, {}, []
     for h, perm in items:
-        try:
-            c = composed[h] = compose_permutation(perm, ctx.library, ctx.languages, ctx.dialects)
+        try:  # each stage once, forward: the resolved key, its linked program, then its sources
+            linked = link_permutation(resolve(perm, ctx.library), ctx.library)
+            c = composed[h] = compose_permutation(linked, ctx.library, ctx.languages, ctx.dialects)
         except SourceError as e:
             errors[h] = [str(e)]
             continue
