@@ -22,6 +22,8 @@ test: setup
 	@if [ -x .venv-alt/bin/python ]; then \
 	  echo "make test: $(ALT_TESTS) on $$(.venv-alt/bin/python -V)"; \
 	  .venv-alt/bin/python -m pytest -q -p no:cacheprovider $(ALT_TESTS); \
+	else \
+	  echo "make test: no second Python of another version on this machine — ALT_TESTS ran on $$($(PY) -V) only"; \
 	fi
 
 lint: setup

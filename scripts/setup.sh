@@ -123,7 +123,7 @@ alt=""
 for cand in /usr/bin/python3 "$(command -v python3 || true)" "$(command -v python3.11 || true)" "$(command -v python3.12 || true)"; do
   [[ -n "$cand" && -x "$cand" ]] || continue
   v=$(py_version "$cand")
-  [[ -n "$v" && "$v" != "$main_version" ]] && "$cand" -c 'import sys; sys.exit(sys.version_info < (3, 11))' &&
+  [[ -n "$v" && "$v" != "$main_version" ]] && "$cand" -c 'import sys; sys.exit(sys.version_info < (3, 11, 2))' &&
     "$cand" -c 'import ensurepip, venv' >/dev/null 2>&1 && { alt=$cand; break; }
 done
 if [[ -n "$alt" ]]; then
@@ -133,9 +133,13 @@ if [[ -n "$alt" ]]; then
   fi
   if [[ ! -f .venv-alt/.setup-stamp || "$(cat .venv-alt/.setup-stamp)" != "$want_stamp" ]]; then
     echo "setup: installing Python packages into .venv-alt (Python $(py_version "$alt"), the second Python of make test)"
-    .venv-alt/bin/python -m pip install -q --disable-pip-version-check -r requirements.lock
-    .venv-alt/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation --config-settings editable_mode=compat -e .
-    echo "$want_stamp" > .venv-alt/.setup-stamp
+    if .venv-alt/bin/python -m pip install -q --disable-pip-version-check -r requirements.lock &&
+       .venv-alt/bin/python -m pip install -q --disable-pip-version-check --no-deps --no-build-isolation --config-settings editable_mode=compat -e .; then
+      echo "$want_stamp" > .venv-alt/.setup-stamp
+    else  # the second Python is a check beside the first, never a reason the set-up fails
+      echo "setup: warning: could not install the packages for $alt — make test runs on .venv's Python only" >&2
+      rm -rf .venv-alt
+    fi
   fi
 fi
 
@@ -143,7 +147,10 @@ fi
 # $SHADERMATRIX_TOOLS, then in the bin/ of the Python that runs it (so also when .venv is not activated),
 # then on PATH (generator/toolchain/locate.py).
 for venv in .venv .venv-alt; do
-  if [[ -x .tools/bin/naga && -d $venv/bin ]]; then
+  [[ -d $venv/bin ]] || continue
+  if [[ "$(naga_version .tools/bin/naga)" == "$NAGA_VERSION" ]]; then
     ln -sfn ../../.tools/bin/naga "$venv/bin/naga"
+  elif [[ -L $venv/bin/naga ]]; then  # a link to a naga of another pin: the one on PATH is the pinned one
+    rm -f "$venv/bin/naga"
   fi
 done

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import in_ci, require
+from tests.conftest import in_ci, require, require_tool
 
 REPO = Path(__file__).resolve().parents[2]
 SOURCES = ("pyproject.toml", "setup.py", "README.md", "generator", "bricks")  # what the wheel is built from
@@ -129,11 +129,14 @@ def test_installed_build_is_byte_identical_to_the_clones(installed, tmp_path):
     # the install compiles every shader itself (a cache of its own, its tools found by its own find_tool);
     # the clone's build then reads the same cache: identical SPIR-V either way, and twice as fast
     cache = tmp_path / "cache"
+    # the tools where the clone's build finds them (make setup puts naga in .venv/bin, not on PATH): the
+    # installed package finds them through the documented setting
+    tools = os.pathsep.join(sorted({str(Path(require_tool(t)).parent) for t in ("naga", "glslc", "spirv-val")}))
     for name, shadermatrix, env in (("installed", [python.parent / "shadermatrix"], {}),
                                     ("clone", [sys.executable, "-m", "generator.cli"], {"PYTHONPATH": str(src)})):
         out = tmp_path / name
         _run([*shadermatrix, "build", scene, "--out", out, "--depfile", tmp_path / f"{name}.d"], cwd=cwd,
-             env=_env(SHADERMATRIX_CACHE_DIR=str(cache), **env))
+             env=_env(SHADERMATRIX_CACHE_DIR=str(cache), SHADERMATRIX_TOOLS=tools, **env))
         outs[name] = _tree(out)
     installed_files, clone_files = outs["installed"], outs["clone"]
     assert sorted(installed_files) == sorted(clone_files)
@@ -163,15 +166,12 @@ def test_installed_build_is_byte_identical_to_the_clones(installed, tmp_path):
 def test_installed_doctor_reads_its_pins_and_finds_tools_by_the_setting(installed, tmp_path):
     python, _, src = installed
     pins = tomllib.loads((src / "generator" / "toolchain" / "pins.toml").read_text())
-    naga = shutil.which("naga")
-    require(naga is not None, "naga not found — run `make setup` (scripts/setup.sh)")
+    naga = require_tool("naga")
     # a PATH holding every tool but naga (links to the real ones), and naga in a folder of its own
     tools, own = tmp_path / "tools", tmp_path / "naga-only"
     tools.mkdir(), own.mkdir()
     for tool in ("glslc", "glslangValidator", "spirv-val", "spirv-opt", "spirv-as"):
-        found = shutil.which(tool)
-        require(found is not None, f"{tool} not found — run `make setup` (scripts/setup.sh)")
-        (tools / tool).symlink_to(found)
+        (tools / tool).symlink_to(require_tool(tool))
     (own / "naga").symlink_to(naga)
     doctor = [python.parent / "shadermatrix", "doctor"]
     r = _run(doctor, cwd=_elsewhere(tmp_path), env=_env(PATH=str(tools)), check=False)

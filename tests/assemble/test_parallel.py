@@ -97,7 +97,7 @@ def _session_pythons(sid: int, tools: bool = False) -> list[int]:
             continue
         comm, rest = text.split(b"(", 1)[1].rsplit(b")", 1)
         fields = rest.split()
-        wanted = b"python" in comm or (tools and comm.startswith((b"glslc", b"naga", b"spirv-")))
+        wanted = b"python" in comm or (tools and comm.startswith((b"glslc", b"glslang", b"naga", b"spirv-", b"dxc")))
         if wanted and int(fields[3]) == sid and fields[0] != b"Z":
             alive.append(int(stat.parent.name))
     return alive

@@ -207,6 +207,7 @@ def _fake_tool(folder, name="naga"):
 
 def test_tools_setting_comes_before_the_environment_and_path(tmp_path, monkeypatch):
     on_path, in_env, in_setting = (_fake_tool(tmp_path / d) for d in ("path", "venv", "setting"))
+    monkeypatch.delenv("SHADERMATRIX_TOOLS", raising=False)
     monkeypatch.setenv("PATH", str(tmp_path / "path"))
     monkeypatch.setattr("sysconfig.get_path", lambda name: str(tmp_path / "venv"))
     assert toolchain.find_tool("naga") == in_env  # the venv's bin/ (where `make setup` links naga) before PATH
