@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from itertools import product
 
+from ..lang import SourceError
 from ..library.bricks import Library
 from ..spec.constraints import CONSTRAINTS
 from ..spec.permutation import Permutation, resolve
@@ -31,7 +32,10 @@ from .load import Scene
 
 def violations(perm: Permutation, lib: Library) -> list[tuple[str, str]]:
     """(constraint name, why) for every constraint the permutation breaks; [] when it may exist."""
-    r = resolve(perm, lib)
+    try:
+        r = resolve(perm, lib)
+    except SourceError as e:  # bricks that cannot share one material (a parameter's type or range clashes)
+        return [("parameter policy", str(e))]
     return [(c.name, why) for c in CONSTRAINTS if (why := c.problem(r)[0])]
 
 

@@ -159,7 +159,7 @@ class ToolsStopped(RuntimeError):
 
 
 _RUNNING: set = set()  # the tool processes running now (any thread)
-_RUNNING_LOCK = threading.Lock()
+_RUNNING_LOCK = threading.RLock()  # re-entrant: the build's signal handler calls stop_tools() on the thread it interrupts, which may hold it
 _STOPPED = threading.Event()
 
 
