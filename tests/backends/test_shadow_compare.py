@@ -25,7 +25,7 @@ from generator.backends import get_target
 from tests.lavapipe import device, no_validation_messages  # noqa: F401  (fixtures)
 from tests.regen_goldens import REPO
 
-BRICK = REPO / "tests" / "bricks" / "ext_shadow_compare.py"
+BRICK = REPO / "tests" / "bricks" / "lang" / "ext_shadow_compare.py"
 GLOBALS = [ir.Global("depth", TEXTURE2D_SHADOW, 0, 2)]
 
 SHELL = {

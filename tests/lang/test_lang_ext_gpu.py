@@ -13,7 +13,7 @@ from generator.backends import get_target
 from tests.lavapipe import device, no_validation_messages  # noqa: F401  (fixtures)
 from tests.regen_goldens import REPO
 
-BRICK = REPO / "tests" / "bricks" / "ext_gpu.py"
+BRICK = REPO / "tests" / "bricks" / "lang" / "ext_gpu.py"
 
 SHELL = {
     "glsl": "#version 450\n{header}\nlayout(local_size_x = 1) in;\n"

@@ -14,7 +14,7 @@ from generator.backends import get_target
 from tests.lavapipe import device, no_validation_messages  # noqa: F401  (fixtures)
 from tests.regen_goldens import REPO
 
-BRICK = REPO / "tests" / "bricks" / "ext_texture.py"
+BRICK = REPO / "tests" / "bricks" / "lang" / "ext_texture.py"
 GLOBALS = [ir.Global("img", TEXTURE2D, 0, 2), ir.Global("cube", TEXTURECUBE, 0, 4)]
 
 SHELL = {

@@ -13,7 +13,7 @@ from generator.backends import get_target
 from tests.lavapipe import device, no_validation_messages  # noqa: F401  (fixtures)
 from tests.regen_goldens import REPO
 
-BRICK = REPO / "tests" / "bricks" / "semantics.py"
+BRICK = REPO / "tests" / "bricks" / "lang" / "semantics.py"
 XS = np.array([-7.5, -3.2, -1.0, -0.5, 0.0, 0.5, 1.7, 3.0, 7.9], np.float32)
 
 SHELL = {
