@@ -40,7 +40,7 @@ class Kind:
 
     entries: the functions the generator calls; a packing's entries are every
       function named `get_<material input>` (prefix_entries), returning that input
-      with the type the BRDF gives it (spec/permutation.check_packing).
+      with the type the BRDF gives it (spec/resolve.check_packing).
     reads: "shading" (the inputs table) or "surface" (P, N, T, B, uv).
     slot: a kind that fills a slot of a host brick (called from the host, not the glue).
     """

@@ -26,7 +26,8 @@ from itertools import product
 from ..lang import SourceError
 from ..library.bricks import Library
 from ..spec.constraints import CONSTRAINTS
-from ..spec.permutation import Permutation, resolve
+from ..spec.permutation import Permutation
+from ..spec.resolve import resolve
 from .load import Scene
 
 

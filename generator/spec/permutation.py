@@ -231,10 +231,3 @@ class Permutation:
         """12 hex digits of the SHA-256 of the canonical key (file names, cache keys)."""
         return hashlib.sha256(self.canonical().encode()).hexdigest()[:12]
 
-
-def __getattr__(name: str):
-    """What spec/resolve.py defines, also importable from here (where it lived before it grew)."""
-    if name in ("Resolved", "resolve", "check_packing", "fp16_warnings"):
-        from . import resolve as _resolve
-        return getattr(_resolve, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

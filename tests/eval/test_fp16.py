@@ -257,7 +257,7 @@ def test_fp16_scene_builds(tmp_path):
 def test_build_warns_for_an_fp16_unsafe_brick(tmp_path):
     """A brick whose metadata says "fp16": "unsafe: ..." makes an fp16 build warn (and only an fp16 one)."""
     from generator.library.bricks import load_library
-    from generator.spec.permutation import fp16_warnings
+    from generator.spec.resolve import fp16_warnings
     from generator.scene.load import load_scene
 
     bricks = tmp_path / "bricks" / "brdf" / "diffuse"

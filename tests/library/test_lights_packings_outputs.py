@@ -403,7 +403,8 @@ def test_specular_map_is_the_course_shift_variant_shader(lib):
     ("lambert+blinn_phong_normalized", "gltf_metallic_roughness", "alpha"),
 ])
 def test_a_packing_providing_what_the_brdf_does_not_read_is_one_clear_error(lib, brdf, packing, names):
-    from generator.spec.permutation import LightKey, Permutation, check_packing, resolve
+    from generator.spec.permutation import LightKey, Permutation
+    from generator.spec.resolve import check_packing, resolve
 
     r = resolve(Permutation(brdf, (LightKey("directional", "none"),), packing, "linear"), lib)
     problem, todo = check_packing(r)

@@ -211,7 +211,7 @@ def test_one_normal_map_binding_and_only_the_parameters_read(lib, brdf, packing,
 @pytest.mark.parametrize("brdf,packing,provides", [(GGX, "toksvig_n", "n"),
                                                    (f"lambert+{BP}", "toksvig_alpha", "alpha")])
 def test_a_toksvig_packing_on_a_brdf_without_its_parameter_is_one_clear_error(lib, brdf, packing, provides):
-    from generator.spec.permutation import check_packing, resolve
+    from generator.spec.resolve import check_packing, resolve
 
     problem, todo = check_packing(resolve(_perm(brdf, packing), lib))
     assert f"packing '{packing}' provides {provides}, which BRDF" in problem, problem

@@ -252,7 +252,7 @@ def test_an_isotropic_brdf_ignores_the_twist(lib):
 
 
 def test_twist_fillers_satisfy_the_tangent_frame_constraint(lib):
-    from generator.spec.permutation import check_packing, resolve
+    from generator.spec.resolve import check_packing, resolve
 
     for normal in ("twist_map", "normal_twist_map"):
         for brdf in ANISOTROPIC:

@@ -102,7 +102,7 @@ def run(args) -> int:
         if args.json:  # a script reading stdout gets its answer too
             print(json.dumps({"ok": False, "failures": [str(e)]}, indent=2))
         raise
-    from ...spec.permutation import fp16_warnings
+    from ...spec.resolve import fp16_warnings
     for w in fp16_warnings(scene.permutations.values(), lib):  # bricks marked "fp16": "unsafe: ..."
         print(f"warning: {w}", file=sys.stderr)
     if args.validate_ir:
