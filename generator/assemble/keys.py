@@ -76,7 +76,7 @@ def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict], mem
             if isinstance(memo[part], Exception):
                 raise memo[part]
             bricks.update(memo[part])
-    except (SourceError, SpecError) as e:  # it will fail to compose too: key it by the error
+    except (SourceError, SpecError, LookupError) as e:  # it will fail to compose too: key it by the error
         bricks = {"error": str(e)}
     mats = sorted({o["material"] for o in objs})
     lights = sorted({ln for o in objs for ln in o["lights"]})
@@ -93,7 +93,8 @@ def _bricks_of(part: tuple, lib: Library):
         if kind in ("light", "output"):  # a light brick (and its shadow filter's spec), an output brick
             brick = lib.get(kind, value.light if kind == "light" else value)
             if brick is None:
-                raise SourceError("<key>", 1, 1, f"unknown {kind} brick in {value}", f"name a known {kind} brick")
+                # only keys the build (the scene loader has reported the unknown name, located)
+                return LookupError(f"unknown {kind} brick in {value}")
             nodes, extra = (parse_spec(value.shadow, lib, ("shadow",)) if kind == "light" else []), [brick]
         else:
             nodes, extra = (parse_brdf(value, lib) if kind == "brdf" else parse_spec(value, lib, ("packing",))), []
