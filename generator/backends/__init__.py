@@ -53,17 +53,6 @@ def template_file(name: str) -> Path:
     return template_root(folder) / rest
 
 
-def template_name(path) -> str:
-    """The name ("glsl/fragment.glsl.j2") of a template file: template_file()'s inverse."""
-    p = Path(path).resolve()
-    for folder in TEMPLATE_PACKAGES:
-        root = template_root(folder).resolve()
-        if p.is_relative_to(root):
-            return f"{folder}/{p.relative_to(root).as_posix()}"
-    raise ValueError(f"{path} is not a template of any back end (their templates/ folders: "
-                     f"{', '.join(TEMPLATE_PACKAGES)})")
-
-
 def parse_languages(text: str) -> list[str]:
     """"glsl,wgsl" -> ["glsl", "wgsl"]; ValueError naming the problem for an unknown, repeated or missing name."""
     items = [x.strip() for x in text.split(",") if x.strip()]
@@ -91,4 +80,4 @@ def get_target(name: str, precision: str = "fp32") -> Target:
 
 
 __all__ = ["DIALECTS", "Emitted", "HALF_TARGETS", "LANGUAGES", "Language", "TARGETS", "TEMPLATE_PACKAGES", "Target",
-           "get_target", "language", "parse_languages", "template_file", "template_name"]
+           "get_target", "language", "parse_languages", "template_file"]

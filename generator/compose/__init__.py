@@ -20,33 +20,20 @@ from ..spec.permutation import Permutation
 from ..backends import LANGUAGES, TEMPLATE_PACKAGES, Language, language, template_file
 from ..backends.base import Emitted
 
-_LOADED: set[str] = set()  # every template file this process has read (for depfiles)
-
-
-class _RecordingLoader(jinja2.PrefixLoader):
+class _TemplateLoader(jinja2.PrefixLoader):
     """Templates by name: "glsl/fragment.glsl.j2" is fragment.glsl.j2 in the templates/ folder of the back end
     owning folder "glsl" (backends.TEMPLATE_PACKAGES), read by a jinja2.PackageLoader wherever the package is
-    installed. Remembers which files it read: a build's depfile lists what was loaded."""
+    installed. (A build's depfile lists the templates its composed units name, not what a process loaded.)"""
 
     # A template compiles under its full name, as it did from one folder (PrefixLoader.load would hand the
     # package's loader the name without its folder): Jinja's messages name "glsl/fragment.glsl.j2".
     load = jinja2.BaseLoader.load
 
-    def get_source(self, environment, template):
-        source, filename, uptodate = super().get_source(environment, template)
-        _LOADED.add(filename)
-        return source, filename, uptodate
-
-
-def loaded_templates() -> list[str]:
-    """The template files (absolute paths) read so far by this process, sorted."""
-    return sorted(_LOADED)
-
 
 def jinja_env() -> jinja2.Environment:
     """The one Jinja environment (StrictUndefined: a missing value is an error, not an empty string)."""
     return jinja2.Environment(
-        loader=_RecordingLoader({folder: jinja2.PackageLoader(package, "templates")
+        loader=_TemplateLoader({folder: jinja2.PackageLoader(package, "templates")
                                  for folder, package in TEMPLATE_PACKAGES.items()}),
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,
