@@ -50,14 +50,9 @@ def position(text: str, index: int) -> tuple[int, int]:
     return line, index - start + 1
 
 
-def read_text(path, what: str, limit: int = MAX_INPUT_BYTES) -> str:
-    """A UTF-8 file's text; a decoding or reading problem is a SourceError at the offending byte.
-
-    Only regular files are read (a FIFO would block forever, a device or a symlink to /dev/zero never
-    ends), and at most `limit` bytes of them: anything else is one located error. A UTF-8 byte-order mark
-    at the start is dropped (Windows editors write one; Python reads source files the same way); a UTF-16
-    or UTF-32 one is an error that says so.
-    """
+def read_bytes(path, what: str, limit: int = MAX_INPUT_BYTES) -> bytes:
+    """A regular file's bytes, at most `limit` of them; anything else (a FIFO, a device, a larger file, an
+    unreadable path) is one SourceError naming the file."""
     import os
     import stat
 
@@ -84,11 +79,23 @@ def read_text(path, what: str, limit: int = MAX_INPUT_BYTES) -> str:
             if size > limit:
                 raise SourceError(shown, 1, 1, f"the {what} is more than {limit} bytes", "check the path")
             chunks.append(part)
-        data = b"".join(chunks)
+        return b"".join(chunks)
     except OSError as e:
         raise SourceError(shown, 1, 1, f"cannot read {what}: {e.strerror}", "check the path") from None
     finally:
         os.close(fd)
+
+
+def read_text(path, what: str, limit: int = MAX_INPUT_BYTES) -> str:
+    """A UTF-8 file's text; a decoding or reading problem is a SourceError at the offending byte.
+
+    Only regular files are read (a FIFO would block forever, a device or a symlink to /dev/zero never
+    ends), and at most `limit` bytes of them: anything else is one located error. A UTF-8 byte-order mark
+    at the start is dropped (Windows editors write one; Python reads source files the same way); a UTF-16
+    or UTF-32 one is an error that says so.
+    """
+    data = read_bytes(path, what, limit)
+    shown = str(path)
     for bom, encoding in _BOMS.items():
         if data.startswith(bom):
             raise SourceError(shown, 1, 1, f"the {what} is {encoding} text (it starts with a {encoding} byte-order "

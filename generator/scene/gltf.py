@@ -67,9 +67,7 @@ from __future__ import annotations
 import binascii
 import json
 import math
-import os
 import re
-import stat
 import struct
 import warnings
 from dataclasses import dataclass, field
@@ -78,6 +76,7 @@ from pathlib import Path
 import numpy as np
 
 from ..lang import SourceError
+from ..lang.errors import read_bytes
 from ..library.bricks import Library
 from ..spec.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
 from ..spec.resolve import check_packing, light_params, resolve
@@ -142,29 +141,7 @@ def _ptr(*parts) -> str:
 
 
 def _read_bytes(path: Path, what: str) -> bytes:
-    shown = str(path)
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except OSError as e:
-        raise SourceError(shown, 1, 1, f"cannot read {what}: {e.strerror}", "check the path") from None
-    try:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise SourceError(shown, 1, 1, f"the {what} is not a regular file", f"give a {what} file")
-        chunks, size = [], 0
-        while True:
-            part = os.read(fd, 1 << 20)
-            if not part:
-                break
-            size += len(part)
-            if size > MAX_GLTF_BYTES:
-                raise SourceError(shown, 1, 1, f"the {what} is more than {MAX_GLTF_BYTES} bytes", "check the path")
-            chunks.append(part)
-        return b"".join(chunks)
-    except OSError as e:
-        raise SourceError(shown, 1, 1, f"cannot read {what}: {e.strerror}", "check the path") from None
-    finally:
-        os.close(fd)
+    return read_bytes(path, what, MAX_GLTF_BYTES)
 
 
 def _parse_json(shown: str, text: str, where: str = ""):
