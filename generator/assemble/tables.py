@@ -2,7 +2,7 @@
 
 A permutation (or the ubershader) that samples a texture a brick declares as a table
 (reference/tables.py) needs the table's texels at run time; the engine loads them from
-``OUT/tables/<table>.<W>x<H>.<format>.<sha12>.ktx2`` (assemble/ktx2.py: one level, RGBA, linear). The file
+``OUT/tables/<table>.<W>x<H>.<format>.<sha12>.ktx2`` (io/ktx2.py: one level, RGBA, linear). The file
 name carries the texels' sha256, so a changed baker writes a new file and never overwrites one a
 manifest names; the manifest's ``tables`` list says, per table: the texture name the shaders bind, the
 table, path, sha256 of the file, format, size, bytes, the reference it is baked from, its filtered error
@@ -48,7 +48,7 @@ def write_tables(out: Path, lib, manifest: dict, count=None, previous: dict | No
     files its baker reads) is that of the `previous` manifest's row, with its file intact, keeps that row:
     neither baked nor measured again."""
     from ..reference.tables import baked, inputs, lookup, sha256, table_error
-    from .ktx2 import encode
+    from ..io.ktx2 import encode
 
     decl = lib.tables()
     users = _users(manifest, decl)

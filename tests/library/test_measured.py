@@ -156,7 +156,7 @@ def test_a_missing_file_or_a_directory_is_an_error_naming_it(tmp_path):
 
 
 def test_the_cli_bakes_both_factors_from_a_measured_file(merl_file, tmp_path):
-    from generator.assemble.ktx2 import decode
+    from generator.io.ktx2 import decode
 
     path, _, _ = merl_file
 

@@ -101,7 +101,7 @@ def test_a_build_writes_the_tables_its_shaders_sample_as_ktx2_listed_in_the_mani
     import subprocess
     import sys
 
-    from generator.assemble.ktx2 import decode
+    from generator.io.ktx2 import decode
 
     def build(brdf, extra=""):
         scene = tmp_path / "s.toml"
@@ -145,7 +145,7 @@ def test_the_tables_command_lists_and_bakes(tmp_path):
     import subprocess
     import sys
 
-    from generator.assemble.ktx2 import decode
+    from generator.io.ktx2 import decode
 
     def cli(*a):
         return subprocess.run([sys.executable, "-m", "generator.cli", "tables", *a], capture_output=True, text=True,

@@ -2,7 +2,7 @@
 
 Without --bake: every texture a brick declares as a baked table (reference/tables.py) — brick, texture,
 table, size, format, bytes, what it is baked from and its filtered error (`table_error`). With
---bake TABLE --out FILE.ktx2: the table's texels in KTX2 (assemble/ktx2.py) at the declaring brick's size
+--bake TABLE --out FILE.ktx2: the table's texels in KTX2 (io/ktx2.py) at the declaring brick's size
 and format (or --size/--format); a painted table (ndf_map, fresnel_ramp, …) takes the artist's image
 with --image FILE.png and normalizes it as the brick needs (the shader stays the same: an engine binds
 the file in place of the build's default table). The factors of `homomorphic_factorization`
@@ -51,7 +51,7 @@ def listing(lib) -> list[dict]:
 
 
 def bake(lib, args) -> int:
-    from ...assemble.ktx2 import encode
+    from ...io.ktx2 import encode
     from ...io import atomic_write
     from ...reference.tables import TableError, baked, lookup
     from ... import __version__

@@ -2,7 +2,7 @@
 
 The independent reader below is written from the KTX 2.0 specification ("File Structure", "Index",
 "Level Index", "Key/Value Data", "mipPadding") and the Khronos Data Format 1.3 basic descriptor
-block (§5) with ``struct`` alone: it does not call generator.assemble.ktx2, so a misreading of the
+block (§5) with ``struct`` alone: it does not call generator.io.ktx2, so a misreading of the
 spec shared by our writer and our reader cannot pass unnoticed.
 """
 from __future__ import annotations
@@ -13,7 +13,7 @@ import struct
 import numpy as np
 import pytest
 
-from generator.assemble.ktx2 import FORMATS, Ktx2Error, decode, encode
+from generator.io.ktx2 import FORMATS, Ktx2Error, decode, encode
 from generator.lang.errors import UserError
 
 KINDS = {"1d": ((1, 7, 4), False), "2d": ((3, 5, 4), False), "cube": ((6, 4, 4, 4), True)}
