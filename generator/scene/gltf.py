@@ -52,6 +52,13 @@ mesh, else `node<i>`), `#<primitive>` when the mesh has several, made unique wit
 carries its mesh (runtime/meshes.Mesh: positions, normals, tangents, uvs, uint32 indices; TRIANGLES,
 strips and fans unrolled; points and lines skipped with a note) and its world matrix (`model`, 4×4).
 Quantized attributes (KHR_mesh_quantization: normalized or plain integers) are decoded to float32.
+Origins. Each permutation carries where its first object asked for it (spec/where.py), so an error
+resolving or linking it names the glTF object to edit, found in the JSON text by scene/jsonpos.py:
+the material (for glTF's default material, the primitive), the primitive's COLOR_0 for the vertex
+colours, each light's KHR_lights_punctual definition. In a .gltf that is the object's line and column
+with its pointer: `model.gltf:12:5: /materials/2: what is wrong — what to do`. A .glb has no lines to
+go to, so its errors are at 1:1 and name the pointer and the object's byte offset in the file:
+`model.glb:1:1: /materials/2 (byte 1234): …` (the pointer is what glTF tools and viewers show).
 Checked on import: what the mapping reads (materials, textures, images, the scenes' node trees,
 the primitives and accessors of the meshes they instance, buffers, lights); meshes no node instances
 and animations, skins, cameras are not read, so not checked.
@@ -70,7 +77,7 @@ import math
 import re
 import struct
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -80,6 +87,7 @@ from ..lang.errors import read_bytes
 from ..library.bricks import Library
 from ..spec.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
 from ..spec.resolve import check_packing, light_params, resolve
+from .jsonpos import origins
 from .load import Light, Material, Scene, surface_specs
 from ..spec.surface import EMISSIVE_MAP, Surface
 
@@ -477,6 +485,8 @@ def load_gltf(path, lib: Library) -> Scene:
     set_names = _unique_names([s.get("name") if isinstance(s.get("name"), str) else "" for s in scenes], "scene")
     obj_names: set[str] = set()
     light_names: set[str] = set()
+    light_ptrs: dict[str, str] = {}  # light name -> the pointer of its KHR_lights_punctual definition
+    asks: dict[str, tuple] = {}  # permutation hash -> (part, pointer) pairs: where its first object asked for it
     hashes: dict[Permutation, str] = {}
     skipped_modes: set[str] = set()
     mesh_cache: dict[tuple, tuple] = {}
@@ -519,6 +529,7 @@ def load_gltf(path, lib: Library) -> Scene:
             lname = _free_name(_clean(base), light_names)
             light_names.add(lname)
             scene.lights[lname] = _light(rd, lib, klights[k], f"{lptr}/lights/{k}", lname, world)
+            light_ptrs[lname] = f"{lptr}/lights/{k}"
             members.append(lname)
         if len(members) > MAX_LIGHTS_PER_SET:
             raise rd.err(sptr, f"scene {si} has {len(members)} lights, more than the {MAX_LIGHTS_PER_SET} a "
@@ -563,13 +574,18 @@ def load_gltf(path, lib: Library) -> Scene:
                 if h is None:
                     h = hashes[perm] = perm.hash
                     scene.permutations.setdefault(h, perm)
-                    scene.where.setdefault(h, (1, 1))
+                    asks[h] = ((("brdf", m.source if mat_i is not None else pptr),)
+                               + ((("vertex_color", f"{pptr}/attributes/COLOR_0"),) if m.surface.vertex_color else ())
+                               + tuple((f"light{k}", light_ptrs[n]) for k, n in enumerate(members)))
                 scene.users.setdefault(h, []).append(oname)
                 scene.objects.append({"name": oname, "material": m.name, "light_set": lset, "lights": list(members),
                                       "permutation": h, "node": ni, "mesh_index": mi, "primitive": pi,
                                       "source": pptr, "mesh": mesh_obj, "model": world.tolist(),
                                       "alpha_mode": m.alpha_mode, "alpha_cutoff": m.alpha_cutoff,
                                       "double_sided": m.double_sided, "tangents": tangents, "vertex_colors": colors})
+    for h, origin in origins(shown, text, asks, binary is not None or path.suffix.lower() == ".glb").items():
+        scene.permutations[h] = replace(scene.permutations[h], origin=origin)
+        scene.where.setdefault(h, (origin.parts[0][1].line, origin.parts[0][1].col))
     if skipped_modes:
         notes.append(f"primitives drawn as {', '.join(sorted(skipped_modes))} are not shaded: skipped")
     gen = sorted({o["name"] for o in scene.objects if o["tangents"] == "generated"})
