@@ -153,7 +153,7 @@ def one_brick(scene_path: Path, out: Path, cache: Path) -> dict:
     """Rebuild after ndf=beckmann's source changes (its hash, in process): time, rebuilt, readers."""
     import copy
 
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.io import Store
     from generator.library.bricks import load_library
     from generator.scene.load import load_scene
@@ -166,7 +166,7 @@ def one_brick(scene_path: Path, out: Path, cache: Path) -> dict:
     lib.bricks[key] = edited
     readers = sum(1 for p in scene.permutations.values() if "ndf=beckmann" in p.brdf)
     t = time.perf_counter()
-    res = build_scene(scene, lib, out, store=Store(cache))
+    res = build(scene, out, BuildContext(lib, store=Store(cache)))
     return {"seconds": time.perf_counter() - t, "rebuilt": len(scene.permutations) - res.kept, "readers": readers,
             "compiled": res.compile.compiled, "from_cache": res.compile.cached}
 

@@ -44,7 +44,7 @@ from generator import __version__  # noqa: E402
 sys.path.insert(0, str(REPO / "benchmarks"))
 from cliargs import positive, size as size_arg  # noqa: E402
 from generator.analysis import entry_cost  # noqa: E402
-from generator.assemble import build_scene  # noqa: E402
+from generator.assemble import BuildContext, build  # noqa: E402
 from generator.library.bricks import load_library  # noqa: E402
 from generator.scene.load import load_scene  # noqa: E402
 from generator.runtime.device import Device  # noqa: E402
@@ -98,7 +98,7 @@ def cold_and_persisted(scene, lib, size, tmp: Path, repeats: int) -> dict:
 
 
 def costs(tmp: Path, scene, lib) -> dict:
-    res = build_scene(scene, lib, tmp / "build", languages=("glsl",))
+    res = build(scene, tmp / "build", BuildContext(lib, languages=("glsl",)))
     assert res.ok, res.failures
     m = res.manifest
     spec = [(p["hash"], p["languages"]["glsl"]["frag"]["cost"]) for p in m["permutations"]]

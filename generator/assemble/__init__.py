@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..backends import LANGUAGES, template_file
+from ..backends import template_file
 from ..lang import SourceError
 from ..library.bricks import Library
 from ..link.uber import coverage
@@ -36,7 +36,7 @@ from .write import Writer, validate_dialects
 
 STATE = state.STATE
 
-__all__ = ["BuildContext", "BuildResult", "build", "build_scene", "STATE"]
+__all__ = ["BuildContext", "BuildResult", "build", "STATE"]
 
 
 @dataclass
@@ -69,17 +69,6 @@ class BuildResult:
     @manifest.setter
     def manifest(self, value: dict) -> None:
         self._manifest = value
-
-
-def build_scene(scene: Scene, lib: Library, out: Path, languages=LANGUAGES, store=None, depfile=None,
-                workers: int | None = None, executor=None, keep_removed: bool = False, pack: bool = False,
-                platforms=PLATFORMS, progress: bool | None = None) -> BuildResult:
-    """build() of `scene` into `out` with the BuildContext these make (lib, languages, platforms, store,
-    progress — by default on a terminal outside CI, io.show_progress —, workers as its jobs, executor)."""
-    from ..io import show_progress
-    ctx = BuildContext(lib, languages, platforms, store=store, progress=show_progress() if progress is None else progress,
-                       jobs=workers, executor=executor)
-    return build(scene, out, ctx, depfile=depfile, keep_removed=keep_removed, pack=pack)
 
 
 def build(scene: Scene, out: Path, ctx: BuildContext, depfile=None, keep_removed: bool = False,

@@ -17,7 +17,7 @@ All checks asked for at once are composed once per permutation and compiled in o
 shaders once, through the compile cache); a failure reads as the brick line that caused it (the
 compilers' diagnostics are mapped back through #line, or the GL sources' line map). Golden sources are
 named by permutation, not by content, so a drift is a diff of one file. `languages` narrows what is
-checked as `build_scene(languages=...)` narrows what is built: a platform is checked when one of the
+checked as `BuildContext(languages=...)` narrows what is built: a platform is checked when one of the
 languages it is made from (MADE_FROM; vulkan: any) is given, and vulkan compiles only those
 given. (`build` is narrower: it writes a platform only when its platforms.PLATFORM_TABLE made_from is built,
 so vulkan needs GLSL there.)
@@ -83,8 +83,7 @@ def checked_platforms(platforms=PLATFORMS, languages=LANGUAGES) -> list[str]:
 def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> list[Outcome]:
     """An Outcome per check, in order. Every check's shaders are compiled in one batch (the tool processes
     run in parallel, identical shaders once) and the GL dialects validated in one more, as `build` does."""
-    from ..compose import compose_permutation
-    from ..lang import SourceError
+    from ..compose.batch import compose_permutations
     from ..toolchain import CompileJob, compile_many
     from ..toolchain.platforms import validate_dialects
     from ..toolchain.jobs import job_key, source_jobs
@@ -94,13 +93,18 @@ def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> lis
         langs, dials = wanted.setdefault(c.hash, (set(), set()))
         langs.update(c.languages)
         dials.update(c.dialects)
-    composed, failed = {}, {}
+    # composed in one batch per set of languages and dialects needed, in LANGUAGES order: the sources, their
+    # jobs and golden files do not depend on the checks' order
+    batches: dict[tuple, list] = {}
     for h, (langs, dials) in wanted.items():
-        try:  # in LANGUAGES order: the sources, their jobs and golden files do not depend on the checks' order
-            composed[h] = compose_permutation(scene.permutations[h], lib, [x for x in LANGUAGES if x in langs],
-                                              tuple(d for d in ("gl", "essl") if d in dials))
-        except SourceError as e:
-            failed[h] = [str(e)]
+        need = (tuple(x for x in LANGUAGES if x in langs), tuple(d for d in ("gl", "essl") if d in dials))
+        batches.setdefault(need, []).append((h, scene.permutations[h]))
+    composed, failed = {}, {}
+    for (langs, dials), items in batches.items():
+        done, errors = compose_permutations(items, lib, langs, dials)
+        composed.update(done)
+        failed.update(errors)
+    composed = {h: composed[h] for h in wanted if h in composed}  # in the checks' order, as the jobs were
     jobs = {j.key: j for h, c in composed.items() for j in source_jobs(h, c.sources)}
     dialect_jobs = [CompileJob(job_key(h, s.stage, s.language), s.language, s.stage, s.text,
                                line_map=tuple(s.line_map)) for h, c in composed.items() for s in c.dialects]

@@ -16,7 +16,8 @@ from ..io import content_key
 from ..lang import SourceError
 from ..library.bricks import BUILTIN_BRICKS, Library
 from ..scene.load import Scene
-from ..spec.permutation import SpecError, parse_brdf, parse_spec
+from ..spec.permutation import SpecError
+from ..spec.resolve import Resolved, resolve
 from .platforms import all_tools
 
 _PACKAGE = Path(__file__).resolve().parents[1]  # generator/ (the templates too: backends/*/templates/)
@@ -52,9 +53,9 @@ def scene_keys(base: str, scene: Scene, lib: Library, keep_removed: bool, pack: 
     users: dict[str, list[dict]] = {}
     for o in scene.objects:
         users.setdefault(o["permutation"], []).append(o)
-    keys, shapes, parts = {}, {}, {}
+    keys, shapes = {}, {}
     for h, perm in sorted(scene.permutations.items()):
-        keys[h], shapes[h] = _perm_key(base, scene, lib, perm, users.get(h, []), parts)
+        keys[h], shapes[h] = _perm_key(base, scene, lib, perm, users.get(h, []))
     uber = content_key(base, "ubershader", [shapes[h] for h in sorted(shapes)])
     tables = content_key(base, scene.name, sorted((k, list(v)) for k, v in scene.light_sets.items()),
                          [[o["name"], o["material"], o["light_set"], o["permutation"]] for o in scene.objects],
@@ -63,20 +64,12 @@ def scene_keys(base: str, scene: Scene, lib: Library, keep_removed: bool, pack: 
     return Keys(keys, uber, tables)
 
 
-def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict], memo: dict) -> tuple[str, str]:
+def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> tuple[str, str]:
     """(Everything a permutation's outputs depend on, the same without the scene values); objs: the objects
-    drawn with it; memo: the bricks of each part, shared by the calls of one build (the permutations of a
-    scene share their materials' BRDFs, their packings and their lights)."""
+    drawn with it."""
     try:
-        bricks = {}
-        for part in (("brdf", perm.brdf), ("packing", perm.packing), ("output", perm.output),
-                     *(("light", lk) for lk in perm.lights)):
-            if part not in memo:
-                memo[part] = _bricks_of(part, lib)
-            if isinstance(memo[part], Exception):
-                raise memo[part]
-            bricks.update(memo[part])
-    except (SourceError, SpecError, LookupError) as e:  # it will fail to compose too: key it by the error
+        bricks = _bricks_of(resolve(perm, lib))
+    except (SourceError, SpecError) as e:  # it will fail to compose too: key it by the error
         bricks = {"error": str(e)}
     mats = sorted({o["material"] for o in objs})
     lights = sorted({ln for o in objs for ln in o["lights"]})
@@ -86,18 +79,9 @@ def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict], mem
     return content_key(shape, values), shape
 
 
-def _bricks_of(part: tuple, lib: Library):
-    """{display path: source hash} of the bricks one part of a permutation key reads, or the error it raises."""
-    kind, value = part
-    try:
-        if kind in ("light", "output"):  # a light brick (and its shadow filter's spec), an output brick
-            brick = lib.get(kind, value.light if kind == "light" else value)
-            if brick is None:
-                # only keys the build (the scene loader has reported the unknown name, located)
-                return LookupError(f"unknown {kind} brick in {value}")
-            nodes, extra = (parse_spec(value.shadow, lib, ("shadow",)) if kind == "light" else []), [brick]
-        else:
-            nodes, extra = (parse_brdf(value, lib) if kind == "brdf" else parse_spec(value, lib, ("packing",))), []
-    except (SourceError, SpecError) as e:
-        return e
-    return {b.display_path: b.module.source_hash for b in [*(x.brick for n in nodes for x in n.walk()), *extra]}
+def _bricks_of(r: Resolved) -> dict[str, str]:
+    """{display path: source hash} of every brick a resolved permutation reads: its BRDF's, its packing's (the
+    normal filler within), each light's and its shadow filter's, its output's."""
+    nodes = [x for top in (*r.brdf, r.packing, *(lt.shadow for lt in r.lights)) for x in top.tree]
+    return {b.display_path: b.module.source_hash for b in [*(n.brick for n in nodes), *(lt.brick for lt in r.lights),
+                                                            r.output]}

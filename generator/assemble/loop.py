@@ -21,7 +21,6 @@ from collections import deque
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ..lang import SourceError
 from ..toolchain import CompileJob, CompileResult, CompileStats, compile_many, resume_tools, stop_tools
 from ..toolchain.jobs import source_jobs
 from .context import BuildContext
@@ -54,19 +53,9 @@ class Compiled:
 
 def compose_chunk(ctx: BuildContext, items) -> tuple[dict[str, Composed], dict[str, list[str]], list[CompileJob]]:
     """(Composed by hash, compose errors by hash, compile jobs) of a chunk of (hash, permutation) pairs."""
-    from ..compose import compose_permutation  # Jinja and the emitters load only when something is composed
-    from ..link import link_permutation
-    from ..spec.resolve import resolve
-    composed, errors, jobs = {}, {}, []
-    for h, perm in items:
-        try:  # each stage once, forward: the resolved key, its linked program, then its sources
-            linked = link_permutation(resolve(perm, ctx.library), ctx.library)
-            c = composed[h] = compose_permutation(linked, ctx.library, ctx.languages, ctx.dialects)
-        except SourceError as e:
-            errors[h] = [str(e)]
-            continue
-        jobs += source_jobs(h, c.sources)
-    return composed, errors, jobs
+    from ..compose.batch import compose_permutations  # Jinja and the emitters load only when something is composed
+    composed, errors = compose_permutations(items, ctx.library, ctx.languages, ctx.dialects)
+    return composed, errors, [j for h, c in composed.items() for j in source_jobs(h, c.sources)]
 
 
 def _resume_after(pool) -> None:

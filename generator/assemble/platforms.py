@@ -34,7 +34,7 @@ from ..toolchain import tool_versions
 class Platform(NamedTuple):
     """What the build needs for a platform and what its pack holds (one row of PLATFORM_TABLE)."""
 
-    made_from: str  # the language `build` must build for the platform to be written (build_scene(languages=...))
+    made_from: str  # the language `build` must build for the platform to be written (BuildContext.languages)
     language: str   # the dialect of its main artifact's source: the pack meta's and manifest ``packs``' "language"
     blob: str       # the kind of its main artifact in the manifest's stages and the pack (d3d12: "dxil" where built)
 
@@ -101,7 +101,7 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
 
     for p in platforms:
         if PLATFORM_TABLE[p].made_from not in langs or (p == "gl" and ("gl", stages[0]) not in sources):
-            continue  # a build of fewer languages (build_scene(languages=...)): the platforms they make
+            continue  # a build of fewer languages (BuildContext.languages): the platforms they make
         d: dict = {"stages": {}}
         if p == "vulkan":
             for stage in stages:

@@ -40,6 +40,7 @@ from .. import GPU_TARGETS
 from ..io import show_progress
 from ..toolchain.jobs import job_key, source_jobs
 from ..compose import Composed, compose_eval, compose_permutation
+from ..compose.batch import compose_permutations
 from ..analysis import Cost, entry_cost
 from ..lang import SourceError
 from ..spec.permutation import LightKey, Permutation, SpecError
@@ -371,14 +372,8 @@ def _compile_scene(scene: Scene, lib: Library, languages, store) -> tuple[dict, 
     """Every permutation composed, and all their shaders compiled in one batch: (Composed by hash, compose errors
     by hash, results by job key). The build's loop (assemble/loop.py) also writes as it goes; a cost report
     reads the results once they are all in."""
-    composed, errors, jobs = {}, {}, []
-    for h, perm in sorted(scene.permutations.items()):
-        try:
-            composed[h] = compose_permutation(perm, lib, languages)
-        except SourceError as e:
-            errors[h] = [str(e)]
-            continue
-        jobs += source_jobs(h, composed[h].sources)
+    composed, errors = compose_permutations(sorted(scene.permutations.items()), lib, languages)
+    jobs = [j for h, c in composed.items() for j in source_jobs(h, c.sources)]
     return composed, errors, compile_many(jobs, optimize=True, validate=True, progress=show_progress(), store=store)
 
 

@@ -132,12 +132,10 @@ class _TestTextures(dict):
 
 # ------------------------------------------------------------------ shadows
 
-def shadow_textures(lib, shadow: str) -> list[str]:
-    """The textures a shadow filter spec samples ([] for "none")."""
-    from ..spec.permutation import parse_spec
-
-    node = parse_spec(shadow, lib, ("shadow",))[0]
-    return [t for n in node.tree for t in n.brick.textures]
+def shadow_textures(resolved) -> dict[str, tuple[str, ...]]:
+    """The textures each shadow filter spec of resolved permutations (spec.resolve values) samples, by spec
+    (() for "none"): what the spec stage found, not the spec parsed again."""
+    return {lk.shadow: lt.textures for r in resolved for lk, lt in zip(r.perm.lights, r.lights)}
 
 
 def shadow_matrix(light, values: dict, points) -> np.ndarray:
@@ -217,6 +215,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from .compute import UNIFORM
     from .device import Device, validation_requested
     from ..link.uber import SPEC_VARIANT
+    from ..spec.resolve import resolve
     from .pipeline_cache import PipelineCacheFile
     from .depth_images import ComparisonSampler, DepthImage
     from . import shader_cache
@@ -256,7 +255,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     light_vals = {ln: {k: L.params.get(k, sp.default) for k, sp in _light_specs(lib, L).items()}
                   for ln, L in scene.lights.items()}
     used = {ln for o in scene.objects for ln in o["lights"]}
-    shadowed = [ln for ln, L in scene.lights.items() if ln in used and shadow_textures(lib, L.shadow)]
+    sampled = shadow_textures(resolve(p, lib) for p in perms.values())  # a used light's filter is among them
+    shadowed = [ln for ln, L in scene.lights.items() if ln in used and sampled[L.shadow]]
     matrices = {ln: gx.column_major(shadow_matrix(scene.lights[ln], light_vals[ln], points)) for ln in shadowed}
     for ln in shadowed:
         light_vals[ln]["shadow_matrix"] = matrices[ln]
@@ -348,7 +348,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                                                                (ob.set, ob.binding): object_bufs[i]})
                                for i in range(len(placed.objects))])
                 shadow_maps[ln] = dt
-                if MOMENTS in shadow_textures(lib, scene.lights[ln].shadow):  # vsm: (d, d²), prefiltered
+                if MOMENTS in sampled[scene.lights[ln].shadow]:  # vsm: (d, d²), prefiltered
                     moments[ln] = device.image(moments_map(dt.read()))
                     owned.append(moments[ln])
                 report.shadow_maps[ln] = {"size": [shadow_size, shadow_size], "gpu_ms": gpu, "sampled": dt.sampled,
@@ -380,7 +380,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for ln in names:
                 L = scene.lights[ln]
                 data = light_entry(u, L.type, L.shadow, light_vals[ln])
-                textured = bool(shadow_textures(lib, L.shadow))
+                textured = bool(sampled[L.shadow])
                 ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), shadow_slot if textured else 0, 0))
                 if textured:
                     slot_lights[set_name].append(ln)

@@ -47,13 +47,13 @@ def by_binding(resources) -> dict:
 @pytest.fixture(scope="module")
 def example(tmp_path_factory, tools):
     """{(hash, stage): {lang: Reflection}} and {hash: GLSL sources by stage} of the built example scene."""
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.library.bricks import load_library
     from generator.scene.load import load_scene
 
     lib = load_library()
     out = tmp_path_factory.mktemp("reflect")
-    res = build_scene(load_scene(EXAMPLE, lib), lib, out)
+    res = build(load_scene(EXAMPLE, lib), out, BuildContext(lib))
     assert res.ok, res.failures
     refl, glsl = {}, {}
     for perm in res.manifest["permutations"]:

@@ -25,36 +25,36 @@ def lib_scene():
 
 @pytest.mark.toolchain
 def test_a_rebuild_from_the_cache_compiles_nothing_and_writes_the_same_bytes(lib_scene, tmp_path):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.io import Store
 
     lib, scene = lib_scene
     store = Store(tmp_path / "cache")
-    cold = build_scene(scene, lib, tmp_path / "a", store=store)
+    cold = build(scene, tmp_path / "a", BuildContext(lib, store=store))
     assert cold.ok and cold.compile.compiled == cold.compile.distinct - cold.compile.cached
     # identical shaders are compiled once: the vertex shaders differ only in their provenance header
     assert cold.compile.distinct < cold.compile.jobs
-    warm = build_scene(scene, lib, tmp_path / "b", store=Store(tmp_path / "cache"))
+    warm = build(scene, tmp_path / "b", BuildContext(lib, store=Store(tmp_path / "cache")))
     assert warm.ok and warm.compile.compiled == 0 and warm.compile.cached == warm.compile.distinct
-    plain = build_scene(scene, lib, tmp_path / "c")  # no cache at all
+    plain = build(scene, tmp_path / "c", BuildContext(lib))  # no cache at all
     assert plain.ok
     assert _tree(tmp_path / "a") == _tree(tmp_path / "b") == _tree(tmp_path / "c")
 
 
 @pytest.mark.toolchain
 def test_a_damaged_entry_is_detected_dropped_and_rebuilt_never_served(lib_scene, tmp_path):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.io import Store
 
     lib, scene = lib_scene
-    build_scene(scene, lib, tmp_path / "a", store=Store(tmp_path / "cache"))
+    build(scene, tmp_path / "a", BuildContext(lib, store=Store(tmp_path / "cache")))
     entries = sorted((tmp_path / "cache" / "compile-v1").glob("*/*"))
     victim = entries[len(entries) // 2]
     data = bytearray(victim.read_bytes())
     data[len(data) // 2] ^= 0xFF  # one flipped byte
     victim.write_bytes(bytes(data))
     store = Store(tmp_path / "cache")
-    again = build_scene(scene, lib, tmp_path / "b", store=store)
+    again = build(scene, tmp_path / "b", BuildContext(lib, store=store))
     assert again.ok and store.corrupt == 1 and again.compile.compiled == 1
     assert _tree(tmp_path / "a") == _tree(tmp_path / "b")
     assert victim.read_bytes() != bytes(data)  # replaced by the rebuilt entry

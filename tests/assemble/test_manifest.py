@@ -22,13 +22,13 @@ EXAMPLE = REPO / "scenes" / "example.toml"
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.library.bricks import load_library
     from generator.scene.load import load_scene
 
     out = tmp_path_factory.mktemp("manifest")
     lib = load_library()
-    res = build_scene(load_scene(EXAMPLE, lib), lib, out)
+    res = build(load_scene(EXAMPLE, lib), out, BuildContext(lib))
     assert res.ok, res.failures
     return out, json.loads((out / "manifest.json").read_text())
 

@@ -65,10 +65,10 @@ def lib_scene():
 
 @pytest.fixture(scope="module")
 def packed(lib_scene, tmp_path_factory):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     lib, scene = lib_scene
     out = tmp_path_factory.mktemp("packed")
-    res = build_scene(scene, lib, out, pack=True)
+    res = build(scene, out, BuildContext(lib), pack=True)
     assert res.ok
     return out, json.loads((out / "manifest.json").read_text())
 
@@ -120,48 +120,48 @@ def test_the_package_reader_and_an_independent_reader_agree_with_the_manifests_s
 
 @pytest.mark.toolchain
 def test_packs_are_deterministic_and_a_rebuild_writes_nothing(packed, lib_scene, tmp_path):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     out, manifest = packed
     lib, scene = lib_scene
-    again = build_scene(scene, lib, tmp_path / "b", pack=True)
+    again = build(scene, tmp_path / "b", BuildContext(lib), pack=True)
     assert again.ok
     for p in manifest["packs"]:
         assert (tmp_path / "b" / p["path"]).read_bytes() == (out / p["path"]).read_bytes()
     assert (tmp_path / "b" / "manifest.json").read_bytes() == (out / "manifest.json").read_bytes()
-    same = build_scene(scene, lib, tmp_path / "b", pack=True)
+    same = build(scene, tmp_path / "b", BuildContext(lib), pack=True)
     assert same.up_to_date and same.written == 0
     (tmp_path / "b" / manifest["packs"][0]["path"]).unlink()  # a pack gone: the no-op check notices
-    fixed = build_scene(scene, lib, tmp_path / "b", pack=True)
+    fixed = build(scene, tmp_path / "b", BuildContext(lib), pack=True)
     assert not fixed.up_to_date and fixed.written == 1 and fixed.compile.compiled == 0
     assert (tmp_path / "b" / manifest["packs"][0]["path"]).read_bytes() == (out / manifest["packs"][0]["path"]).read_bytes()
 
 
 @pytest.mark.toolchain
 def test_without_pack_the_manifest_is_what_it_was_and_no_pack_is_left(packed, lib_scene, tmp_path):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     out, manifest = packed
     lib, scene = lib_scene
     plain = tmp_path / "plain"
-    assert build_scene(scene, lib, plain).ok
+    assert build(scene, plain, BuildContext(lib)).ok
     text = (plain / "manifest.json").read_text()
     assert "packs" not in json.loads(text) and not (plain / "packs").exists()
     without = {k: v for k, v in manifest.items() if k != "packs"}
     assert text == json.dumps(without, indent=2) + "\n"  # byte for byte the manifest minus its "packs"
     # --pack then a build without it: the packs leave with the manifest's list; and back
-    assert build_scene(scene, lib, plain, pack=True).ok and (plain / "packs").is_dir()
-    assert build_scene(scene, lib, plain).ok
+    assert build(scene, plain, BuildContext(lib), pack=True).ok and (plain / "packs").is_dir()
+    assert build(scene, plain, BuildContext(lib)).ok
     assert (plain / "manifest.json").read_text() == text and not (plain / "packs").exists()
 
 
 @pytest.mark.toolchain
 def test_a_changed_tool_version_changes_the_pack_key(packed, lib_scene, tmp_path, monkeypatch):
-    import generator.assemble as build
+    import generator.assemble as assemble
     from generator.assemble.pack import read_pack
     out, manifest = packed
     lib, scene = lib_scene
-    real = build.tool_versions()
-    monkeypatch.setattr(build, "tool_versions", lambda: {**real, "spirv-tools": real["spirv-tools"] + "-upgraded"})
-    assert build.build_scene(scene, lib, tmp_path / "up", pack=True).ok
+    real = assemble.tool_versions()
+    monkeypatch.setattr(assemble, "tool_versions", lambda: {**real, "spirv-tools": real["spirv-tools"] + "-upgraded"})
+    assert assemble.build(scene, tmp_path / "up", assemble.BuildContext(lib), pack=True).ok
     upgraded = json.loads((tmp_path / "up" / "manifest.json").read_text())
     for old, new in zip(manifest["packs"], upgraded["packs"]):
         assert new["key"] != old["key"] and new["path"] != old["path"]

@@ -179,10 +179,10 @@ def test_the_manifest_reflects_a_depth_texture_and_its_comparison_sampler_as_the
     import json
 
     from generator.analysis.reflect import reflect
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from tests.assemble.test_manifest import _expected_resources, _reflected_resources
 
-    res = build_scene(_hw_scene(lib, tmp_path), lib, tmp_path / "out")
+    res = build(_hw_scene(lib, tmp_path), tmp_path / "out", BuildContext(lib))
     assert res.ok, res.failures
     manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
     (perm,) = manifest["permutations"]

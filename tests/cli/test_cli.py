@@ -189,13 +189,13 @@ def test_compiler_failure_names_the_brick_line_and_other_permutations_still_buil
 def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, tools):
     from generator import io as cache
     from generator.library.bricks import load_library
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
 
     lib = load_library()
     scene = load_scene(EXAMPLE, lib)
     out = tmp_path / "out"
-    build_scene(scene, lib, out)
+    build(scene, out, BuildContext(lib))
     before = tree(out)
     # Make the next build produce different bytes everywhere, then interrupt it mid-way.
     monkeypatch.setattr("generator.compose.__version__", "9.9.9")
@@ -210,7 +210,7 @@ def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, to
 
     monkeypatch.setattr(cache.os, "replace", flaky_replace)
     with pytest.raises(KeyboardInterrupt):
-        build_scene(scene, lib, out)
+        build(scene, out, BuildContext(lib))
     after = tree(out)
     assert not [p for p in after if p.endswith(".tmp")], "temporary files are removed"
     assert after["manifest.json"] == before["manifest.json"], "the manifest is written last"
@@ -218,7 +218,7 @@ def test_interrupted_build_leaves_no_half_written_file(tmp_path, monkeypatch, to
     new = set(after) - set(before)
     assert len(new) == 6, "what was renamed before the interruption are whole new files under new names"
     monkeypatch.setattr(cache.os, "replace", real_replace)
-    again = build_scene(scene, lib, out)  # the next build finishes the job and leaves a consistent tree
+    again = build(scene, out, BuildContext(lib))  # the next build finishes the job and leaves a consistent tree
     assert again.ok
     m = json.loads((out / "manifest.json").read_text())
     from generator.assemble.outputs import named

@@ -237,13 +237,13 @@ def test_fp16_scene_builds(tmp_path):
     and their fragment shaders declare Float16."""
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
 
     lib = _lib()
     scene = load_scene(_fp16_scene(tmp_path), lib)
     assert scene.precision == "fp16" and all(p.precision == "fp16" for p in scene.permutations.values())
-    res = build_scene(scene, lib, tmp_path / "out")
+    res = build(scene, tmp_path / "out", BuildContext(lib))
     assert res.ok, res.failures
     m = res.manifest
     assert all(p["status"] == "ok" and p["id"].endswith("precision=fp16") for p in m["permutations"])

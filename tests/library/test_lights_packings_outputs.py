@@ -583,7 +583,7 @@ def _scene_text(output, materials):
 def test_a_scene_of_the_new_bricks_builds_in_every_language(lib, tmp_path, output, materials):
     """Every permutation (and the ubershader) compiles and validates in GLSL, HLSL and WGSL; the
     fragment shader declares exactly the textures its packing and normal read, with their color spaces."""
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
 
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
@@ -591,7 +591,7 @@ def test_a_scene_of_the_new_bricks_builds_in_every_language(lib, tmp_path, outpu
         require_tool(t)
     path = tmp_path / "scene.toml"
     path.write_text(_scene_text(output, materials))
-    res = build_scene(load_scene(path, lib), lib, tmp_path / "out")
+    res = build(load_scene(path, lib), tmp_path / "out", BuildContext(lib))
     assert res.ok, res.failures
     manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
     want = {"gltf_metallic_roughness(normal=normal_map)": [("base_color_map", "srgb"), ("orm_map", "linear"),

@@ -259,7 +259,7 @@ def test_a_scene_of_toksvig_materials_builds_in_every_language(lib, tmp_path):
     permutations: `shiny` (Toksvig) and `course` (the 30 % reduction alone) share one shader."""
     import json
 
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
     from tests.conftest import require_tool
 
@@ -267,7 +267,7 @@ def test_a_scene_of_toksvig_materials_builds_in_every_language(lib, tmp_path):
         require_tool(tool)
     path = tmp_path / "lod.toml"
     path.write_text(SCENE)
-    res = build_scene(load_scene(path, lib), lib, tmp_path / "out")
+    res = build(load_scene(path, lib), tmp_path / "out", BuildContext(lib))
     assert res.ok, res.failures
     manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
     assert len(manifest["permutations"]) == 3

@@ -306,13 +306,13 @@ def _scene(tmp_path, materials, **brdf):
 def test_a_scene_of_twist_materials_builds_in_every_language(lib, tmp_path):
     """GLSL, HLSL and WGSL compile and validate (and the ubershader); each fragment shader declares the
     textures and interpolants it reads: the tangent only where the BRDF is anisotropic."""
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
     from tests.conftest import require_tool
 
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
-    res = build_scene(load_scene(_scene(tmp_path, ("brushed", "radial", "plastic")), lib), lib, tmp_path / "out")
+    res = build(load_scene(_scene(tmp_path, ("brushed", "radial", "plastic")), lib), tmp_path / "out", BuildContext(lib))
     assert res.ok, res.failures
     manifest = json.loads((tmp_path / "out" / "manifest.json").read_text())
     assert len(manifest["permutations"]) == 3

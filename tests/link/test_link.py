@@ -570,7 +570,7 @@ def test_packing_that_provides_a_parameter_with_the_wrong_type_is_a_clear_error(
 
 @pytest.mark.toolchain
 def test_scene_sets_output_parameters_per_material_and_the_upload_carries_them(lib, tmp_path):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
     import json
     import struct as st
@@ -580,7 +580,7 @@ def test_scene_sets_output_parameters_per_material_and_the_upload_carries_them(l
                      'params = { ev = 1.5 }\n[lights.sun]\ntype = "directional"\n[light_sets]\nall = ["sun"]\n'
                      '[[objects]]\nname = "o"\nmaterial = "m"\nlights = "all"\n')
     s = load_scene(scene, lib)
-    res = build_scene(s, lib, tmp_path / "out", languages=("glsl",))
+    res = build(s, tmp_path / "out", BuildContext(lib, languages=("glsl",)))
     assert res.ok, res.failures
     m = json.loads((tmp_path / "out" / "manifest.json").read_text())
     assert m["materials"]["m"]["params"]["ev"] == 1.5

@@ -295,11 +295,11 @@ def test_scene_costs_markdown_and_csv(scene_json):
 @pytest.mark.toolchain
 def test_manifest_carries_the_same_costs(scene_json, tmp_path):
     from generator.library.bricks import load_library
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.analysis import entry_cost
     from generator.scene.load import load_scene
     lib = load_library()
-    res = build_scene(load_scene(EXAMPLE, lib), lib, tmp_path)
+    res = build(load_scene(EXAMPLE, lib), tmp_path, BuildContext(lib))
     assert res.ok
     by_key = {(r["subject"], r["stage"], r["language"]): r for r in json.loads(scene_json)["rows"]}
     for p in res.manifest["permutations"]:

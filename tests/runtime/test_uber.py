@@ -32,12 +32,12 @@ def lib():
 
 @pytest.fixture(scope="module")
 def example_build(tmp_path_factory):
-    from generator.assemble import build_scene
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
 
     base = load_library()
     out = tmp_path_factory.mktemp("uber")
-    res = build_scene(load_scene(REPO / "scenes" / "example.toml", base), base, out)
+    res = build(load_scene(REPO / "scenes" / "example.toml", base), out, BuildContext(base))
     assert res.ok, res.failures
     return out, json.loads((out / "manifest.json").read_text())
 
@@ -215,15 +215,15 @@ def test_a_scene_without_lights_gets_an_ubershader_without_a_light_loop(lib):
 @pytest.mark.toolchain
 def test_the_build_fails_naming_a_value_the_ubershader_cannot_reach(tmp_path, monkeypatch):
     """An ubershader that lost a variant (simulated by linking it from all but one permutation) fails the build."""
-    import generator.assemble as build
     import generator.compose.uber as uber
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
 
     base = load_library()
     scene = load_scene(REPO / "scenes" / "example.toml", base)
     real = uber.compose_ubershader
     monkeypatch.setattr(uber, "compose_ubershader", lambda perms, lib, langs: real(perms[1:], lib, langs))
-    res = build.build_scene(scene, base, tmp_path / "out", languages=("glsl",))
+    res = build(scene, tmp_path / "out", BuildContext(base, languages=("glsl",)))
     assert not res.ok
     msg = "\n".join(res.failures)
     assert "ubershader" in msg and "coverage:" in msg and "is no variant of the ubershader" in msg

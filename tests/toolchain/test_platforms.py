@@ -29,10 +29,10 @@ def lib():
     return load_library()
 
 
-def _build(lib, scene_path, out, **kw) -> dict:
-    from generator.assemble import build_scene
+def _build(lib, scene_path, out) -> dict:
+    from generator.assemble import BuildContext, build
     from generator.scene.load import load_scene
-    res = build_scene(load_scene(scene_path, lib), lib, out, **kw)
+    res = build(load_scene(scene_path, lib), out, BuildContext(lib))
     assert res.ok, res.failures
     return json.loads((out / "manifest.json").read_text())
 

@@ -34,10 +34,12 @@ def add_arguments(p) -> None:
 def spirv_identities(scene, lib, cache_dir, no_cache: bool = False) -> tuple[dict[str, tuple], list[str]]:
     """({permutation hash: its SPIR-V (sha256 per language and stage)}, the build's failures), from a build into a
     temporary directory through the compile cache."""
-    from ...assemble import build_scene
+    from ...assemble import BuildContext, build
     from ...assemble.checks import default_store
+    from ...io import show_progress
+    ctx = BuildContext(lib, store=None if no_cache else default_store(cache_dir), progress=show_progress())
     with tempfile.TemporaryDirectory(prefix="shadermatrix-matrix-") as tmp:
-        res = build_scene(scene, lib, Path(tmp), store=None if no_cache else default_store(cache_dir))
+        res = build(scene, Path(tmp), ctx)
         ids = {p["hash"]: tuple(sorted((lang, stage, item.get("spirv_sha256") or item["spirv"])
                                        for lang, stages in p["languages"].items() for stage, item in stages.items()))
                for p in res.manifest["permutations"] if p.get("status") == "ok"}
