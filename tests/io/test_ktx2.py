@@ -1,4 +1,5 @@
-"""KTX2 files of baked tables: round trip, identical bytes, an independent reader, and corrupt files refused.
+"""KTX2 files of baked tables and mipmapped textures: round trip, identical bytes, an independent reader, and
+corrupt or compressed files refused.
 
 The independent reader below is written from the KTX 2.0 specification ("File Structure", "Index",
 "Level Index", "Key/Value Data", "mipPadding") and the Khronos Data Format 1.3 basic descriptor
@@ -13,22 +14,26 @@ import struct
 import numpy as np
 import pytest
 
-from generator.io.ktx2 import FORMATS, Ktx2Error, decode, encode
+from generator.io.ktx2 import FORMATS, Ktx2Error, decode, decode_levels, encode, encode_levels
 from generator.lang.errors import UserError
 
 KINDS = {"1d": ((1, 7, 4), False), "2d": ((3, 5, 4), False), "cube": ((6, 4, 4, 4), True)}
 
 # what the independent reader expects of each format (KTX2 "vkFormat", "typeSize"; KDF §5)
+# (transfer 1 linear, 2 sRGB; an sRGB format's alpha sample is qualified LINEAR, 0x10, KTX2 "dataFormatDescriptor")
 SPEC = {
-    "unorm8": dict(vk=37, dtype="<u1", bits=8, qualifiers=0, lower=0, upper=255),
-    "fp16": dict(vk=97, dtype="<f2", bits=16, qualifiers=0xC0, lower=0xBF800000, upper=0x3F800000),
-    "fp32": dict(vk=109, dtype="<f4", bits=32, qualifiers=0xC0, lower=0xBF800000, upper=0x3F800000),
+    "unorm8": dict(vk=37, dtype="<u1", bits=8, qualifiers=0, lower=0, upper=255, transfer=1, alpha=0),
+    "fp16": dict(vk=97, dtype="<f2", bits=16, qualifiers=0xC0, lower=0xBF800000, upper=0x3F800000, transfer=1,
+                 alpha=0xC0),
+    "fp32": dict(vk=109, dtype="<f4", bits=32, qualifiers=0xC0, lower=0xBF800000, upper=0x3F800000, transfer=1,
+                 alpha=0xC0),
+    "srgb8": dict(vk=43, dtype="<u1", bits=8, qualifiers=0, lower=0, upper=255, transfer=2, alpha=0x10),
 }
 
 
 def _texels(fmt: str, shape: tuple[int, ...]) -> np.ndarray:
     rng = np.random.default_rng(sum(shape) + len(fmt))
-    if fmt == "unorm8":
+    if FORMATS[fmt][1] == np.uint8:
         return rng.integers(0, 256, size=shape, dtype=np.uint8)
     values = rng.standard_normal(shape) * 100.0  # negative, large and small values: the full range is kept
     return values.astype(FORMATS[fmt][1])
@@ -92,11 +97,13 @@ def test_independent_reader(fmt, kind):
     d = f["dfd"]
     assert f["dfdByteOffset"] == 104 and f["dfdByteLength"] == d["total"] == 4 + d["block_size"]
     assert (d["vendor"], d["type"], d["version"], d["block_size"]) == (0, 0, 2, 24 + 16 * 4)
-    assert (d["model"], d["primaries"], d["transfer"], d["flags"]) == (1, 1, 1, 0)  # RGBSDA, BT709, linear, straight
+    # RGBSDA, BT709, linear (sRGB), straight alpha
+    assert (d["model"], d["primaries"], d["transfer"], d["flags"]) == (1, 1, spec["transfer"], 0)
     assert d["block_dims"] == 0 and d["bytes_planes"] == (4 * spec["bits"] // 8, 0)
     for i, (s, channel) in enumerate(zip(d["samples"], (0, 1, 2, 15))):
         assert s == dict(bit_offset=i * spec["bits"], bit_length=spec["bits"], channel=channel,
-                         qualifiers=spec["qualifiers"], position=0, lower=spec["lower"], upper=spec["upper"])
+                         qualifiers=spec["alpha"] if channel == 15 else spec["qualifiers"], position=0,
+                         lower=spec["lower"], upper=spec["upper"])
     assert f["kvdByteOffset"] == f["dfdByteOffset"] + f["dfdByteLength"]
     assert f["kv"] == {"KTXorientation": b"rd\0", "KTXwriter": b"shadermatrix\0"}
     assert f["kv_order"] == sorted(f["kv_order"]) and f["kv_end"] == f["kvdByteOffset"] + f["kvdByteLength"]
@@ -140,7 +147,7 @@ def test_writer_string():
     (np.zeros((6, 2, 2, 4), np.uint8), "unorm8", False, "(H, W, 4)"),
     (np.zeros((2, 2, 4), np.uint8), "unorm8", True, "(6, S, S, 4)"),
     (np.zeros((6, 2, 3, 4), np.uint8), "unorm8", True, "faces are square"),
-    (np.zeros((2, 2, 4), np.uint8), "rgba8", False, "unknown KTX2 table format 'rgba8'"),
+    (np.zeros((2, 2, 4), np.uint8), "rgba8", False, "unknown KTX2 format 'rgba8'"),
     (np.full((2, 2, 4), np.nan, np.float32), "fp32", False, "NaN or infinity"),
     ([[[0, 0, 0, 0]]], "unorm8", False, "numpy array"),
 ])
@@ -171,7 +178,7 @@ LEVEL_OFFSET = struct.unpack_from("<Q", GOOD, 80)[0]
     (b"\x89PNG\r\n\x1a\n" + GOOD[8:], "not a KTX 2.0 file"),
     (b"\xabKTX 11\xbb\r\n\x1a\n" + GOOD[12:], "a KTX 1 file"),
     (_patched(GOOD, 20, "<I", 0), "pixelWidth 0"),
-    (_patched(GOOD, 12, "<I", 44), "vkFormat 44 is not a table format"),
+    (_patched(GOOD, 12, "<I", 44), "vkFormat 44 is not a format this reader takes"),
     (_patched(GOOD, 16, "<I", 1), "typeSize is 1"),
     (_patched(GOOD, 44, "<I", 2), "supercompressionScheme is 2"),
     (_patched(GOOD, 40, "<I", 3), "levelCount is 3"),
@@ -221,3 +228,162 @@ def test_every_truncation_and_byte_flip_is_a_ktx2_error():
                 decode(bytes(corrupt))
             except Ktx2Error:
                 pass
+
+
+# ------------------------------------------------------------------ mip chains
+
+def _chain(fmt: str, width: int, height: int, cube: bool = False) -> list[np.ndarray]:
+    """Random texels for every level of a full chain, level i of max(1, W >> i) × max(1, H >> i)."""
+    out, i = [], 0
+    while True:
+        w, h = max(1, width >> i), max(1, height >> i)
+        out.append(_texels(fmt, (6, h, w, 4) if cube else (h, w, 4)))
+        if (w, h) == (1, 1):
+            return out
+        i += 1
+
+
+CHAINS = {"5x3": (5, 3, False), "16x4": (16, 4, False), "1x9": (1, 9, False), "cube8": (8, 8, True)}
+
+
+@pytest.mark.parametrize("chain", CHAINS)
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_levels_independent_reader(fmt, chain):
+    """Level index largest first, level data smallest first, each level aligned and zero-padded, level 0 last."""
+    width, height, cube = CHAINS[chain]
+    levels = _chain(fmt, width, height, cube)
+    data = encode_levels(levels, fmt, cube=cube)
+    f, spec = _read_independently(data), SPEC[fmt]
+    assert f["levelCount"] == len(levels) == max(width, height).bit_length()
+    assert (f["pixelWidth"], f["pixelHeight"], f["faceCount"]) == (width, height, 6 if cube else 1)
+    assert f["dfdByteOffset"] == 80 + 24 * len(levels)
+    texel = 4 * spec["bits"] // 8
+    align = texel * 4 // np.gcd(texel, 4)
+    end = f["kv_end"]
+    for i in reversed(range(len(levels))):  # the file holds the smallest level first
+        offset, length, raw = f["levels"][i]
+        assert offset % align == 0 and end <= offset < end + align, (i, offset, end)
+        assert data[end:offset] == b"\0" * (offset - end)
+        assert length == raw == levels[i].size * spec["bits"] // 8
+        assert data[offset:offset + length] == np.ascontiguousarray(levels[i], dtype=spec["dtype"]).tobytes()
+        end = offset + length
+    assert end == len(data)  # level 0 ends the file
+    offsets = [lv[0] for lv in f["levels"]]
+    assert offsets == sorted(offsets, reverse=True)  # index order: level 0 first, at the highest offset
+
+
+@pytest.mark.parametrize("chain", CHAINS)
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_levels_round_trip(fmt, chain):
+    width, height, cube = CHAINS[chain]
+    levels = _chain(fmt, width, height, cube)
+    back, got_fmt, got_cube = decode_levels(encode_levels(levels, fmt, cube=cube), "t.ktx2")
+    assert (got_fmt, got_cube, len(back)) == (fmt, cube, len(levels))
+    for a, b in zip(back, levels):
+        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def test_a_prefix_of_the_chain_and_one_level_agree_with_encode():
+    levels = _chain("unorm8", 8, 8)
+    assert encode_levels(levels[:1], "unorm8") == encode(levels[0], "unorm8")
+    back, _, _ = decode_levels(encode_levels(levels[:2], "unorm8"))
+    assert [b.shape for b in back] == [(8, 8, 4), (4, 4, 4)]
+
+
+@pytest.mark.parametrize("levels, message", [
+    ([], "at least one level"),
+    ([np.zeros((4, 4, 4), np.uint8), np.zeros((3, 2, 4), np.uint8)], "level 1 is (3, 2, 4), not (2, 2, 4)"),
+    ([np.zeros((1, 2, 4), np.uint8), np.zeros((1, 1, 4), np.uint8), np.zeros((1, 1, 4), np.uint8)],
+     "3 levels, more than the 2"),
+    ([np.zeros((2, 2, 4), np.uint8), np.zeros((1, 1, 4), np.float32)], "level 1: unorm8 texels are uint8"),
+])
+def test_encode_levels_refuses(levels, message):
+    with pytest.raises(ValueError) as e:
+        encode_levels(levels, "unorm8")
+    assert message in str(e.value)
+
+
+def _id(value) -> str:
+    return value if isinstance(value, str) else "file"
+
+
+CHAIN = encode_levels(_chain("srgb8", 5, 3), "srgb8")  # levels 5 × 3, 2 × 1, 1 × 1
+CHAIN_INDEX = [struct.unpack_from("<3Q", CHAIN, 80 + 24 * i) for i in range(3)]
+
+
+@pytest.mark.parametrize("data, message", [
+    (CHAIN, "levelCount is 3; a baked table has one level"),  # decode: the tables' reader
+], ids=_id)
+def test_decode_takes_one_level(data, message):
+    with pytest.raises(Ktx2Error) as e:
+        decode(data, "t.ktx2")
+    assert message in str(e.value)
+
+
+@pytest.mark.parametrize("data, message", [
+    (_patched(CHAIN, 40, "<I", 4), "levelCount is 4, more than the 3 levels of a 5 × 3 texture"),
+    (_patched(CHAIN, 80, "<Q", CHAIN_INDEX[1][0]), "level 0's texels (byte"),  # level 0 on top of level 1
+    (_patched(CHAIN, 104, "<Q", CHAIN_INDEX[0][0]), "level 0's texels (byte 308) overlap level 1"),  # 1 after 0
+    (_patched(CHAIN, 128, "<Q", 200), "level 2's texels (byte 200) overlap the descriptors"),
+    (_patched(CHAIN, 112, "<Q", 4), "level 1 is 4 bytes (8 uncompressed), not the 8 of 1 face(s) × 1 × 2"),
+    (CHAIN + b"\0" * 4, "4 bytes follow level 0's texels"),
+], ids=_id)
+def test_decode_levels_refuses(data, message):
+    with pytest.raises(Ktx2Error) as e:
+        decode_levels(data, "t.ktx2")
+    assert message in str(e.value), str(e.value)
+
+
+def test_level_count_zero_is_one_level():
+    """levelCount 0 (KTX2: the loader generates the mips) stores one level, read as such."""
+    texels = _texels("unorm8", (4, 4, 4))
+    back, _, _ = decode_levels(_patched(encode(texels, "unorm8"), 40, "<I", 0))
+    assert len(back) == 1 and back[0].tobytes() == texels.tobytes()
+
+
+def test_srgb_alpha_without_the_linear_bit_is_read():
+    """Other tools' sRGB files may leave the alpha sample's LINEAR qualifier unset; the texels are the same."""
+    texels = _texels("srgb8", (2, 3, 4))
+    data = encode(texels, "srgb8")
+    alpha_word = 104 + 28 + 3 * 16
+    word = struct.unpack_from("<I", data, alpha_word)[0]
+    assert word >> 24 == 0x1F  # channel 15, LINEAR
+    assert decode(_patched(data, alpha_word, "<I", word & 0x00FFFFFF | 0x0F << 24))[0].tobytes() == texels.tobytes()
+    unorm = encode(texels, "unorm8")
+    with pytest.raises(Ktx2Error, match="transfer function is 1, not sRGB"):
+        decode(_patched(unorm, 12, "<I", 43))  # vkFormat says sRGB, the descriptor linear
+
+
+def _basis(model: int) -> bytes:
+    """A file of vkFormat 0 whose descriptor's colorModel is `model` (163 ETC1S, 166 UASTC), as basisu writes."""
+    data = _patched(encode(_texels("unorm8", (4, 4, 4)), "unorm8"), 12, "<2I", 0, 1)
+    return _patched(data, 104 + 12, "<I", model | 1 << 8 | 2 << 16)
+
+
+@pytest.mark.parametrize("data, message", [
+    (_patched(GOOD, 44, "<I", 1), "supercompressionScheme is 1 (BasisLZ (Basis Universal ETC1S))"),
+    (_patched(GOOD, 44, "<I", 2), "supercompressionScheme is 2 (Zstandard)"),
+    (_patched(GOOD, 44, "<I", 3), "supercompressionScheme is 3 (ZLIB)"),
+    (_basis(166), "a Basis Universal UASTC file (vkFormat 0, colorModel 166)"),
+    (_basis(163), "a Basis Universal ETC1S file"),
+    (_basis(1), "vkFormat 0 (UNDEFINED) is not a format this reader takes"),
+    (_patched(GOOD, 12, "<I", 29), "vkFormat 29 (R8G8B8_SRGB) is not a format this reader takes"),
+], ids=_id)
+def test_compressed_files_are_refused_by_name(data, message):
+    with pytest.raises(Ktx2Error) as e:
+        decode_levels(data, "albedo.ktx2")
+    text = str(e.value)
+    assert message in text and ("uncompressed" in text or "re-export it as RGBA" in text), text
+
+
+def test_every_truncation_of_a_chain_is_a_ktx2_error():
+    for n in range(len(CHAIN)):
+        with pytest.raises(Ktx2Error):
+            decode_levels(CHAIN[:n])
+    for i in range(CHAIN_INDEX[2][0]):  # every byte before the texels
+        corrupt = bytearray(CHAIN)
+        corrupt[i] ^= 0xFF
+        try:
+            decode_levels(bytes(corrupt))
+        except Ktx2Error:
+            pass
