@@ -22,58 +22,188 @@ Per permutation the manifest's ``platforms`` maps each built platform to ``{"sta
 validate gets ``"essl": {"unsupported": [errors]}`` instead of an artifact, and still builds; a GL core
 error fails the permutation like a compile error, its source written beside as
 ``gl/<hash>.<stage>.failed.glsl`` and named in the entry's ``failed_sources`` (``"gl.<stage>"``).
+
+Each platform is one class below and one entry of PLATFORM_TABLE: what it is made from, its dialects, its
+tools, its conventions (platform_base.Conventions: depth range, NDC y, framebuffer origin, front face) and
+the method writing its section. Adding a platform is adding a class and its entry; write_platforms, the
+build's key (all_tools), packs and the output tree read the table and nothing else about a platform.
 """
 from __future__ import annotations
 
-from typing import NamedTuple
-
-from ..io import sha256
-from ..toolchain import tool_versions
+from .platform_base import Conventions, Platform, Unit, resource_rows
 
 
-class Platform(NamedTuple):
-    """What the build needs for a platform and what its pack holds (one row of PLATFORM_TABLE)."""
+class Vulkan(Platform):
+    """SPIR-V of the GLSL, and every language's source and SPIR-V (what the other front ends make): the
+    language trees' own files, so nothing is written here."""
 
-    made_from: str  # the language `build` must build for the platform to be written (BuildContext.languages)
-    language: str   # the dialect of its main artifact's source: the pack meta's and manifest ``packs``' "language"
-    blob: str       # the kind of its main artifact in the manifest's stages and the pack (d3d12: "dxil" where built)
+    name, made_from, language, blob = "vulkan", "glsl", "glsl", "spirv"
+    tools = ("glslc", "glslang", "spirv-tools", "naga")  # glslang: the HLSL's SPIR-V in the vulkan tree
+    own_files = False
+    conventions = Conventions(depth_range="0..1", ndc_y="down", framebuffer_origin="top-left", front_face="ccw")
+    _TYPES = {"uniform": "uniform_buffer", "storage": "storage_buffer", "image": "sampled_image", "sampler": "sampler"}
+
+    def section(self, unit: Unit) -> dict:
+        langs, stages = unit.langs, {}
+        for stage in unit.stages:
+            item = {"spirv": {"path": langs["glsl"][stage]["spirv"], "sha256": langs["glsl"][stage]["spirv_sha256"]}}
+            for lang in langs:
+                item[lang] = {"path": langs[lang][stage]["source"], "sha256": langs[lang][stage]["source_sha256"],
+                              "spirv": langs[lang][stage]["spirv"]}
+            stages[stage] = item
+        return {"stages": stages, "spirv_from": "glsl", "cost": unit.cost("glsl")}
+
+    def reflection(self, iface) -> dict:
+        """Descriptor (set, binding, descriptor type) per resource."""
+        return {"descriptors": [{"set": s, "binding": b, "type": self._TYPES[k], "name": n, "stages": st, **x}
+                                for k, s, b, n, st, x in resource_rows(iface)],
+                "vertex_inputs": [{"location": v.location, "name": v.name, "format": v.format}
+                                  for v in iface.vertex_inputs],
+                "push_constants": []}
 
 
-# The one table of the platforms, in build order. gl is made from the GLSL target (its `gl` dialect is a
-# GlslTarget subclass composed beside the languages: DIALECTS) and ships the 4.50 core text, kind "glsl".
-PLATFORM_TABLE: dict[str, Platform] = {
-    "vulkan": Platform(made_from="glsl", language="glsl", blob="spirv"),
-    "d3d12": Platform(made_from="hlsl", language="hlsl", blob="hlsl"),
-    "gl": Platform(made_from="glsl", language="gl", blob="glsl"),
-    "webgpu": Platform(made_from="wgsl", language="wgsl", blob="wgsl"),
-}
+class D3D12(Platform):
+    """HLSL for Shader Model 6 (the vulkan tree's text: ``register(xN, spaceM)``), DXIL where a dxc is on PATH."""
+
+    name, made_from, language, blob = "d3d12", "hlsl", "hlsl", "hlsl"
+    tools = ("glslang", "dxc")
+    ext = {"hlsl": "hlsl", "dxil": "dxil"}
+    conventions = Conventions(depth_range="0..1", ndc_y="up", framebuffer_origin="top-left", front_face="ccw")
+    _CLASSES = {"uniform": ("CBV", "b"), "storage": ("SRV", "t"), "image": ("SRV", "t"), "sampler": ("Sampler", "s")}
+    _FORMATS = {"R32G32B32_SFLOAT": "DXGI_FORMAT_R32G32B32_FLOAT", "R32G32B32A32_SFLOAT": "DXGI_FORMAT_R32G32B32A32_FLOAT",
+                "R32G32_SFLOAT": "DXGI_FORMAT_R32G32_FLOAT"}
+    _SEMANTICS = {"a_position": ("POSITION", 0), "a_normal": ("NORMAL", 0), "a_tangent": ("TANGENT", 0),
+                  "a_uv": ("TEXCOORD", 0), "a_color": ("COLOR", 0)}  # backends/hlsl/templates/vertex.hlsl.j2
+
+    def section(self, unit: Unit) -> dict:
+        from ..toolchain.platforms import DX_PROFILES
+        stages = {}
+        for stage in unit.stages:
+            src = unit.sources[("hlsl", stage)]
+            item = {"hlsl": self.put(unit, stage, src.text.encode(), "hlsl")}
+            if unit.dxil is not None:
+                blob, errors = unit.dxil(unit.name, src, unit.precision)
+                unit.errors += errors
+                if blob is not None:
+                    item["dxil"] = self.put(unit, stage, blob, "dxil")
+            stages[stage] = item
+        return {"stages": stages, "profiles": {s: DX_PROFILES[(s, unit.precision)] for s in unit.stages},
+                "dxil": "built" if unit.dxil is not None else
+                "no dxc on PATH: HLSL only (docs/guide/install.md: where to get dxc)",
+                "cost": unit.cost("hlsl"), "cost_from": "hlsl SPIR-V (glslang)"}
+
+    def reflection(self, iface) -> dict:
+        """Register class and number, space, and the input layout's semantics."""
+        cls = self._CLASSES
+        return {"resources": [{"name": n, "type": cls[k][0], "register": f"{cls[k][1]}{b}", "space": s,
+                               "visibility": st, **x} for k, s, b, n, st, x in resource_rows(iface)],
+                "input_layout": [{"semantic": self._SEMANTICS[v.name][0], "semantic_index": self._SEMANTICS[v.name][1],
+                                  "format": self._FORMATS[v.format], "name": v.name} for v in iface.vertex_inputs]}
+
+
+class Gl(Platform):
+    """GLSL 4.50 core and, where the bricks allow, GLSL ES 3.10: the `gl` and `essl` dialects (a GlslTarget
+    subclass each, backends/gl/emit.py), validated by glslangValidator."""
+
+    name, made_from, language, blob = "gl", "glsl", "gl", "glsl"
+    dialects = ("gl", "essl")
+    tools = ("glslang",)
+    ext = {"gl": "glsl", "essl": "essl"}
+    conventions = Conventions(depth_range="-1..1", ndc_y="up", framebuffer_origin="bottom-left", front_face="ccw")
+
+    def section(self, unit: Unit) -> dict:
+        name = unit.name
+        es_errors = [e for s in unit.stages for e in unit.dialect_errors.get(f"{name}.{s}.essl", [])]
+        stages = {}
+        for stage in unit.stages:
+            core = unit.dialect_errors.get(f"{name}.{stage}.gl", [])
+            text = unit.text("gl", stage)
+            if core:  # it fails the permutation: the source beside, as a compile failure's (write.Writer.unit)
+                unit.errors += core
+                rel = f"gl/{name}.{stage}.failed.{self.ext['gl']}"
+                unit.write(rel, text)
+                unit.entry.setdefault("failed_sources", {})[f"gl.{stage}"] = rel
+                continue
+            item = {"glsl": self.put(unit, stage, text, "gl")}
+            if not es_errors:
+                item["essl"] = self.put(unit, stage, unit.text("essl", stage), "essl")
+            stages[stage] = item
+        return {"stages": stages, "versions": {"glsl": "450 core", "essl": "310 es"},
+                "essl": "ok" if not es_errors else {"unsupported": es_errors}}
+
+    def reflection(self, iface) -> dict:
+        """Uniform-block binding points, texture units and storage-block bindings (backends/gl/emit.py
+        gl_bindings: Vulkan's pairs flattened per namespace)."""
+        from ..backends.gl.emit import gl_bindings
+        m = gl_bindings(iface.blocks, iface.textures)
+        rows = resource_rows(iface)
+        blocks = [r for r in rows if r[0] in ("uniform", "storage")]
+        return {"uniform_blocks": [{"name": n, "binding": m["uniform"][(s, b)], "stages": st}
+                                   for k, s, b, n, st, _ in blocks if k == "uniform"],
+                "storage_blocks": [{"name": n, "binding": m["storage"][(s, b)], "stages": st}
+                                   for k, s, b, n, st, _ in blocks if k == "storage"],
+                "samplers": [{"name": n, "unit": m["texture"][(s, b)], "type": _gl_sampler(x), **x}
+                             for k, s, b, n, st, x in rows if k == "image"],
+                "vertex_inputs": [{"location": v.location, "name": v.name} for v in iface.vertex_inputs]}
+
+
+def _gl_sampler(x: dict) -> str:
+    if x["compare"]:
+        return "sampler2DShadow"
+    return {"2d": "sampler2D", "cube": "samplerCube"}[x["dimension"]]
+
+
+class WebGpu(Platform):
+    """WGSL (the vulkan tree's text), validated by naga."""
+
+    name, made_from, language, blob = "webgpu", "wgsl", "wgsl", "wgsl"
+    tools = ("naga",)
+    ext = {"wgsl": "wgsl"}
+    conventions = Conventions(depth_range="0..1", ndc_y="up", framebuffer_origin="top-left", front_face="ccw")
+    _FORMATS = {"R32G32B32_SFLOAT": "float32x3", "R32G32B32A32_SFLOAT": "float32x4", "R32G32_SFLOAT": "float32x2"}
+    _VISIBILITY = {"vert": "VERTEX", "frag": "FRAGMENT"}
+
+    def section(self, unit: Unit) -> dict:
+        return {"stages": {s: {"wgsl": self.put(unit, s, unit.text("wgsl", s), "wgsl")} for s in unit.stages},
+                "cost": unit.cost("wgsl"), "cost_from": "wgsl SPIR-V (naga)"}
+
+    def reflection(self, iface) -> dict:
+        """Bind group, binding and the GPUBindGroupLayoutEntry resource type."""
+        def resource(k, x):
+            if k in ("uniform", "storage"):
+                return {"buffer": {"type": "uniform" if k == "uniform" else "read-only-storage"}}
+            if k == "image":
+                return {"texture": {"sampleType": "depth" if x["compare"] else "float", "viewDimension": x["dimension"]}}
+            return {"sampler": {"type": "comparison" if x["compare"] else "filtering"}}
+        return {"bind_groups": [{"group": s, "binding": b, "name": n, "visibility": [self._VISIBILITY[v] for v in st],
+                                 **resource(k, x)} for k, s, b, n, st, x in resource_rows(iface)],
+                "vertex_inputs": [{"shaderLocation": v.location, "name": v.name, "format": self._FORMATS[v.format]}
+                                  for v in iface.vertex_inputs]}
+
+
+# The one table of the platforms, in build order (the manifest's and --platform's).
+PLATFORM_TABLE: dict[str, Platform] = {p.name: p for p in (Vulkan(), D3D12(), Gl(), WebGpu())}
 PLATFORMS: tuple[str, ...] = tuple(PLATFORM_TABLE)
-DIALECTS = {"gl": ("gl", "essl")}  # platform -> dialects composed beside the languages (compose.Composed.dialects)
-EXT = {"gl": "glsl", "essl": "essl", "hlsl": "hlsl", "wgsl": "wgsl", "dxil": "dxil"}
+DIALECTS = {p.name: p.dialects for p in PLATFORM_TABLE.values() if p.dialects}  # compose.Composed.dialects
+EXT = {kind: ext for p in PLATFORM_TABLE.values() for kind, ext in p.ext.items()}  # artifact kind -> extension
 
 
 def parse_platforms(text: str) -> list[str]:
-    """"vulkan,gl" -> ["vulkan", "gl"] (in PLATFORMS order); ValueError naming the problem."""
+    """"vulkan,gl" -> ["vulkan", "gl"] (in the table's order); ValueError naming the problem."""
     items = [x.strip() for x in text.split(",") if x.strip()]
-    bad = [x for x in items if x not in PLATFORMS]
+    bad = [x for x in items if x not in PLATFORM_TABLE]
     if not items or bad or len(set(items)) != len(items):
-        raise ValueError(f"{text!r} is not a comma-separated list of {', '.join(PLATFORMS)}, each at most once")
-    return [p for p in PLATFORMS if p in items]
+        raise ValueError(f"{text!r} is not a comma-separated list of {', '.join(PLATFORM_TABLE)}, each at most once")
+    return [p for p in PLATFORM_TABLE if p in items]
 
 
 def dialects_of(platforms) -> tuple[str, ...]:
-    return tuple(d for p in platforms for d in DIALECTS.get(p, ()))
+    return tuple(d for p in platforms for d in PLATFORM_TABLE[p].dialects)
 
 
 def platform_tools(platform: str) -> dict[str, str]:
     """The exact versions of the tools that made and checked a platform's artifacts."""
-    from ..toolchain.platforms import dxc_version
-    t = tool_versions()
-    return {"vulkan": lambda: {"glslc": t["glslc"], "glslang": t["glslang"], "spirv-tools": t["spirv-tools"],
-                               "naga": t["naga"]},  # glslang: the HLSL's SPIR-V in the vulkan tree
-            "d3d12": lambda: {"glslang": t["glslang"], "dxc": dxc_version()},
-            "gl": lambda: {"glslang": t["glslang"]},
-            "webgpu": lambda: {"naga": t["naga"]}}[platform]()
+    return PLATFORM_TABLE[platform].tool_versions()
 
 
 def all_tools(platforms) -> dict:
@@ -86,79 +216,19 @@ def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_
     """Fill entry["platforms"] for one permutation whose languages compiled (entry["languages"] is written);
     returns the errors that fail it (a GL core stage's among them, its source then written beside and named in
     entry["failed_sources"]). write(rel, data): the build's atomic writer. dialect_errors: job key ->
-    glslangValidator errors. dxil(source) -> (bytes | None, errors): the DXC step (None: no dxc)."""
-    from .reflection import platform_reflection
-    langs = entry["languages"]
-    sources = {(s.language, s.stage): s for s in [*composed.sources, *composed.dialects]}
-    stages = sorted({s.stage for s in composed.sources}, key=("vert", "frag", "comp").index)
-    out, errs = {}, []
-
-    def put(tree: str, stage: str, data: bytes, kind: str) -> dict:
-        digest = sha256(data)
-        rel = f"{tree}/{name}.{stage}.{digest[:12]}.{EXT[kind]}"
-        write(rel, data)
-        return {"path": rel, "sha256": digest}
-
-    for p in platforms:
-        if PLATFORM_TABLE[p].made_from not in langs or (p == "gl" and ("gl", stages[0]) not in sources):
-            continue  # a build of fewer languages (BuildContext.languages): the platforms they make
-        d: dict = {"stages": {}}
-        if p == "vulkan":
-            for stage in stages:
-                item = {"spirv": {"path": langs["glsl"][stage]["spirv"], "sha256": langs["glsl"][stage]["spirv_sha256"]}}
-                for lang in langs:
-                    item[lang] = {"path": langs[lang][stage]["source"], "sha256": langs[lang][stage]["source_sha256"],
-                                  "spirv": langs[lang][stage]["spirv"]}
-                d["stages"][stage] = item
-            d.update(spirv_from="glsl", cost={s: langs["glsl"][s]["cost"] for s in stages})
-        elif p == "d3d12":
-            for stage in stages:
-                src = sources[("hlsl", stage)]
-                item = {"hlsl": put("d3d12", stage, src.text.encode(), "hlsl")}
-                if dxil is not None:
-                    blob, e = dxil(name, src, precision)
-                    errs += e
-                    if blob is not None:
-                        item["dxil"] = put("d3d12", stage, blob, "dxil")
-                d["stages"][stage] = item
-            from ..toolchain.platforms import DX_PROFILES
-            d.update(profiles={s: DX_PROFILES[(s, precision)] for s in stages},
-                     dxil="built" if dxil is not None else "no dxc on PATH: HLSL only (docs/guide/install.md: where to get dxc)",
-                     cost={s: langs["hlsl"][s]["cost"] for s in stages}, cost_from="hlsl SPIR-V (glslang)")
-        elif p == "gl":
-            es_errors = [e for s in stages for e in dialect_errors.get(f"{name}.{s}.essl", [])]
-            for stage in stages:
-                core = dialect_errors.get(f"{name}.{stage}.gl", [])
-                text = sources[("gl", stage)].text.encode()
-                if core:  # it fails the permutation: the source beside, as a compile failure's (build._write_all)
-                    errs += core
-                    rel = f"gl/{name}.{stage}.failed.{EXT['gl']}"
-                    write(rel, text)
-                    entry.setdefault("failed_sources", {})[f"gl.{stage}"] = rel
-                    continue
-                item = {"glsl": put("gl", stage, text, "gl")}
-                if not es_errors:
-                    item["essl"] = put("gl", stage, sources[("essl", stage)].text.encode(), "essl")
-                d["stages"][stage] = item
-            d.update(versions={"glsl": "450 core", "essl": "310 es"},
-                     essl="ok" if not es_errors else {"unsupported": es_errors})
-        elif p == "webgpu":
-            for stage in stages:
-                d["stages"][stage] = {"wgsl": put("webgpu", stage, sources[("wgsl", stage)].text.encode(),
-                                                  "wgsl")}
-            d.update(cost={s: langs["wgsl"][s]["cost"] for s in stages}, cost_from="wgsl SPIR-V (naga)")
-        d["reflection"] = platform_reflection(composed.interface, p)
-        d["tools"] = platform_tools(p)
-        out[p] = d
-    entry["platforms"] = out
-    return errs
+    glslangValidator errors. dxil(name, source, precision) -> (bytes | None, errors): the DXC step (None: no dxc)."""
+    unit = Unit(name, composed, entry, precision, dialect_errors, write, dxil)
+    chosen = [PLATFORM_TABLE[p] for p in platforms]
+    # a build of fewer languages (BuildContext(languages=...)) writes the platforms they make
+    entry["platforms"] = {p.name: p.manifest(unit) for p in chosen if p.builds(unit)}
+    return unit.errors
 
 
 def platform_files(entry: dict):
-    """(path, sha256) of every file a manifest entry's platforms name that its languages do not (vulkan's are
-    the language tree's own files)."""
+    """(path, sha256) of every file a manifest entry's platforms name in their own trees (vulkan's are the
+    language trees' files, tracked with them)."""
     for p, d in (entry.get("platforms") or {}).items():
-        if p == "vulkan":
+        if not PLATFORM_TABLE[p].own_files:
             continue
         for item in d.get("stages", {}).values():
             for art in item.values():
