@@ -191,7 +191,7 @@ class _Build:
 
     def _written(self, pairs, part) -> None:
         """A compiled chunk: written and analysed while the next chunks compile."""
-        checked = validate_dialects(pairs, self.ctx.store) if self.ctx.dialects else {}
+        checked = validate_dialects(pairs, self.ctx.store, self.ctx.gate) if self.ctx.dialects else {}
         for h, c in pairs:
             objs = self.users.get(h, [])
             entry = {**self._head(h), "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),

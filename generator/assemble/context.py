@@ -7,10 +7,11 @@ value (BuildContext.for_workers), so they compose from exactly what the build do
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from ..backends import LANGUAGES
 from ..library.bricks import Library
+from ..toolchain import Gate
 from .platforms import PLATFORMS, dialects_of
 
 
@@ -23,6 +24,8 @@ class BuildContext:
     progress: bool = False  # draw progress bars (on stderr)
     jobs: int | None = None  # worker processes (from MIN_PERMUTATIONS), else tool processes; None: the core count
     executor: object = None  # where compiles run instead of here (toolchain/dask.py), or None
+    # this build's switch for its tools (toolchain.Gate): the build's signal handler stops it, which kills them
+    gate: Gate = field(default_factory=Gate, compare=False, repr=False)
 
     def __post_init__(self):
         object.__setattr__(self, "languages", tuple(self.languages))
@@ -35,7 +38,8 @@ class BuildContext:
 
     def for_workers(self) -> BuildContext:
         """This context as it is sent to worker processes (pickled): the bricks without what this process derived
-        from them (each worker links its own), no executor (the workers are where compiles run), no progress bar
-        and no store (it holds a lock: a worker opens its own at the store's root, parallel.py)."""
+        from them (each worker links its own), no executor (the workers are where compiles run), no progress bar,
+        no store (it holds a lock: a worker opens its own at the store's root, parallel.py) and a gate of their
+        own (this one holds a lock and this process's tools; the build ends its workers by killing them)."""
         return replace(self, library=Library(bricks=self.library.bricks, errors=self.library.errors),
-                       executor=None, progress=False, store=None)
+                       executor=None, progress=False, store=None, gate=Gate())

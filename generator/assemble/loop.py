@@ -16,12 +16,11 @@ chunk's, so that its large shaders start with the others instead of after them.
 from __future__ import annotations
 
 import os
-import threading
 from collections import deque
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ..toolchain import CompileJob, CompileResult, CompileStats, compile_many, resume_tools, stop_tools
+from ..toolchain import CompileJob, CompileResult, CompileStats, compile_many
 from ..toolchain.jobs import source_jobs
 from .context import BuildContext
 
@@ -56,11 +55,6 @@ def compose_chunk(ctx: BuildContext, items) -> tuple[dict[str, Composed], dict[s
     from ..compose.batch import compose_permutations  # Jinja and the emitters load only when something is composed
     composed, errors = compose_permutations(items, ctx.library, ctx.languages, ctx.dialects)
     return composed, errors, [j for h, c in composed.items() for j in source_jobs(h, c.sources)]
-
-
-def _resume_after(pool) -> None:
-    pool.shutdown(wait=True)
-    resume_tools()
 
 
 def compile_permutations(ctx: BuildContext, permutations: dict, extra=(), on_done=None,
@@ -108,27 +102,22 @@ def _here(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileSt
                 on_done([(h, out.composed[h]) for h in hashes], part)
 
     pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="compile")
-    resume_tools()
+    ctx.gate.resume()  # a context built again: its last build may have stopped it
     try:
         for k, chunk in enumerate(chunks):
             composed, errors, jobs = compose_chunk(ctx, chunk)
             out.add(composed, errors)
             waiting.append((list(composed), pool.submit(
                 compile_many, (extra if k == 0 else []) + jobs, optimize=True, validate=True, progress=ctx.progress,
-                store=ctx.store, stats=stats, workers=ctx.jobs, executor=ctx.executor, memo=memo)))
+                store=ctx.store, stats=stats, workers=ctx.jobs, executor=ctx.executor, memo=memo, gate=ctx.gate)))
             deliver(block=False)
         deliver(block=True)
     except BaseException as e:
         # Ctrl-C, SIGTERM or a failure: the build ends now, not when the compile thread's batch is done (its
         # running tools are killed and its queued ones never start; an executor's are cancelled when it closes)
-        stop_tools()
-        pool.shutdown(wait=False, cancel_futures=True)
-        # Tools may start again once the compile thread has seen the stop: a process that goes on (a caller of
-        # the library after a failed build, a test) compiles again. After a failure wait for that thread (its
-        # tools are dead: it ends at once); an interrupted process is exiting, so it does not wait for it.
-        if isinstance(e, Exception):
-            _resume_after(pool)
-        else:
-            threading.Thread(target=_resume_after, args=(pool,), daemon=True).start()
+        ctx.gate.stop()  # this build's gate: a later build, with a context of its own, compiles as before
+        # After a failure wait for the compile thread (its tools are dead: it ends at once), so that none outlives
+        # the build; an interrupted process is exiting, so it does not wait for it.
+        pool.shutdown(wait=isinstance(e, Exception), cancel_futures=True)
         raise
     pool.shutdown(wait=True)

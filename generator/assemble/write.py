@@ -83,12 +83,12 @@ class Writer:
         return cost
 
 
-def validate_dialects(pairs, store) -> dict[str, list[str]]:
+def validate_dialects(pairs, store, gate=None) -> dict[str, list[str]]:
     """glslangValidator's errors (job key -> errors) for the platform dialect sources of a compiled chunk."""
     from ..toolchain.platforms import validate_dialects as validate
     jobs = [CompileJob(job_key(h, s.stage, s.language), s.language, s.stage, s.text, line_map=tuple(s.line_map))
             for h, c in pairs for s in c.dialects]
-    return validate(jobs, store) if jobs else {}
+    return validate(jobs, store, gate=gate) if jobs else {}
 
 
 def dxil_step():

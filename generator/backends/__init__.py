@@ -12,6 +12,7 @@ import importlib.util
 from pathlib import Path
 
 from .base import Emitted, Target
+from .front_end import FrontEnd
 from .gl.context import DIALECTS as _DIALECTS
 from .glsl.context import LANGUAGE as _GLSL
 from .hlsl.context import LANGUAGE as _HLSL
@@ -25,6 +26,8 @@ DIALECTS: dict[str, Language] = dict(_DIALECTS)
 TARGETS: dict[str, Target] = {lang.name: lang.full for lang in _SHADING}
 # fp16 variants: the brick language's float is the language's 16-bit float (half arithmetic, not only storage)
 HALF_TARGETS: dict[str, Target] = {lang.name: lang.half for lang in _SHADING}
+# How each shading language's text becomes SPIR-V: what the toolchain reads instead of the language's name.
+FRONT_ENDS: dict[str, FrontEnd] = {lang.name: lang.front_end for lang in _SHADING}
 # Template names start with a folder ("glsl/fragment.glsl.j2"): the back-end package whose templates/ holds the file.
 TEMPLATE_PACKAGES: dict[str, str] = {lang.folder: lang.package for lang in (*_SHADING, *DIALECTS.values())}
 
@@ -79,5 +82,5 @@ def get_target(name: str, precision: str = "fp32") -> Target:
         raise ValueError(f"unknown target '{name}' (known: {', '.join(sorted({*TARGETS, 'numpy'}))})") from None
 
 
-__all__ = ["DIALECTS", "Emitted", "HALF_TARGETS", "LANGUAGES", "Language", "TARGETS", "TEMPLATE_PACKAGES", "Target",
-           "get_target", "language", "parse_languages", "template_file"]
+__all__ = ["DIALECTS", "Emitted", "FRONT_ENDS", "FrontEnd", "HALF_TARGETS", "LANGUAGES", "Language", "TARGETS",
+           "TEMPLATE_PACKAGES", "Target", "get_target", "language", "parse_languages", "template_file"]

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from ..lang.types import BUILTIN_TYPES
 from .base import Target
+from .front_end import FrontEnd
 
 
 @dataclass(frozen=True, eq=False)
@@ -24,6 +25,8 @@ class Language:
     half: Target | None = None
     # The ubershader fragment's expression for the draw's material variant (its template's Draw block).
     material_index: str = ""
+    # How its text becomes SPIR-V (front_end.py); None for a platform dialect, which is validated, not compiled.
+    front_end: FrontEnd | None = None
 
     def template(self, kind: str) -> str:
         """The template rendering `kind`: "vertex", "fragment", "ubershader", "eval" or "shade"."""

@@ -49,7 +49,7 @@ def _rows(pins: dict[str, str]) -> tuple[list[tuple], bool]:
             rows.append(("MISSING", tool, "-", pin, "install: " + how_to_get(pin_key, pin)))
             failed = True
             continue
-        version = toolchain._version_of(tool, lambda text: (m.group(1) if (m := re.search(pattern, text, re.M)) else None))
+        version = toolchain.version_of(tool, lambda text: (m.group(1) if (m := re.search(pattern, text, re.M)) else None))
         if tool == "naga":
             status = "ok" if version == pin else "MISMATCH"
             failed |= status != "ok"

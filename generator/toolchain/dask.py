@@ -2,7 +2,7 @@
 
 A compile job is a pure function of its inputs (source, language, stage, flags, tool versions: the
 cache key), so any worker can run it. The jobs are cut into chunks (four per worker), each chunk is
-compiled on a worker by the same code as a local build (toolchain._compile_all), and the results come
+compiled on a worker by the same code as a local build (toolchain.compile_all), and the results come
 back to this process, which deduplicates, serves and fills the content-addressed store exactly as it
 does for a local build: the output is byte-identical.
 
@@ -14,7 +14,7 @@ compiler is never taken.
 """
 from __future__ import annotations
 
-from . import ToolMissing, _compile_all, tool_versions
+from . import ToolMissing, compile_all, tool_versions
 from ..lang.errors import UserError
 
 SCHEME = "dask://"
@@ -33,7 +33,7 @@ def _on_worker(jobs, optimize: bool, validate: bool, versions: dict):
         raise WorkerMismatch(f"dask worker {socket.gethostname()}: {what} — install the pinned tools there "
                              "(`make setup`)")
     try:
-        return _compile_all(list(jobs), optimize, validate, False)
+        return compile_all(list(jobs), optimize, validate, False)
     except ToolMissing as e:
         raise WorkerMismatch(f"dask worker {socket.gethostname()}: {e}") from None
 

@@ -28,7 +28,10 @@ from pathlib import Path
 
 from ..io import content_key
 from .. import toolchain as _tc  # find_tool read at call time (tests replace it on the package)
-from . import CompileJob, Diagnostic, ToolMissing, _map_line, _normalized, _run, tool_versions
+from .cache import normalized
+from .diagnostics import map_line
+from .model import CompileJob, Diagnostic
+from .run import Gate, ToolMissing, run, tool_versions
 
 NAMESPACE = "gl-validate-v1"
 _SELF_HASH = hashlib.sha256(Path(__file__).read_bytes()).hexdigest()
@@ -39,13 +42,14 @@ DX_PROFILES = {("vert", "fp32"): "vs_6_0", ("frag", "fp32"): "ps_6_0",
 
 
 def validation_key(job: CompileJob) -> str:
-    return content_key(NAMESPACE, _normalized(job.source), job.language, job.stage, tool_versions()["glslang"],
+    return content_key(NAMESPACE, normalized(job.source), job.language, job.stage, tool_versions()["glslang"],
                        _SELF_HASH)
 
 
-def validate_dialects(jobs: list[CompileJob], store=None, workers: int | None = None) -> dict[str, list[str]]:
+def validate_dialects(jobs: list[CompileJob], store=None, workers: int | None = None,
+                      gate: Gate | None = None) -> dict[str, list[str]]:
     """{job key: errors as `path:line:col: error: what [glslang]`} for GL/ES jobs (language "gl" or "essl");
-    an empty list means valid. Raises ToolMissing without glslangValidator."""
+    an empty list means valid. gate: the build's (run.Gate), or None. Raises ToolMissing without glslangValidator."""
     errors: dict[str, list[str]] = {}
     todo = []
     for job in jobs:
@@ -60,7 +64,7 @@ def validate_dialects(jobs: list[CompileJob], store=None, workers: int | None = 
         raise ToolMissing("glslangValidator")
     n = max(1, min(workers or os.cpu_count() or 1, -(-len(todo) // 16)))
     with tempfile.TemporaryDirectory(prefix=f"shadermatrix-{os.getpid()}-gl-") as tmp, ThreadPoolExecutor(n) as pool:
-        for part in pool.map(lambda k: _batch(tool, tmp, list(enumerate(todo))[k::n]), range(n)):
+        for part in pool.map(lambda k: _batch(tool, tmp, list(enumerate(todo))[k::n], gate), range(n)):
             errors.update(part)
     if store is not None:
         for job in todo:
@@ -69,13 +73,13 @@ def validate_dialects(jobs: list[CompileJob], store=None, workers: int | None = 
     return {j.key: errors[j.key] for j in jobs}
 
 
-def _batch(tool: str, tmp: str, items: list[tuple[int, CompileJob]]) -> dict[str, list[str]]:
+def _batch(tool: str, tmp: str, items: list[tuple[int, CompileJob]], gate: Gate | None) -> dict[str, list[str]]:
     names = {}
     for idx, job in items:
         name = f"g{idx:06d}.{job.stage}"  # the extension is the stage
         Path(tmp, name).write_text(job.source, encoding="utf-8")
         names[name] = job
-    rc, text = _run([tool, *names], cwd=tmp)
+    rc, text = run([tool, *names], cwd=tmp, gate=gate)
     out: dict[str, list[str]] = {job.key: [] for job in names.values()}
     current = None
     for raw in text.splitlines():
@@ -88,7 +92,7 @@ def _batch(tool: str, tmp: str, items: list[tuple[int, CompileJob]]) -> dict[str
             continue
         if "compilation terminated" in m["msg"]:  # glslang's trailer after the real error, with or without a line
             continue
-        path, lineno = _map_line(current, int(m["line"])) if m["line"] else (current.key, 0)
+        path, lineno = map_line(current, int(m["line"])) if m["line"] else (current.key, 0)
         msg = re.sub(r"^'' :\s+", "", m["msg"].strip())
         out[current.key].append(str(Diagnostic(path, lineno, 0, "error", msg, "glslang")))
     if rc != 0 and not any(out.values()):  # a failure glslang gave no message for (a crash): never silent
@@ -108,14 +112,14 @@ def dxc_version() -> str:
 def _dxc_version_at(path: str) -> str:
     """Once per process and dxc path (a build asks for every permutation's d3d12 tools, as tool_versions is)."""
     try:
-        _, out = _run([path, "--version"])
+        _, out = run([path, "--version"])
     except OSError as exc:
         return f"unusable ({exc.strerror})"
     return (out.strip().splitlines() or ["unknown"])[0]
 
 
-def compile_dxil(job: CompileJob, precision: str = "fp32") -> tuple[bytes | None, list[str]]:
-    """(DXIL, errors) of one HLSL job with dxc; (None, []) when dxc is not on PATH."""
+def compile_dxil(job: CompileJob, precision: str = "fp32", gate: Gate | None = None) -> tuple[bytes | None, list[str]]:
+    """(DXIL, errors) of one HLSL job with dxc; (None, []) when dxc is not on PATH. gate: the build's, or None."""
     path = _tc.find_tool("dxc")
     if path is None:
         return None, []
@@ -125,7 +129,7 @@ def compile_dxil(job: CompileJob, precision: str = "fp32") -> tuple[bytes | None
         src.write_text(job.source, encoding="utf-8")
         args = [path, "-T", profile, "-E", job.entry, *(["-enable-16bit-types"] if precision == "fp16" else []),
                 "-Fo", str(out), str(src)]
-        rc, text = _run(args, cwd=tmp)
+        rc, text = run(args, cwd=tmp, gate=gate)
         if rc != 0 or not out.is_file():
             return None, [f"{job.key}:0:0: error: dxc: {line}" for line in text.strip().splitlines()[:8]] or \
                 [f"{job.key}:0:0: error: dxc failed (exit status {rc})"]

@@ -9,7 +9,9 @@ import pytest
 
 from tests.conftest import require_tool
 from generator import toolchain
+from generator.backends import FRONT_ENDS
 from generator.toolchain import CompileJob, Diagnostic, ToolMissing, compile_many, tool_versions
+from generator.toolchain.spirv import spirv_steps
 
 pytestmark = pytest.mark.toolchain
 
@@ -48,7 +50,7 @@ SOURCES = {("glsl", "frag"): GLSL_FRAG, ("glsl", "comp"): GLSL_COMP, ("hlsl", "f
 
 
 def _front_end(language: str) -> str:
-    return "naga" if language == "wgsl" else "glslc"
+    return FRONT_ENDS[language].tool
 
 
 def _spirv_val_ok(tmp_path, blob: bytes) -> None:
@@ -263,7 +265,7 @@ def test_an_invalid_front_end_module_fails_in_spirv_opt_with_the_validator_messa
     subprocess.run([spirv_as, "--target-env", "vulkan1.1", "-", "-o", str(bad)], input=INVALID_SPVASM.encode(),
                    check=True)
     job = CompileJob("bad.frag.glsl", "glsl", "frag", "")
-    res = toolchain._spirv_steps({"spirv-opt": require_tool("spirv-opt"), "spirv-val": require_tool("spirv-val")},
-                                 str(tmp_path), 0, job, bad.read_bytes(), [], optimize=True, validate=True)
+    res = spirv_steps({"spirv-opt": require_tool("spirv-opt"), "spirv-val": require_tool("spirv-val")},
+                      str(tmp_path), 0, job, bad.read_bytes(), [], optimize=True, validate=True)
     assert not res.ok and res.spirv is None
     assert any("requires a type" in d.message and d.tool == "spirv-opt" for d in res.diagnostics), res.diagnostics

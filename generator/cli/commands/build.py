@@ -68,12 +68,14 @@ def summary(scene, res, out, seconds: float, pack: bool = False) -> dict:
             **({"packs": [p["path"] for p in res.manifest.get("packs", [])]} if pack else {})}
 
 
-def _interrupted(signum, frame):
-    """Ctrl-C or SIGTERM during a build: its tools are killed at once (whatever thread runs them: none waits for
-    a batch to finish), then the build unwinds like Ctrl-C (atomic writes remove their temporary files)."""
-    from ...toolchain import stop_tools
-    stop_tools()
-    raise KeyboardInterrupt
+def _interrupter(gate):
+    """The handler of Ctrl-C and SIGTERM during the build of `gate`: its tools are killed at once (whatever thread
+    runs them: none waits for a batch to finish), then the build unwinds like Ctrl-C (atomic writes remove their
+    temporary files)."""
+    def interrupted(signum, frame):
+        gate.stop()
+        raise KeyboardInterrupt
+    return interrupted
 
 
 def run(args) -> int:
@@ -124,7 +126,7 @@ def run(args) -> int:
         executor = DaskExecutor(args.executor)
     ctx = BuildContext(lib, platforms=platforms, store=store, progress=show_progress() and not args.quiet,
                        jobs=args.jobs, executor=executor)
-    handlers = {sig: signal.signal(sig, _interrupted) for sig in (signal.SIGINT, signal.SIGTERM)}
+    handlers = {sig: signal.signal(sig, _interrupter(ctx.gate)) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         res = build(scene, Path(args.out), ctx, depfile=args.depfile, keep_removed=args.keep_removed, pack=args.pack)
     finally:
