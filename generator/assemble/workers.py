@@ -10,6 +10,10 @@ each (tools included: nothing keeps writing into a temporary directory after the
 with a timeout. A terminal's Ctrl-C reaches the build alone (the workers are not in its foreground group), and
 SIGTERM of the build's group too: the build, not a dying worker, says what happened.
 
+A reply is pickled before it is sent: a result that cannot be pickled, or an exception that cannot make the
+trip (one whose class needs other arguments than its message to be made again), is reported as what it is —
+the pickling error's type and message, or the exception's — never as a worker that died.
+
 Workers are started by a forkserver (never a fork of the building process, which has threads): modules named
 in `preload` are imported once, by the forkserver, and each worker starts as a fork of it.
 """
@@ -24,6 +28,7 @@ import time
 import traceback
 from collections import deque
 from multiprocessing.connection import wait
+from multiprocessing.reduction import ForkingPickler
 
 from ..lang.errors import UserError
 
@@ -37,6 +42,10 @@ class WorkerDied(UserError):
     def __init__(self):
         super().__init__("a worker process of the build died (killed, or out of memory) — build again, or with "
                          "fewer jobs (-j)")
+
+
+class ReplyNotSent(RuntimeError):
+    """A worker's reply that could not make the trip to the build (it did not pickle, or not unpickle)."""
 
 
 class RemoteTraceback(Exception):
@@ -72,18 +81,26 @@ def _serve(conn, build: int, init, init_args: tuple, run) -> None:
             except BaseException as e:  # noqa: BLE001 — as above
                 reply = ("error", _portable(e))
         try:
-            conn.send(reply)
-        except (OSError, ValueError):  # the build is gone (or the result cannot be sent): nobody reads it
+            data = ForkingPickler.dumps(reply)  # as conn.send would, but a failure here is the task's error
+        except Exception as e:  # noqa: BLE001 — whatever the result's pickling raises
+            what = type(reply[1]).__name__ if reply[0] == "ok" else "error"
+            data = ForkingPickler.dumps(("error", _portable(ReplyNotSent(
+                f"a worker's result ({what}) cannot be sent to the build: {type(e).__name__}: {e}"))))
+        try:
+            conn.send_bytes(data)
+        except (OSError, ValueError):  # the build is gone: nobody reads it
             return
 
 
 def _portable(e: BaseException) -> tuple:
-    """(the exception, or a stand-in that pickles, and the worker's traceback as text)."""
+    """(the exception, or a stand-in that makes the trip with its type and message, and the worker's traceback as
+    text). The round trip is tried here: an exception whose class takes other arguments than the message it was
+    given (a SourceError: path, line, col, …) pickles, and fails only when the build unpickles it."""
     text = traceback.format_exc()
     try:
-        pickle.dumps(e)
-    except Exception:  # noqa: BLE001 — any exception may refuse pickling
-        e = RuntimeError(f"{type(e).__name__}: {e}")
+        pickle.loads(ForkingPickler.dumps(e))
+    except Exception:  # noqa: BLE001 — any exception may refuse the trip, either way
+        e = UserError(str(e)) if isinstance(e, UserError) else RuntimeError(f"{type(e).__name__}: {e}")
     return e, text
 
 
@@ -171,9 +188,14 @@ class Workers:
                 raise WorkerDied()
             for w in replies:
                 try:
-                    status, value = self._conns[w].recv()
-                except (EOFError, OSError, pickle.UnpicklingError):
+                    data = self._conns[w].recv_bytes()
+                except (EOFError, OSError):
                     raise WorkerDied() from None
+                try:
+                    status, value = pickle.loads(data)
+                except Exception as e:  # noqa: BLE001 — a result that pickled and does not unpickle here
+                    raise ReplyNotSent(f"a worker's result cannot be read by the build: {type(e).__name__}: "
+                                       f"{e}") from e
                 k = busy.pop(w)
                 if status == "error":
                     error, text = value
