@@ -133,6 +133,7 @@ class _Build:
         self.previous: dict = {}
         self.old: dict[str, dict] = {}  # the previous manifest's entries by hash
         self.built: dict[str, dict] = {}
+        self.uber_kept = False
 
     def run(self) -> BuildResult:
         scene, out, res, keys = self.scene, self.out, self.res, self.keys
@@ -147,6 +148,7 @@ class _Build:
         old_uber = self.previous.get("ubershader") or {}
         uber_kept = (old_uber.get("input_key") == keys.ubershader and old_uber.get("status") == "ok"
                      and state.intact(out, old_uber))
+        self.uber_kept = uber_kept  # the record keeps the last build's templates for it (it is not composed)
         uber_unit = None if uber_kept else _compose_ubershader(scene, self.ctx.library, self.ctx.languages)
         extra = []
         if isinstance(uber_unit, tuple):
@@ -232,7 +234,8 @@ class _Build:
         from .tables import collect_tables
         collect_packs(out, res.manifest)
         collect_tables(out, res.manifest)
-        state.record(out, res.manifest, text, self.keys, res.kept, res.templates)  # last: the no-op check trusts it
+        state.record(out, res.manifest, text, self.keys, res.kept + self.uber_kept,  # units kept, not composed
+                     res.templates)  # last: the no-op check trusts it
 
     def _settle(self, entry: dict, errs: list[str], old: dict | None, what: tuple[str, str]) -> dict:
         """An entry's status: ok; or, when it failed, its last good entry kept whole and marked stale.

@@ -19,7 +19,8 @@ STATE = ".shadermatrix-state.json"
 
 def record(out: Path, manifest: dict, text: bytes, keys: Keys, kept: int, templates: set[str]) -> None:
     """Write the record of the build that just wrote `manifest` (as bytes `text`); `templates`: those it composed
-    with (a build that kept permutations adds the last build's, which composed them)."""
+    with; kept: the units it kept (permutations and the ubershader) — it adds the last build's templates then,
+    which composed them."""
     templates = set(templates)
     if kept:
         templates.update(read(out).get("templates", []))
