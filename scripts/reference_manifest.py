@@ -165,10 +165,13 @@ shape("member", "Block member", "", {
     "matrix_stride": F("bytes between matrix columns", when="a matrix member"),
     "members": F("the members of the struct an array holds", "member", when="an array of structs"),
 })
-shape("parameter", "Parameter slot", "A parameter's place in a block: one vec4 each (four for a mat4).", {
+shape("parameter", "Parameter slot", "A parameter's place in a block's vec4 array, packed: a vec3 at .xyz, a vec2 at "
+      ".xy or .zw, a scalar in any component, a vec4 whole, a mat4 in four vec4s (docs/design/link.md, "
+      "\"Uniform layout\").", {
     "name": F("the parameter (`name[i]` for an element of an array parameter)"),
     "type": F("its brick-language type"),
-    "offset": F("byte offset in the block"),
+    "offset": F("byte offset in the block (in each element, for a storage block of light entries); "
+                "16 · vec4 + 4 · component"),
     "size": F("bytes it occupies"),
     "light": F("the index of the light it belongs to", when="a light's parameter"),
     "default": F("its default value"),

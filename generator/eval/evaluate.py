@@ -116,14 +116,12 @@ def _vectors(L, V, N, T, tangent: bool, spec: str) -> list[np.ndarray]:
 
 
 def _param_block(ep: EvalProgram, values: dict[str, list[float]]) -> np.ndarray:
-    """The kernel's vec4 parameter array (one vec4 per scalar/vector, four per mat4, column-major)."""
+    """The kernel's vec4 parameter array, packed as link.interface.layout placed it (a mat4 column-major)."""
+    from ..link.interface import put
+
     block = np.zeros((max(ep.param_vec4s, 1), 4), np.float32)
     for slot in ep.slots:
-        vals = values[slot.name]
-        if slot.width == 4:
-            block[slot.index: slot.index + 4] = np.asarray(vals, np.float32).reshape(4, 4)
-        else:
-            block[slot.index, : len(vals)] = vals
+        put(block.reshape(-1), slot, values[slot.name])
     return block
 
 

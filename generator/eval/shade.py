@@ -32,17 +32,15 @@ def _values(c, values: dict | None) -> dict:
     return out
 
 
-def _buffer_fields(glob, given: dict, n: int) -> dict[str, np.ndarray]:
-    """(n, 4) float arrays per field of a LightData struct from the lights' parameter values."""
-    out = {}
-    for f, _ in glob.ty.elem.fields:
-        if "_c" in f and f[:f.rindex("_c")] in given:  # a mat4 column
-            name, c = f[:f.rindex("_c")], int(f[f.rindex("_c") + 2:])
-            out[f] = np.asarray(given[name], np.float64).reshape(n, 4, 4)[:, c, :]
-            continue
-        v = np.asarray(given[f], np.float64).reshape(n, -1)
-        out[f] = np.concatenate([v, np.zeros((n, 4 - v.shape[1]))], 1)
-    return out
+def _buffer_fields(slots, given: dict, n: int) -> dict[str, np.ndarray]:
+    """The `data` field, (n, vec4s, 4) float, of n LightData elements from the lights' parameter values, each at
+    its slot (the LightBuffer block's parameters; a mat4's columns first)."""
+    vec4s = max([1] + [s.index + s.width for s in slots])
+    data = np.zeros((n, vec4s * 4), np.float64)
+    for s in slots:
+        v = np.asarray(given[s.param], np.float64).reshape(n, -1)
+        data[:, s.words()] = np.repeat(v, s.ty.components, 1) if v.shape[1] == 1 else v
+    return {"data": data.reshape(n, vec4s, 4)}
 
 
 def shade_samples(perm, P, Ng, V, T=None, uv=None, values: dict | None = None, buffers: dict | None = None,
@@ -59,7 +57,8 @@ def shade_samples(perm, P, Ng, V, T=None, uv=None, values: dict | None = None, b
     if set(buffers) != set(globs):
         raise EvalError(f"permutation has buffer lights {sorted(globs)}, got buffers for {sorted(buffers)}",
                         "give buffers={light index: {parameter: values per light}}")
-    fields = {i: _buffer_fields(globs[i], b, len(next(iter(b.values())))) for i, b in buffers.items()}
+    fields = {i: _buffer_fields(lp.interface.block(f"LightBuffer{i}").slots, b, len(next(iter(b.values()))))
+              for i, b in buffers.items()}
     n = len(P)
     if target == "numpy":
         return _numpy(lp, P, Ng, V, T, uv, vals, fields, globs)
@@ -97,8 +96,8 @@ def _gpu(source, c, n, P, Ng, V, T, uv, vals, fields, globs) -> np.ndarray:
     rows = [P, Ng, V] + ([np.asarray(T)[:, :4]] if T is not None else []) + ([uv] if uv is not None else [])
     blocks = [(UNIFORM, pack([s for ls in c.lights for s in ls], vals, c.interface.block("Lights").size // 16)),
               (UNIFORM, pack(c.material, vals, c.interface.block("Material").size // 16))]
-    for i in sorted(globs):  # (n, fields, 4): one vec4 per LightData field
-        blocks.append((STORAGE, np.stack([fields[i][f] for f, _ in globs[i].ty.elem.fields], 1).astype(np.float32)))
+    for i in sorted(globs):  # (n, vec4s, 4): LightData.data of each light
+        blocks.append((STORAGE, fields[i]["data"].astype(np.float32)))
     return _run(source, _samples(rows, n), blocks, what="shade kernel")
 
 

@@ -37,7 +37,7 @@ class EvalProgram:
     program: Program
     specs: Params  # the one parameter policy's group (spec/params.py)
     signature: list[tuple[str, Type]]  # the entry's parameters
-    slots: list[Slot]  # params in the vec4 parameter array
+    slots: list[Slot]  # params in the vec4 parameter array, packed (interface.layout)
     param_vec4s: int
     tangent: bool  # the entry reads T and B
     interface: Interface
@@ -151,6 +151,21 @@ def link_permutation(perm: Permutation | Resolved, lib: Library, kernel: bool = 
         return _link(r, lib, kernel)
 
 
+def _pack_values(g: ShadeGlue, surface: int) -> tuple[list[Slot], int, list[Slot], int]:
+    """The Material block's slots and vec4s, then the Lights block's: packed per group, each group from a new
+    vec4 — the material's brick parameters, then its last `surface` values (the surface state's), then each
+    light. So the ubershader's MaterialEntry.data, the bricks' part, is a prefix of every specialized Material
+    block of its variant, and one light's values are whole vec4s an engine may rewrite alone."""
+    cut = len(g.material) - surface
+    mat, bricks_end = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.material[:cut]])
+    more, mat_count = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.material[cut:]], bricks_end)
+    light_slots, light_count = [], 0
+    for i, vals in enumerate(g.lights):
+        slots, light_count = layout([(n, p, e, t, s, i) for n, p, e, t, s in vals], light_count)
+        light_slots += slots
+    return mat + more, mat_count, light_slots, light_count
+
+
 def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
     if r.problems:
         raise KeyProblem(*r.problems[0])
@@ -165,8 +180,7 @@ def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
         raise KeyProblem("vertex_color", f"a shade kernel has no vertex colours, and {r.key} reads COLOR_0",
                          "run vertex-colour permutations as fragment shaders")
     assign_bindings(g.textures, {"light": 2, "material": 1})
-    mat_slots, mat_count = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.material])
-    light_slots, light_count = layout([(n, p, e, t, s, i) for i, vals in enumerate(g.lights) for n, p, e, t, s in vals])
+    mat_slots, mat_count, light_slots, light_count = _pack_values(g, len(r.surface_params))
     if kernel:
         blocks = [vec4_array_block("Lights", 0, SHADE_KERNEL["Lights"], light_slots, max(light_count, 1)),
                   vec4_array_block("Material", 0, SHADE_KERNEL["Material"], mat_slots, max(mat_count, 1))]
@@ -178,14 +192,15 @@ def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
         if mat_count:
             blocks.append(vec4_array_block("Material", 1, 0, mat_slots, mat_count))
         binding = max([1] + [t.binding + 1 for t in g.textures if t.set == 0]) + 1
-    for gl in g.light_buffers:  # dynamic lights: read-only storage buffers after the light textures
-        gl.set, gl.binding = 0, binding
+    for gl, slots in zip(g.light_buffers, g.light_buffer_slots):  # dynamic lights: read-only storage buffers
+        gl.set, gl.binding = 0, binding  # after the light textures
         binding += 1
         elem = gl.ty.elem
-        fields = [{"name": f, "type": str(ft), "offset": 16 * k, "size": 16} for k, (f, ft) in enumerate(elem.fields)]
+        n = elem.fields[0][1].size  # LightData<i> { vec4 data[n]; }, the light's parameters packed (layout)
+        fields = [{"name": "data", "type": f"vec4[{n}]", "offset": 0, "size": 16 * n, "array_stride": 16}]
         blocks.append(Block(f"LightBuffer{elem.name[len('LightData'):]}", gl.set, gl.binding, "storage",
                             [{"name": "data", "type": f"{elem.name}[]", "offset": 0, "size": 0,
-                              "array_stride": 16 * len(fields), "members": fields}]))
+                              "array_stride": 16 * n, "members": fields}], slots))
     params = {"material": {p: s for _, p, _, _, s in g.material}}
     for i, lt in enumerate(r.lights):
         params[f"light{i}"] = lt.params

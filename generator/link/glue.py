@@ -16,13 +16,13 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from ..lang import SourceError, ir
-from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, storage_buffer, struct
+from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
 from ..spec.params import Params
 from ..spec.permutation import Node
 from ..spec.resolve import LightPart, Resolved, ResolvedBrdf
 from ..spec.surface import EMISSIVE_MAP
-from .interface import Texture, texture_type
+from .interface import Slot, Texture, layout, texture_type
 from .irgen import Builder
 from .program import Program
 
@@ -131,6 +131,7 @@ class ShadeGlue:
     textures: list[Texture]
     brdf: BrdfGlue
     light_buffers: list[ir.Global] = field(default_factory=list)  # per dynamic light: its storage buffer
+    light_buffer_slots: list[list[Slot]] = field(default_factory=list)  # and where its element holds each value
 
 
 class _Binder:
@@ -183,6 +184,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     prog.link(out_node)
     bind = _Binder(b)
     dynamic_lights: list[ir.Global] = []
+    buffer_slots: list[list[Slot]] = []
     provided: dict[str, ir.Expr] = {}
     lights = []
 
@@ -204,7 +206,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         for i, lt in enumerate(r.lights):
             pre = f"l{i}_"
             ln, sh, dyn = lt.node, lt.shadow, lt.dynamic
-            values = _light_buffer(prog, b, i, lt, dynamic_lights) if dyn else None
+            values = _light_buffer(prog, b, i, lt, dynamic_lights, buffer_slots) if dyn else None
             Li = f"L{i}"
             body_i = [b.decl(Li, bind.call(prog, ln, "light_dir", pre, "light", i, locals_, values))]
             cos = b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var(Li, VEC3))
@@ -268,7 +270,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         return stmts
     prog.add(b.function("shade", sig, VEC4, shade_body))
     prog.globals.extend(dynamic_lights)
-    return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights)
+    return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights, buffer_slots)
 
 
 VERTEX_COLOR = "vertex_color"  # shade()'s parameter: COLOR_0, interpolated (the templates' local of that name)
@@ -356,12 +358,13 @@ def shading_tangent(prog: Program, b: Builder, bind: _Binder, normal: Node, need
     return [("Ts", T), ("Bs", b.intrinsic("cross", VEC3, b.var("N", VEC3), b.var("Ts", VEC3)))]
 
 
-def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list) -> dict[str, ir.Expr]:
+def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list,
+                  slots_out: list) -> dict[str, ir.Expr]:
     """The storage buffer of dynamic light i and, per parameter, the expression reading it for element k<i>.
 
-    The element struct LightData<i> holds one vec4 per parameter (a scalar in .x, a vec3 in .xyz)
-    and four per mat4 (its columns): the layout rule of types.buffer_layout_error, so GLSL std430,
-    HLSL structured buffers and WGSL storage agree byte for byte.
+    The element struct LightData<i> is `vec4 data[n]`, the light's parameters packed as a
+    Lights block packs them (interface.layout): the layout rule of types.buffer_layout_error, so
+    GLSL std430, HLSL structured buffers and WGSL storage agree byte for byte.
     """
     params = lt.params
     owners = [(n.brick, x) for n in [lt.node, *lt.shadow.tree] for x in n.brick.textures]
@@ -371,27 +374,26 @@ def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list) -
         raise SourceError(brick.display_path, loc.line, loc.col, f"a loop over a buffer of '{lt.brick.id}' lights cannot "
                           f"bind texture '{tex}' of {brick.kind} '{brick.id}' per light",
                           "use a shadow filter without a texture (shadow none) for buffer lights")
-    fields = []
-    for k, p in params.items():
-        fields += [(f"{k}_c{c}", VEC4) for c in range(4)] if p.ty == MAT4 else [(k, VEC4)]
-    elem = struct(f"LightData{i}", fields)
+    slots, n = layout([(k, k, None, p.ty, p, i) for k, p in params.items()])
+    data_ty = array(VEC4, max(n, 1))
+    elem = struct(f"LightData{i}", (("data", data_ty),))
     g = ir.Global(f"light_buffer{i}", storage_buffer(elem))
     prog.structs.append(elem)
     out.append(g)
+    slots_out.append(slots)
     item = ir.Index(elem, b.here(), ir.Var(g.ty, b.here(), g.name, "global"), ir.Var(UINT, b.here(), f"k{i}"))
+    return {s.name: read_slot(b, item, data_ty, s) for s in slots}
 
-    def member(name):
-        return ir.Member(VEC4, b.here(), b.copy(item), name)
 
-    values = {}
-    for k, p in params.items():
-        if p.ty == MAT4:
-            values[k] = b.construct(MAT4, *(member(f"{k}_c{c}") for c in range(4)))
-        elif p.ty.components == 4:
-            values[k] = member(k)
-        else:
-            values[k] = ir.Swizzle(p.ty, b.here(), member(k), "xyzw"[:p.ty.components])
-    return values
+def read_slot(b: Builder, entry: ir.Expr, data_ty: Type, slot: Slot) -> ir.Expr:
+    """The value of `slot` in entry.data, a vec4 array: its components of vec4 slot.index (a mat4 spans four)."""
+    def vec4(i):
+        return ir.Index(VEC4, b.here(), ir.Member(data_ty, b.here(), b.copy(entry), "data"), ir.Const(INT, b.here(), i))
+    if slot.ty == MAT4:
+        return b.construct(MAT4, *(vec4(slot.index + c) for c in range(4)))
+    if slot.ty.components == 4:
+        return vec4(slot.index)
+    return ir.Swizzle(slot.ty, b.here(), vec4(slot.index), slot.swizzle[1:])
 
 
 def bind_texture(bind: _Binder, name: str, ty: Type, nodes) -> ir.Var:

@@ -2,9 +2,11 @@
 
 Everything downstream reads it: compose (templates declare it), build (the manifest's
 reflection), the runtime (what to bind), measure (stand-ins). Layout (docs/design/link.md,
-"Uniform layout"): material and light parameters live in arrays of vec4, one vec4
-per scalar or vector and four per mat4 (column-major), identical in std140, HLSL
-cbuffers and WGSL uniforms, so one byte block serves all three languages. Set 0:
+"Uniform layout"): material and light parameters live in arrays of vec4, packed (`layout`):
+a vec3 at .xyz, a vec2 at .xy or .zw, a scalar in any free component, a vec4 whole and a
+mat4 in four whole vec4s (column-major). Every value sits at its natural alignment inside
+one vec4, so the bytes are the same under std140, HLSL cbuffer rules and WGSL uniforms and
+one byte block serves all three languages. Set 0:
 frame (b0), lights (b1), light textures (b2+); set 1: material (b0), material
 textures (b1+); a texture takes two bindings, the image at B and its sampler at B+1 (a
 texture2d_shadow: a depth image and a comparison sampler, reflected as such in the manifest).
@@ -22,7 +24,7 @@ VEC4_BYTES = 16
 
 @dataclass
 class Slot:
-    """One parameter in a vec4-array block: shader name, engine name, type, vec4 index."""
+    """One parameter in a vec4-array block: shader name, engine name, type, vec4 index and first component."""
 
     name: str  # the glue's name (m_alpha, l0_color)
     param: str  # the engine's name (alpha, color)
@@ -32,6 +34,7 @@ class Slot:
     light: int | None = None  # the light it belongs to
     base: int = 0  # byte offset of the vec4 array in its block
     element: int | None = None  # the element of an array parameter
+    component: int = 0  # its first component in vec4 `index` (0 = .x … 3 = .w); 0 for a vec4 or mat4
 
     @property
     def width(self) -> int:
@@ -41,7 +44,18 @@ class Slot:
     @property
     def offset(self) -> int:
         """Byte offset in the block."""
-        return self.base + self.index * VEC4_BYTES
+        return self.base + self.index * VEC4_BYTES + self.component * 4
+
+    @property
+    def swizzle(self) -> str:
+        """How a shader reads it from its vec4 (`.w`, `.zw`, `.xyz`; '' for a whole vec4 or a mat4's columns)."""
+        n = self.ty.components
+        return "" if n % 4 == 0 else "." + "xyzw"[self.component:self.component + n]
+
+    def words(self) -> list[int]:
+        """The float32 words of the vec4 array it occupies, in the order of its value (a mat4's columns)."""
+        first = 4 * self.index + self.component
+        return list(range(first, first + self.ty.components))
 
     def as_dict(self) -> dict:
         name = self.param if self.element is None else f"{self.param}[{self.element}]"
@@ -54,14 +68,60 @@ class Slot:
         return d
 
 
-def layout(values: list[tuple]) -> tuple[list[Slot], int]:
-    """(name, param, element, type, spec, light) in order → slots, one vec4 each (four per mat4), and the vec4 count."""
-    slots, i = [], 0
-    for name, param, element, ty, spec, light in values:
-        s = Slot(name, param, ty, i, spec, light, element=element)
-        slots.append(s)
-        i += s.width
-    return slots, i
+# Where a value may start in a vec4, by component count: its natural alignment, so that the packed bytes are a
+# valid std140 / HLSL cbuffer / WGSL layout (HLSL would put a float3 after a float at offset 4, std140 at 16).
+_STARTS = {1: (0, 1, 2, 3), 2: (0, 2), 3: (0,)}
+
+
+def layout(values: list[tuple], start: int = 0) -> tuple[list[Slot], int]:
+    """(name, param, element, type, spec, light) in order → packed slots from vec4 `start`, and the vec4 after them.
+
+    Deterministic first fit: vectors and matrices first, in their declared order (a vec2 into the .zw a
+    vec2 left free, a vec3, vec4 or mat4 into new vec4s), then the scalars, in their declared order, each
+    into the first free component — the .w after a vec3 or the holes beside a vec2 before a new vec4.
+    Scalars go last so that one declared before a vec3 does not take the .x that vec3 needs.
+    """
+    used: list[list[bool]] = []  # per vec4 from `start`: which components are taken
+    placed: dict[int, Slot] = {}
+    order = sorted(range(len(values)), key=lambda k: (values[k][3].components == 1, k))
+    for k in order:
+        name, param, element, ty, spec, light = values[k]
+        index, component = _fit(used, ty.components)
+        placed[k] = Slot(name, param, ty, start + index, spec, light, element=element, component=component)
+    return [placed[k] for k in range(len(values))], start + len(used)
+
+
+def _fit(used: list[list[bool]], n: int) -> tuple[int, int]:
+    """The first (vec4, component) where `n` components fit (n = 16: four whole vec4s), marking them taken."""
+    if n % 4 == 0:  # a vec4 or a mat4: whole new vec4s
+        used.extend([True] * 4 for _ in range(n // 4))
+        return len(used) - n // 4, 0
+    for i, taken in enumerate(used):
+        for c in _STARTS[n]:
+            if not any(taken[c:c + n]):
+                taken[c:c + n] = [True] * n
+                return i, c
+    used.append([c < n for c in range(4)])
+    return len(used) - 1, 0
+
+
+def slot_value(slot: Slot, value) -> list[float]:
+    """A value as the words `slot.words()` hold: a scalar given for a vector splats, a mat4 is its columns."""
+    v = value.tolist() if hasattr(value, "tolist") else value  # a NumPy array or scalar
+    flat = [float(x) for x in (_flatten(v) if isinstance(v, (list, tuple)) else [v])]
+    if slot.ty.kind == "vector" and len(flat) == 1:
+        flat = flat * slot.ty.size
+    return flat
+
+
+def _flatten(v) -> list:
+    return [y for x in v for y in (_flatten(x) if isinstance(x, (list, tuple)) else [x])]
+
+
+def put(words, slot: Slot, value) -> None:
+    """Write `value` at `slot` into `words`, a flat float list or array over the block's vec4s."""
+    for w, x in zip(slot.words(), slot_value(slot, value)):
+        words[w] = x
 
 
 def pack(slots: list[Slot], values: dict[str, object], count: int) -> bytes:
@@ -69,17 +129,8 @@ def pack(slots: list[Slot], values: dict[str, object], count: int) -> bytes:
     words = [0.0] * (4 * max(count, 1))
     for s in slots:
         v = values.get(s.name)
-        if v is None:
-            continue
-        v = v.tolist() if hasattr(v, "tolist") else v  # a NumPy array or scalar
-        flat = list(v) if isinstance(v, (list, tuple)) else [v]
-        if s.ty.kind == "vector" and len(flat) == 1:
-            flat = flat * s.ty.size
-        if s.ty.kind == "matrix":  # column-major, one column per vec4
-            for c in range(4):
-                words[4 * (s.index + c):4 * (s.index + c) + 4] = [float(x) for x in flat[4 * c:4 * c + 4]]
-        else:
-            words[4 * s.index:4 * s.index + len(flat)] = [float(x) for x in flat]
+        if v is not None:
+            put(words, s, v)
     return struct.pack(f"<{len(words)}f", *words)
 
 

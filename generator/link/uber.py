@@ -10,24 +10,26 @@ Data (documented in docs/design/link.md, "The ubershader's data"; the manifest l
   material *variant* — a (BRDF, packing, output) combination of the table `variants`; ids.y,
   ids.z and ids.w are reserved (0).
   `data` holds exactly the variant's specialized Material block (the same bytes as the
-  specialized permutation's `uploads`), M the largest of them.
+  specialized permutation's `uploads`, less the surface state's vec4s at its end), M the
+  largest of them.
 - `light_buffer`: LightEntry { ids: ivec4; data: vec4[K] } per light, looped over with a
   runtime count. ids.x indexes `light_types`, ids.y `shadows`, ids.z the shadow map the
   light's filter samples (0 … shadow_maps-1). data[0 …) holds the light brick's parameters,
-  data[A …) the shadow filter's (A = the most vec4s any light type needs).
+  data[A …) the shadow filter's (A = the most vec4s any light type needs), each packed as a
+  Lights block packs a light (interface.layout).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 from ..lang import ir
-from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
+from ..lang.types import FLOAT, INT, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
 from ..library.inputs import SURFACE
 from ..spec.permutation import Permutation
 from ..spec.resolve import Resolved, resolve
 from ..spec.where import KeyProblem, within
-from .glue import _Binder, brdf_glue, has_tangent, shading_tangent
-from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture
+from .glue import _Binder, brdf_glue, has_tangent, read_slot, shading_tangent
+from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, layout
 from .irgen import Builder
 from .program import Program
 
@@ -60,7 +62,7 @@ class Uber:
     material_vec4s: int
     light_split: int  # A: where the shadow filter's parameters start in LightEntry.data
     light_vec4s: int
-    light_layouts: dict = field(default_factory=dict)  # (light, shadow) -> {param: (index, type)}
+    light_layouts: dict = field(default_factory=dict)  # (light, shadow) -> {param: Slot in LightEntry.data}
     textures: list[Texture] = field(default_factory=list)
     signature: list[tuple[str, Type]] = field(default_factory=list)
     surface: list[str] = field(default_factory=list)
@@ -92,17 +94,6 @@ class Uber:
                 "material_entry": {"ids": "ivec4 (variant, 0, 0, 0)", "data_vec4s": self.material_vec4s},
                 "light_entry": {"ids": "ivec4 (light type, shadow, shadow map, 0)", "data_vec4s": self.light_vec4s,
                                 "shadow_parameters_at": self.light_split}}
-
-
-def _read(b: Builder, entry: ir.Expr, data_ty: Type, index: int, ty: Type) -> ir.Expr:
-    """The value of type `ty` at vec4 `index` of entry.data (a mat4 spans four)."""
-    def vec4(i):
-        return ir.Index(VEC4, b.here(), ir.Member(data_ty, b.here(), b.copy(entry), "data"), ir.Const(INT, b.here(), i))
-    if ty == MAT4:
-        return b.construct(MAT4, *(vec4(index + c) for c in range(4)))
-    if ty.components == 4:
-        return vec4(index)
-    return ir.Swizzle(ty, b.here(), vec4(index), "xyzw"[:ty.components])
 
 
 def _zero(b: Builder, ty: Type) -> ir.Expr:
@@ -180,15 +171,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     layouts = {}
     for t in lnodes:
         for s in snodes:
-            lay, i = {}, 0
-            for name, _, _, ty, _ in lights[t][1].flat:
-                lay[name] = (i, ty)
-                i += 4 if ty == MAT4 else 1
-            i = A
-            for name, _, _, ty, _ in shadow_of[s][1].flat:
-                lay[name] = (i, ty)
-                i += 4 if ty == MAT4 else 1
-            layouts[(t, s)] = lay
+            own = _packed(lights[t][1]) + _packed(shadow_of[s][1], A)
+            layouts[(t, s)] = {x.name: x for x in own}
 
     me = b.var("me", MaterialEntry)
     if specialized:
@@ -206,7 +190,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
 
     def material_args(k) -> dict[str, ir.Expr]:
         """Variant k's parameters read from the entry, by the name an entry binds (alpha, lobes_0, ev)."""
-        return {s.name[2:]: _read(b, me, mat_data, s.index, s.ty) for s in variants[k].slots}
+        return {s.name[2:]: read_slot(b, me, mat_data, s) for s in variants[k].slots}
 
     def body():
         stmts = [b.decl("me", ir.Index(MaterialEntry, b.here(), ir.Var(mbuf.ty, b.here(), mbuf.name, "global"),
@@ -277,9 +261,14 @@ def _texture_types(node) -> dict[str, Type]:
             if p.ty.kind == "texture" and p.name in n.brick.textures}
 
 
+def _packed(params, start: int = 0) -> list[Slot]:
+    """A light's or shadow filter's parameters packed from vec4 `start` of LightEntry.data (interface.layout)."""
+    return layout([(n, k, e, ty, p, None) for n, k, e, ty, p in params.flat], start)[0]
+
+
 def _vec4s(params) -> int:
-    """vec4s a parameter group occupies (four per mat4)."""
-    return sum(4 if ty == MAT4 else 1 for _, _, _, ty, _ in params.flat)
+    """vec4s a parameter group occupies, packed."""
+    return layout([(n, k, e, ty, p, None) for n, k, e, ty, p in params.flat])[1]
 
 
 def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues, packings, provided,
@@ -292,7 +281,7 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
         return ir.Swizzle(INT, b.here(), b.copy(ids), c)
 
     def light_args(t, s):
-        return {name: _read(b, le, light_data, i, ty) for name, (i, ty) in layouts[(t, s)].items()}
+        return {name: read_slot(b, le, light_data, x) for name, x in layouts[(t, s)].items()}
 
     first_shadow = next(iter(snodes))
     body = [b.decl("le", ir.Index(LightEntry, b.here(), ir.Var(lbuf.ty, b.here(), lbuf.name, "global"),

@@ -8,7 +8,7 @@ ubershader's LightEntry / MaterialEntry storage buffers (link/uber.py).
 from __future__ import annotations
 
 from ..scene.load import Scene
-from .interface import pack
+from .interface import pack, put
 
 
 def material_values(scene: Scene, name: str, specs: dict) -> dict:
@@ -57,17 +57,14 @@ def _element(value, slot):
 
 
 def light_entry(u, light_type: str, shadow: str, values: dict):
-    """LightEntry.data of one light, (light_vec4s, 4) float32: each parameter at its vec4 of
+    """LightEntry.data of one light, (light_vec4s, 4) float32: each parameter at its slot of
     u.light_layouts (a scalar for a vector parameter splats, as pack() does; a mat4 spans four)."""
     import numpy as np
 
     data = np.zeros((u.light_vec4s, 4), np.float32)
-    for name, (j, ty) in u.light_layouts[(light_type, shadow)].items():
-        val = np.asarray(values[name], np.float32).reshape(-1)
-        if ty.kind == "vector" and len(val) == 1:
-            val = np.repeat(val, ty.components)
-        for c in range(0, len(val), 4):
-            data[j + c // 4, :len(val[c:c + 4])] = val[c:c + 4]
+    words = data.reshape(-1)
+    for name, slot in u.light_layouts[(light_type, shadow)].items():
+        put(words, slot, values[name])
     return data
 
 

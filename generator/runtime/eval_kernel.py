@@ -3,7 +3,7 @@
 Buffer layout (docs/design/runtime.md, "Eval kernels"): binding 0 the samples, 3 vec4s per
 sample (L, V, N) or 4 with T (xyz; w unused); binding 1 the result, one vec4
 per sample (f_r in xyz); binding 2 a uniform block: uvec4 info (x = sample
-count) then one vec4 per parameter (four per mat4); for kernels that sample
+count) then the parameters packed in vec4s (link.interface.layout); for kernels that sample
 textures, texture k's image at binding 3 + 2k (SAMPLED_IMAGE) and its sampler at
 4 + 2k (SAMPLER). The w of the first vec4 (L.w) carries an optional per-sample
 id as a float (0 when none is given: the switch kernel reads ``int(L.w)`` as

@@ -185,12 +185,14 @@ def moments_map(depth: np.ndarray, box: int = MOMENTS_BOX) -> np.ndarray:
 def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict, texels: dict | None = None) -> bytes:
     """A specialized Lights block with each shadowed light's l<i>_shadow_matrix slot replaced (and its
     l<i>_pcf_texel, for the lights in `texels`)."""
-    data = np.frombuffer(raw, np.float32).reshape(-1, 4).copy()
+    from ..link.interface import put
+
+    data = np.frombuffer(raw, np.float32).copy()
     for s in slots:
         if s.param == "shadow_matrix" and s.light is not None and lights[s.light] in matrices:
-            data[s.index:s.index + 4] = np.asarray(matrices[lights[s.light]], np.float32).reshape(4, 4)
+            put(data, s, np.asarray(matrices[lights[s.light]], np.float32))
         if s.param == PCF_TEXEL and s.light is not None and lights[s.light] in (texels or {}):
-            data[s.index, 0] = texels[lights[s.light]]
+            put(data, s, texels[lights[s.light]])
     return data.tobytes()
 
 

@@ -8,6 +8,7 @@ binary (generator/analysis/reflect.py) are exactly what the manifest says.
 from __future__ import annotations
 
 import json
+import re
 import struct
 from pathlib import Path
 
@@ -109,12 +110,38 @@ def test_ubershader_reflection_matches_its_spirv_in_every_language(built):
             assert _stage_vars(entry.outputs) == _locations(want["outputs"]), where
 
 
-def test_every_parameter_lies_inside_its_block(built):
-    _, manifest = built
+ALIGNED = {4: (0, 4, 8, 12), 8: (0, 8), 12: (0,), 16: (0,), 64: (0,)}  # bytes -> where in a vec4 it may start
+
+
+@pytest.mark.toolchain
+def test_every_parameter_is_packed_inside_the_vec4_array_the_spirv_declares(built):
+    """Each parameter lies in its block's `data` vec4 array as the SPIR-V of every language lays it out, at its
+    natural alignment within one vec4 (a vec3 at .xyz, a vec2 at .xy or .zw, a mat4 on whole vec4s: the bytes std140,
+    HLSL cbuffers and WGSL agree on), and no two parameters share a byte."""
+    from generator.analysis.reflect import flatten_layout
+    out, manifest = built
+    packed = 0
     for perm in manifest["permutations"]:
-        for b in perm["interface"]["frag"]["uniform_blocks"]:
-            for p in b.get("parameters", []):
-                assert p["offset"] % 16 == 0 and p["offset"] + p["size"] <= b["size"], (perm["hash"], b["name"], p)
+        blocks = [b for b in perm["interface"]["frag"]["uniform_blocks"] if b.get("parameters")]
+        for lang, stages in perm["languages"].items():
+            res = {(r.set, r.binding): r for r in reflect((out / stages["frag"]["spirv"]).read_bytes()).entry("frag").resources}
+            for b in blocks:
+                where = (perm["hash"], lang, b["name"])
+                # the vec4 array after any header (`data`; HLSL `<block>_data`; naga wraps the block in a struct)
+                leaf = flatten_layout(res[(b["set"], b["binding"])].members)[-1]
+                found = re.fullmatch(r"(\d+):vec4\[(\d+)\] s16", leaf)
+                assert found, (where, leaf)
+                start, end = int(found[1]), int(found[1]) + 16 * int(found[2])
+                taken = set()
+                for p in b["parameters"]:
+                    lo, hi = p["offset"], p["offset"] + p["size"]
+                    assert start <= lo and hi <= end, (where, p)
+                    assert (lo - start) % 16 in ALIGNED[p["size"]], (where, p)
+                    assert p["size"] > 16 or (lo - start) // 16 == (hi - 1 - start) // 16, (where, p)
+                    assert not taken & set(range(lo, hi)), (where, p)
+                    taken |= set(range(lo, hi))
+                    packed += (lo - start) % 16 != 0
+    assert packed, "some scalar shares a vec4 with another parameter"
 
 
 def test_uploads_are_the_scene_values_at_their_offsets(built):

@@ -115,7 +115,7 @@ def test_light_brick_equals_its_float64_reference_in_numpy(lib, light, change):
 
 @pytest.mark.parametrize("light", ["point_range", "spot", "uberlight"])
 def test_a_storage_buffer_of_the_new_lights_equals_them_unrolled(lib, light):
-    """`*light/none` (a loop over LightData, one vec4 per parameter) sums what two static lights give."""
+    """`*light/none` (a loop over LightData, its parameters packed in vec4s) sums what two static lights give."""
     from generator.eval.shade import shade_samples
     from generator.spec.permutation import LightKey, Permutation
 

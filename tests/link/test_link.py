@@ -274,7 +274,11 @@ def test_fragment_loops_over_a_storage_buffer_of_lights_with_a_runtime_count(lib
     V = np.array([[0.0, 0.0, 1.0]])
     mat = {"m_rho_d": [0.6, 0.5, 0.4], "m_n": 32.0, "m_f0": [0.04, 0.04, 0.04]}
     t = NumpyTarget()
-    res = {"light_buffer0": {"position": np.c_[pos, np.zeros(3)], "color": np.c_[col, np.zeros(3)]}}
+    slots = {s.param: s for s in blocks["LightBuffer0"].slots}  # each element: vec4 data[2], packed
+    assert [(slots[k].index, slots[k].swizzle) for k in ("position", "color")] == [(0, ".xyz"), (1, ".xyz")]
+    data = np.zeros((3, 2, 4))
+    data[:, 0, :3], data[:, 1, :3] = pos, col
+    res = {"light_buffer0": {"data": data}}
     f_dyn = t.load(t.emit(dyn.program.structs, dyn.program.functions, dyn.program.globals),
                    np.dtype("float64"), resources=res)["shade"]
     f_static = t.load(t.emit(static.program.structs, static.program.functions), np.dtype("float64"))["shade"]
@@ -308,7 +312,7 @@ def test_buffer_light_loop_compiles_and_its_spirv_declares_the_storage_block(lib
             res = {(x.set, x.binding): x for x in reflect(r.spirv).entry("frag").resources}
             buf = res[(0, 4)]
             assert buf.kind == "storage_buffer" and buf.readonly, key
-            assert flatten_layout(buf.members) == ["0:{0:vec4,16:vec4}[] s32"], key
+            assert flatten_layout(buf.members) == ["0:{0:vec4[2] s16}[] s32"], key
 
 
 # ------------------------------------------------------------------ an array parameter whose count is in the key

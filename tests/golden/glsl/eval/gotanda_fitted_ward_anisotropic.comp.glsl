@@ -13,7 +13,7 @@
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } samples;
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
-layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[5]; } params;
+layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[3]; } params;
 
 #line N "bricks/brdf/diffuse/gotanda_fitted.py"
 float gotanda_fitted_one_minus_pow5_complement(float x) {
@@ -89,5 +89,5 @@ void main() {
     vec3 N = samples.data[base + 2u].xyz;
     vec3 T = samples.data[base + 3u].xyz;
     vec3 B = cross(N, T);
-    result.data[i] = vec4(brdf(L, V, N, T, B, params.data[0].xyz, params.data[1].x, params.data[2].xyz, params.data[3].x, params.data[4].x), 0.0);
+    result.data[i] = vec4(brdf(L, V, N, T, B, params.data[0].xyz, params.data[0].w, params.data[1].xyz, params.data[1].w, params.data[2].x), 0.0);
 }

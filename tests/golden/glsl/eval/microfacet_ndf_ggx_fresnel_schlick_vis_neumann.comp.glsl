@@ -15,7 +15,7 @@
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } samples;
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
-layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[2]; } params;
+layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[1]; } params;
 
 #line N "bricks/brdf/microfacet/ndf/ggx.py"
 float ggx_ndf(float NdotH, float NxH2, float alpha) {
@@ -75,5 +75,5 @@ void main() {
     vec3 L = samples.data[base].xyz;
     vec3 V = samples.data[base + 1u].xyz;
     vec3 N = samples.data[base + 2u].xyz;
-    result.data[i] = vec4(brdf(L, V, N, params.data[0].x, params.data[1].xyz), 0.0);
+    result.data[i] = vec4(brdf(L, V, N, params.data[0].w, params.data[0].xyz), 0.0);
 }

@@ -12,7 +12,7 @@
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } samples;
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
-layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[2]; } params;
+layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[1]; } params;
 
 #line N "bricks/brdf/specular/phong_normalized.py"
 vec3 phong_normalized_specular(float RdotV, float n, vec3 f0) {
@@ -43,5 +43,5 @@ void main() {
     vec3 L = samples.data[base].xyz;
     vec3 V = samples.data[base + 1u].xyz;
     vec3 N = samples.data[base + 2u].xyz;
-    result.data[i] = vec4(brdf(L, V, N, params.data[0].x, params.data[1].xyz), 0.0);
+    result.data[i] = vec4(brdf(L, V, N, params.data[0].w, params.data[0].xyz), 0.0);
 }

@@ -20,8 +20,8 @@
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 
-layout(set = 0, binding = 1) uniform Lights { vec4 data[9]; } lights;
-layout(set = 1, binding = 0) uniform Material { vec4 data[3]; } material;
+layout(set = 0, binding = 1) uniform Lights { vec4 data[8]; } lights;
+layout(set = 1, binding = 0) uniform Material { vec4 data[2]; } material;
 layout(set = 1, binding = 1) uniform texture2D t_albedo_map;
 layout(set = 1, binding = 2) uniform sampler _smp_t_albedo_map;
 layout(set = 1, binding = 3) uniform texture2D t_normal_map;
@@ -166,5 +166,5 @@ void main() {
     vec3 T = normalize(v_tangent.xyz);
     vec3 B = cross(Ng, T) * v_tangent.w;
     vec2 uv = v_uv;
-    out_color = shade(P, Ng, V, T, B, uv, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, t_albedo_map, _smp_t_albedo_map, t_normal_map, _smp_t_normal_map, l0_shadow_map, _smp_l0_shadow_map);
+    out_color = shade(P, Ng, V, T, B, uv, material.data[0].xyz, material.data[0].w, material.data[1].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[0].w, lights.data[6].xyz, lights.data[7].xyz, t_albedo_map, _smp_t_albedo_map, t_normal_map, _smp_t_normal_map, l0_shadow_map, _smp_l0_shadow_map);
 }

@@ -19,8 +19,8 @@
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 
-layout(set = 0, binding = 1) uniform Lights { vec4 data[9]; } lights;
-layout(set = 1, binding = 0) uniform Material { vec4 data[2]; } material;
+layout(set = 0, binding = 1) uniform Lights { vec4 data[8]; } lights;
+layout(set = 1, binding = 0) uniform Material { vec4 data[1]; } material;
 layout(set = 0, binding = 2) uniform texture2D l0_shadow_map;
 layout(set = 0, binding = 3) uniform sampler _smp_l0_shadow_map;
 layout(location = 0) in vec3 v_position;
@@ -140,5 +140,5 @@ void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);
     vec3 V = normalize(frame.camera_pos.xyz - P);
-    out_color = shade(P, Ng, V, material.data[0].x, material.data[1].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, l0_shadow_map, _smp_l0_shadow_map);
+    out_color = shade(P, Ng, V, material.data[0].w, material.data[0].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[0].w, lights.data[6].xyz, lights.data[7].xyz, l0_shadow_map, _smp_l0_shadow_map);
 }

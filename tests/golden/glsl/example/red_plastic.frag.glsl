@@ -16,7 +16,7 @@
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 
 layout(set = 0, binding = 1) uniform Lights { vec4 data[4]; } lights;
-layout(set = 1, binding = 0) uniform Material { vec4 data[3]; } material;
+layout(set = 1, binding = 0) uniform Material { vec4 data[2]; } material;
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 0) out vec4 out_color;
@@ -91,5 +91,5 @@ void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);
     vec3 V = normalize(frame.camera_pos.xyz - P);
-    out_color = shade(P, Ng, V, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, lights.data[2].xyz, lights.data[3].xyz);
+    out_color = shade(P, Ng, V, material.data[0].xyz, material.data[0].w, material.data[1].xyz, lights.data[0].xyz, lights.data[1].xyz, lights.data[2].xyz, lights.data[3].xyz);
 }

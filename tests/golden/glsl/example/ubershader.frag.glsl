@@ -45,7 +45,7 @@ layout(location = 0) out vec4 out_color;
 
 struct MaterialEntry {
     ivec4 ids;
-    vec4 data[3];
+    vec4 data[2];
 };
 
 struct LightEntry {
@@ -342,23 +342,23 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 T, vec3 B, vec2 uv, int material, textu
             vec3 f = vec3(0.0);
             switch (me.ids.x) {
                 case 0: {
-                    f = brdf_lit_0(L, V, N, me.data[0].xyz, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_0(L, V, N, me.data[0].xyz, me.data[0].w, me.data[1].xyz);
                     break;
                 }
                 case 1: {
-                    f = brdf_lit_1(L, V, N, me.data[0].x, me.data[1].xyz);
+                    f = brdf_lit_1(L, V, N, me.data[0].w, me.data[0].xyz);
                     break;
                 }
                 case 2: {
-                    f = brdf_lit_2(L, V, N, me.data[0].xyz, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_2(L, V, N, me.data[0].xyz, me.data[0].w, me.data[1].xyz);
                     break;
                 }
                 case 3: {
-                    f = brdf_lit_3(L, V, N, p_rho_d, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_3(L, V, N, p_rho_d, me.data[0].w, me.data[1].xyz);
                     break;
                 }
                 case 4: {
-                    f = brdf_lit_4(L, V, N, p_rho_d, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_4(L, V, N, p_rho_d, me.data[0].w, me.data[1].xyz);
                     break;
                 }
             }

@@ -17,8 +17,8 @@
 
 layout(set = 0, binding = 0) uniform Frame { mat4 view_proj; vec4 camera_pos; } frame;
 
-layout(set = 0, binding = 1) uniform Lights { vec4 data[7]; } lights;
-layout(set = 1, binding = 0) uniform Material { vec4 data[4]; } material;
+layout(set = 0, binding = 1) uniform Lights { vec4 data[6]; } lights;
+layout(set = 1, binding = 0) uniform Material { vec4 data[2]; } material;
 layout(set = 0, binding = 2) uniform texture2D l0_shadow_map;
 layout(set = 0, binding = 3) uniform sampler _smp_l0_shadow_map;
 layout(location = 0) in vec3 v_position;
@@ -26,8 +26,7 @@ layout(location = 1) in vec3 v_normal;
 layout(location = 0) out vec4 out_color;
 
 struct LightData1 {
-    vec4 position;
-    vec4 color;
+    vec4 data[2];
 };
 
 layout(set = 0, binding = 4, std430) readonly buffer _blk_light_buffer1 { LightData1 data[]; } light_buffer1;
@@ -105,10 +104,10 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_n, vec3 m_f0, float o_
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     for (uint k1 = 0u; k1 < uint(light_buffer1.data.length()); k1++) {
-        vec3 L1 = point_light_dir(P, light_buffer1.data[k1].position.xyz);
+        vec3 L1 = point_light_dir(P, light_buffer1.data[k1].data[0].xyz);
         float NdotL1 = dot(N, L1);
         if (NdotL1 > 0.0) {
-            vec3 c1 = point_light_radiance(P, light_buffer1.data[k1].position.xyz, light_buffer1.data[k1].color.xyz);
+            vec3 c1 = point_light_radiance(P, light_buffer1.data[k1].data[0].xyz, light_buffer1.data[k1].data[1].xyz);
             float s1 = none_shadow(P);
             Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
         }
@@ -122,5 +121,5 @@ void main() {
     vec3 P = v_position;
     vec3 Ng = normalize(v_normal);
     vec3 V = normalize(frame.camera_pos.xyz - P);
-    out_color = shade(P, Ng, V, material.data[0].xyz, material.data[1].x, material.data[2].xyz, material.data[3].x, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, l0_shadow_map, _smp_l0_shadow_map);
+    out_color = shade(P, Ng, V, material.data[0].xyz, material.data[0].w, material.data[1].xyz, material.data[1].w, lights.data[0].xyz, lights.data[1].xyz, mat4(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[0].w, l0_shadow_map, _smp_l0_shadow_map);
 }

@@ -21,11 +21,10 @@ layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } sa
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
 layout(set = 0, binding = 2) uniform Info { uvec4 info; } params;
 layout(set = 0, binding = 3) uniform Lights { vec4 data[2]; } lights;
-layout(set = 0, binding = 4) uniform Material { vec4 data[4]; } material;
+layout(set = 0, binding = 4) uniform Material { vec4 data[2]; } material;
 
 struct LightData1 {
-    vec4 position;
-    vec4 color;
+    vec4 data[2];
 };
 
 layout(set = 0, binding = 5, std430) readonly buffer _blk_light_buffer1 { LightData1 data[]; } light_buffer1;
@@ -85,10 +84,10 @@ vec4 shade(vec3 P, vec3 Ng, vec3 V, vec3 m_rho_d, float m_n, vec3 m_f0, float o_
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     for (uint k1 = 0u; k1 < uint(light_buffer1.data.length()); k1++) {
-        vec3 L1 = point_light_dir(P, light_buffer1.data[k1].position.xyz);
+        vec3 L1 = point_light_dir(P, light_buffer1.data[k1].data[0].xyz);
         float NdotL1 = dot(N, L1);
         if (NdotL1 > 0.0) {
-            vec3 c1 = point_light_radiance(P, light_buffer1.data[k1].position.xyz, light_buffer1.data[k1].color.xyz);
+            vec3 c1 = point_light_radiance(P, light_buffer1.data[k1].data[0].xyz, light_buffer1.data[k1].data[1].xyz);
             float s1 = none_shadow(P);
             Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
         }
@@ -107,5 +106,5 @@ void main() {
     vec3 P = samples.data[base].xyz;
     vec3 Ng = normalize(samples.data[base + 1u].xyz);
     vec3 V = normalize(samples.data[base + 2u].xyz);
-    result.data[i] = shade(P, Ng, V, material.data[0].xyz, material.data[1].x, material.data[2].xyz, material.data[3].x, lights.data[0].xyz, lights.data[1].xyz);
+    result.data[i] = shade(P, Ng, V, material.data[0].xyz, material.data[0].w, material.data[1].xyz, material.data[1].w, lights.data[0].xyz, lights.data[1].xyz);
 }

@@ -15,7 +15,7 @@
 layout(local_size_x = 64) in;
 layout(set = 0, binding = 0, std430) readonly buffer Samples { vec4 data[]; } samples;
 layout(set = 0, binding = 1, std430) writeonly buffer Result { vec4 data[]; } result;
-layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[4]; } params;
+layout(set = 0, binding = 2) uniform Params { uvec4 info; vec4 data[2]; } params;
 
 #line N "tests/bricks/link/ndf/aniso_ggx.py"
 float aniso_ggx_ndf(float NdotH, float HdotT, float HdotB, float alpha_u, float alpha_v) {
@@ -82,5 +82,5 @@ void main() {
     vec3 N = samples.data[base + 2u].xyz;
     vec3 T = samples.data[base + 3u].xyz;
     vec3 B = cross(N, T);
-    result.data[i] = vec4(brdf(L, V, N, T, B, params.data[0].x, params.data[1].xyz, params.data[2].x, params.data[3].x), 0.0);
+    result.data[i] = vec4(brdf(L, V, N, T, B, params.data[0].w, params.data[0].xyz, params.data[1].x, params.data[1].y), 0.0);
 }

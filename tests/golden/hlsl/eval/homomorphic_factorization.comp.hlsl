@@ -7,9 +7,9 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per
 // sample: L, V, N, T (xyz; w unused). info.x = sample count.
-StructuredBuffer<float4> samples : register(t0, space0);
-RWStructuredBuffer<float4> result : register(u1, space0);
-cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[1]; };
+[[vk::binding(0, 0)]] StructuredBuffer<float4> samples : register(t0, space0);
+[[vk::binding(1, 0)]] RWStructuredBuffer<float4> result : register(u1, space0);
+[[vk::binding(2, 0)]] cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[1]; };
 [[vk::binding(3, 0)]] TextureCube hf_p : register(t3, space0);
 [[vk::binding(4, 0)]] SamplerState _smp_hf_p : register(s4, space0);
 [[vk::binding(5, 0)]] TextureCube hf_q : register(t5, space0);

@@ -8,9 +8,9 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per
 // sample: L, V, N, T (xyz; w unused). info.x = sample count.
-StructuredBuffer<float4> samples : register(t0, space0);
-RWStructuredBuffer<float4> result : register(u1, space0);
-cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[3]; };
+[[vk::binding(0, 0)]] StructuredBuffer<float4> samples : register(t0, space0);
+[[vk::binding(1, 0)]] RWStructuredBuffer<float4> result : register(u1, space0);
+[[vk::binding(2, 0)]] cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[2]; };
 [[vk::binding(3, 0)]] Texture2D banks_kernel : register(t3, space0);
 [[vk::binding(4, 0)]] SamplerState _smp_banks_kernel : register(s4, space0);
 
@@ -58,5 +58,5 @@ void main(uint3 gid : SV_DispatchThreadID) {
     float3 N = samples[base + 2u].xyz;
     float3 T = samples[base + 3u].xyz;
     float3 B = cross(N, T);
-    result[i] = float4(brdf(L, V, N, T, B, params_data[0].xyz, params_data[1].x, params_data[2].xyz, banks_kernel, _smp_banks_kernel), 0.0);
+    result[i] = float4(brdf(L, V, N, T, B, params_data[0].xyz, params_data[0].w, params_data[1].xyz, banks_kernel, _smp_banks_kernel), 0.0);
 }

@@ -8,9 +8,9 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per
 // sample: L, V, N, T (xyz; w unused). info.x = sample count.
-StructuredBuffer<float4> samples : register(t0, space0);
-RWStructuredBuffer<float4> result : register(u1, space0);
-cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[9]; };
+[[vk::binding(0, 0)]] StructuredBuffer<float4> samples : register(t0, space0);
+[[vk::binding(1, 0)]] RWStructuredBuffer<float4> result : register(u1, space0);
+[[vk::binding(2, 0)]] cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[9]; };
 
 #line N "bricks/brdf/diffuse/lambert.py"
 float3 lambert_diffuse(float3 rho_d) {

@@ -10,9 +10,9 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per
 // sample: L, V, N (xyz; w unused). info.x = sample count.
-StructuredBuffer<float4> samples : register(t0, space0);
-RWStructuredBuffer<float4> result : register(u1, space0);
-cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[2]; };
+[[vk::binding(0, 0)]] StructuredBuffer<float4> samples : register(t0, space0);
+[[vk::binding(1, 0)]] RWStructuredBuffer<float4> result : register(u1, space0);
+[[vk::binding(2, 0)]] cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[1]; };
 
 #line N "bricks/brdf/microfacet/ndf/ggx.py"
 float ggx_ndf(float NdotH, float NxH2, float alpha) {
@@ -73,5 +73,5 @@ void main(uint3 gid : SV_DispatchThreadID) {
     float3 L = samples[base].xyz;
     float3 V = samples[base + 1u].xyz;
     float3 N = samples[base + 2u].xyz;
-    result[i] = float4(brdf(L, V, N, params_data[0].x, params_data[1].xyz), 0.0);
+    result[i] = float4(brdf(L, V, N, params_data[0].w, params_data[0].xyz), 0.0);
 }

@@ -16,10 +16,10 @@
 // template hlsl/fragment.hlsl.j2 sha256:<elided>
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
+[[vk::binding(0, 0)]] cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
-cbuffer Lights : register(b1, space0) { float4 lights_data[9]; };
-cbuffer Material : register(b0, space1) { float4 material_data[3]; };
+[[vk::binding(1, 0)]] cbuffer Lights : register(b1, space0) { float4 lights_data[8]; };
+[[vk::binding(0, 1)]] cbuffer Material : register(b0, space1) { float4 material_data[2]; };
 [[vk::binding(1, 1)]] Texture2D t_albedo_map : register(t1, space1);
 [[vk::binding(2, 1)]] SamplerState _smp_t_albedo_map : register(s2, space1);
 [[vk::binding(3, 1)]] Texture2D t_normal_map : register(t3, space1);
@@ -166,5 +166,5 @@ float4 main(PSIn i) : SV_Target0 {
     float3 T = normalize(i.v_tangent.xyz);
     float3 B = cross(Ng, T) * i.v_tangent.w;
     float2 uv = i.v_uv;
-    return shade(P, Ng, V, T, B, uv, material_data[0].xyz, material_data[1].x, material_data[2].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[6].x, lights_data[7].xyz, lights_data[8].xyz, t_albedo_map, _smp_t_albedo_map, t_normal_map, _smp_t_normal_map, l0_shadow_map, _smp_l0_shadow_map);
+    return shade(P, Ng, V, T, B, uv, material_data[0].xyz, material_data[0].w, material_data[1].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[0].w, lights_data[6].xyz, lights_data[7].xyz, t_albedo_map, _smp_t_albedo_map, t_normal_map, _smp_t_normal_map, l0_shadow_map, _smp_l0_shadow_map);
 }

@@ -15,10 +15,10 @@
 // template hlsl/fragment.hlsl.j2 sha256:<elided>
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
+[[vk::binding(0, 0)]] cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
-cbuffer Lights : register(b1, space0) { float4 lights_data[9]; };
-cbuffer Material : register(b0, space1) { float4 material_data[2]; };
+[[vk::binding(1, 0)]] cbuffer Lights : register(b1, space0) { float4 lights_data[8]; };
+[[vk::binding(0, 1)]] cbuffer Material : register(b0, space1) { float4 material_data[1]; };
 [[vk::binding(2, 0)]] Texture2D l0_shadow_map : register(t2, space0);
 [[vk::binding(3, 0)]] SamplerState _smp_l0_shadow_map : register(s3, space0);
 
@@ -140,5 +140,5 @@ float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);
     float3 V = normalize(camera_pos.xyz - P);
-    return shade(P, Ng, V, material_data[0].x, material_data[1].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[6].x, lights_data[7].xyz, lights_data[8].xyz, l0_shadow_map, _smp_l0_shadow_map);
+    return shade(P, Ng, V, material_data[0].w, material_data[0].xyz, lights_data[0].xyz, lights_data[1].xyz, transpose(float4x4(lights_data[2], lights_data[3], lights_data[4], lights_data[5])), lights_data[0].w, lights_data[6].xyz, lights_data[7].xyz, l0_shadow_map, _smp_l0_shadow_map);
 }

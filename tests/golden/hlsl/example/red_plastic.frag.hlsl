@@ -11,10 +11,10 @@
 // template hlsl/fragment.hlsl.j2 sha256:<elided>
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
+[[vk::binding(0, 0)]] cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
-cbuffer Lights : register(b1, space0) { float4 lights_data[4]; };
-cbuffer Material : register(b0, space1) { float4 material_data[3]; };
+[[vk::binding(1, 0)]] cbuffer Lights : register(b1, space0) { float4 lights_data[4]; };
+[[vk::binding(0, 1)]] cbuffer Material : register(b0, space1) { float4 material_data[2]; };
 
 struct PSIn {
     [[vk::location(0)]] float3 v_position : TEXCOORD0;
@@ -91,5 +91,5 @@ float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);
     float3 V = normalize(camera_pos.xyz - P);
-    return shade(P, Ng, V, material_data[0].xyz, material_data[1].x, material_data[2].xyz, lights_data[0].xyz, lights_data[1].xyz, lights_data[2].xyz, lights_data[3].xyz);
+    return shade(P, Ng, V, material_data[0].xyz, material_data[0].w, material_data[1].xyz, lights_data[0].xyz, lights_data[1].xyz, lights_data[2].xyz, lights_data[3].xyz);
 }

@@ -25,10 +25,10 @@
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 // template hlsl/ubershader.hlsl.j2 sha256:<elided>
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
+[[vk::binding(0, 0)]] cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
 // Ubershader: the material's variant, parameters and lights come from buffers (link/uber.py).
-cbuffer Draw : register(b0, space1) { int4 draw_material; };
+[[vk::binding(0, 1)]] cbuffer Draw : register(b0, space1) { int4 draw_material; };
 [[vk::binding(2, 1)]] Texture2D t_albedo_map : register(t2, space1);
 [[vk::binding(3, 1)]] SamplerState _smp_t_albedo_map : register(s3, space1);
 [[vk::binding(4, 1)]] Texture2D t_normal_map : register(t4, space1);
@@ -45,9 +45,9 @@ struct PSIn {
 
 struct MaterialEntry {
     int4 ids;
-    float4 data[3];
+    float4 data[2];
 };
-MaterialEntry _make_MaterialEntry(int4 ids, float4 data[3]) {
+MaterialEntry _make_MaterialEntry(int4 ids, float4 data[2]) {
     MaterialEntry _s;
     _s.ids = ids;
     _s.data = data;
@@ -356,23 +356,23 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 T, float3 B, float2 uv, int m
             float3 f = ((float3)(0.0));
             switch (me.ids.x) {
                 case 0: {
-                    f = brdf_lit_0(L, V, N, me.data[0].xyz, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_0(L, V, N, me.data[0].xyz, me.data[0].w, me.data[1].xyz);
                     break;
                 }
                 case 1: {
-                    f = brdf_lit_1(L, V, N, me.data[0].x, me.data[1].xyz);
+                    f = brdf_lit_1(L, V, N, me.data[0].w, me.data[0].xyz);
                     break;
                 }
                 case 2: {
-                    f = brdf_lit_2(L, V, N, me.data[0].xyz, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_2(L, V, N, me.data[0].xyz, me.data[0].w, me.data[1].xyz);
                     break;
                 }
                 case 3: {
-                    f = brdf_lit_3(L, V, N, p_rho_d, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_3(L, V, N, p_rho_d, me.data[0].w, me.data[1].xyz);
                     break;
                 }
                 case 4: {
-                    f = brdf_lit_4(L, V, N, p_rho_d, me.data[1].x, me.data[2].xyz);
+                    f = brdf_lit_4(L, V, N, p_rho_d, me.data[0].w, me.data[1].xyz);
                     break;
                 }
             }

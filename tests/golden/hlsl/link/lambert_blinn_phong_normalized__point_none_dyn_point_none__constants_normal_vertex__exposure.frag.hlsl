@@ -11,10 +11,10 @@
 // template hlsl/fragment.hlsl.j2 sha256:<elided>
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
+[[vk::binding(0, 0)]] cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
-cbuffer Lights : register(b1, space0) { float4 lights_data[2]; };
-cbuffer Material : register(b0, space1) { float4 material_data[4]; };
+[[vk::binding(1, 0)]] cbuffer Lights : register(b1, space0) { float4 lights_data[2]; };
+[[vk::binding(0, 1)]] cbuffer Material : register(b0, space1) { float4 material_data[2]; };
 
 struct PSIn {
     [[vk::location(0)]] float3 v_position : TEXCOORD0;
@@ -22,13 +22,11 @@ struct PSIn {
 };
 
 struct LightData1 {
-    float4 position;
-    float4 color;
+    float4 data[2];
 };
-LightData1 _make_LightData1(float4 position, float4 color) {
+LightData1 _make_LightData1(float4 data[2]) {
     LightData1 _s;
-    _s.position = position;
-    _s.color = color;
+    _s.data = data;
     return _s;
 }
 
@@ -90,10 +88,10 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_n, float3 m_
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     for (uint k1 = 0u; k1 < _len_light_buffer1(); k1++) {
-        float3 L1 = point_light_dir(P, light_buffer1[k1].position.xyz);
+        float3 L1 = point_light_dir(P, light_buffer1[k1].data[0].xyz);
         float NdotL1 = dot(N, L1);
         if (NdotL1 > 0.0) {
-            float3 c1 = point_light_radiance(P, light_buffer1[k1].position.xyz, light_buffer1[k1].color.xyz);
+            float3 c1 = point_light_radiance(P, light_buffer1[k1].data[0].xyz, light_buffer1[k1].data[1].xyz);
             float s1 = none_shadow(P);
             Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
         }
@@ -107,5 +105,5 @@ float4 main(PSIn i) : SV_Target0 {
     float3 P = i.v_position;
     float3 Ng = normalize(i.v_normal);
     float3 V = normalize(camera_pos.xyz - P);
-    return shade(P, Ng, V, material_data[0].xyz, material_data[1].x, material_data[2].xyz, material_data[3].x, lights_data[0].xyz, lights_data[1].xyz);
+    return shade(P, Ng, V, material_data[0].xyz, material_data[0].w, material_data[1].xyz, material_data[1].w, lights_data[0].xyz, lights_data[1].xyz);
 }

@@ -14,20 +14,18 @@
 // Shade kernel: the permutation's shade() for each sample, in a compute shader (the fragment
 // glue without a graphics pipeline). Samples are float4s, 3 per sample: P, Ng, V
 // (T.w: the bitangent's sign). info.x = sample count. Result: shade()'s float4.
-StructuredBuffer<float4> samples : register(t0, space0);
-RWStructuredBuffer<float4> result : register(u1, space0);
-cbuffer Info : register(b2, space0) { uint4 info; };
-cbuffer Lights : register(b3, space0) { float4 lights_data[2]; };
-cbuffer Material : register(b4, space0) { float4 material_data[4]; };
+[[vk::binding(0, 0)]] StructuredBuffer<float4> samples : register(t0, space0);
+[[vk::binding(1, 0)]] RWStructuredBuffer<float4> result : register(u1, space0);
+[[vk::binding(2, 0)]] cbuffer Info : register(b2, space0) { uint4 info; };
+[[vk::binding(3, 0)]] cbuffer Lights : register(b3, space0) { float4 lights_data[2]; };
+[[vk::binding(4, 0)]] cbuffer Material : register(b4, space0) { float4 material_data[2]; };
 
 struct LightData1 {
-    float4 position;
-    float4 color;
+    float4 data[2];
 };
-LightData1 _make_LightData1(float4 position, float4 color) {
+LightData1 _make_LightData1(float4 data[2]) {
     LightData1 _s;
-    _s.position = position;
-    _s.color = color;
+    _s.data = data;
     return _s;
 }
 
@@ -89,10 +87,10 @@ float4 shade(float3 P, float3 Ng, float3 V, float3 m_rho_d, float m_n, float3 m_
         Lo += (((3.141592653589793 * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     for (uint k1 = 0u; k1 < _len_light_buffer1(); k1++) {
-        float3 L1 = point_light_dir(P, light_buffer1[k1].position.xyz);
+        float3 L1 = point_light_dir(P, light_buffer1[k1].data[0].xyz);
         float NdotL1 = dot(N, L1);
         if (NdotL1 > 0.0) {
-            float3 c1 = point_light_radiance(P, light_buffer1[k1].position.xyz, light_buffer1[k1].color.xyz);
+            float3 c1 = point_light_radiance(P, light_buffer1[k1].data[0].xyz, light_buffer1[k1].data[1].xyz);
             float s1 = none_shadow(P);
             Lo += (((3.141592653589793 * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
         }
@@ -112,5 +110,5 @@ void main(uint3 gid : SV_DispatchThreadID) {
     float3 P = samples[base].xyz;
     float3 Ng = normalize(samples[base + 1u].xyz);
     float3 V = normalize(samples[base + 2u].xyz);
-    result[i] = shade(P, Ng, V, material_data[0].xyz, material_data[1].x, material_data[2].xyz, material_data[3].x, lights_data[0].xyz, lights_data[1].xyz);
+    result[i] = shade(P, Ng, V, material_data[0].xyz, material_data[0].w, material_data[1].xyz, material_data[1].w, lights_data[0].xyz, lights_data[1].xyz);
 }

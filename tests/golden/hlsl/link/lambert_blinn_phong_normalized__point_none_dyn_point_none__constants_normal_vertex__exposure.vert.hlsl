@@ -11,9 +11,9 @@
 // template hlsl/macros.hlsl.j2 sha256:<elided>
 // template hlsl/vertex.hlsl.j2 sha256:<elided>
 
-cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
+[[vk::binding(0, 0)]] cbuffer Frame : register(b0, space0) { float4x4 view_proj; float4 camera_pos; };
 
-cbuffer Object : register(b0, space2) { float4x4 model; float4x4 normal_matrix; };
+[[vk::binding(0, 2)]] cbuffer Object : register(b0, space2) { float4x4 model; float4x4 normal_matrix; };
 
 struct VSIn {
     [[vk::location(0)]] float3 a_position : POSITION;

@@ -7,9 +7,9 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 3 per
 // sample: L, V, N (xyz; w unused). info.x = sample count.
-StructuredBuffer<float4> samples : register(t0, space0);
-RWStructuredBuffer<float4> result : register(u1, space0);
-cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[4]; };
+[[vk::binding(0, 0)]] StructuredBuffer<float4> samples : register(t0, space0);
+[[vk::binding(1, 0)]] RWStructuredBuffer<float4> result : register(u1, space0);
+[[vk::binding(2, 0)]] cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[4]; };
 
 #line N "tests/bricks/link/specular/lobes.py"
 float3 lobes_798a48_specular(float NdotL, float NdotV, float LdotV, float4 lobes[4], int lobes_count) {

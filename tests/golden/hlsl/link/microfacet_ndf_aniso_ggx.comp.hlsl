@@ -10,9 +10,9 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are float4s, 4 per
 // sample: L, V, N, T (xyz; w unused). info.x = sample count.
-StructuredBuffer<float4> samples : register(t0, space0);
-RWStructuredBuffer<float4> result : register(u1, space0);
-cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[4]; };
+[[vk::binding(0, 0)]] StructuredBuffer<float4> samples : register(t0, space0);
+[[vk::binding(1, 0)]] RWStructuredBuffer<float4> result : register(u1, space0);
+[[vk::binding(2, 0)]] cbuffer Params : register(b2, space0) { uint4 info; float4 params_data[2]; };
 
 #line N "tests/bricks/link/ndf/aniso_ggx.py"
 float aniso_ggx_ndf(float NdotH, float HdotT, float HdotB, float alpha_u, float alpha_v) {
@@ -80,5 +80,5 @@ void main(uint3 gid : SV_DispatchThreadID) {
     float3 N = samples[base + 2u].xyz;
     float3 T = samples[base + 3u].xyz;
     float3 B = cross(N, T);
-    result[i] = float4(brdf(L, V, N, T, B, params_data[0].x, params_data[1].xyz, params_data[2].x, params_data[3].x), 0.0);
+    result[i] = float4(brdf(L, V, N, T, B, params_data[0].w, params_data[0].xyz, params_data[1].x, params_data[1].y), 0.0);
 }

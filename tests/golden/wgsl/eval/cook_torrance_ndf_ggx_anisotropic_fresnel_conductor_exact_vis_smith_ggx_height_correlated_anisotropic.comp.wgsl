@@ -10,7 +10,7 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 4 per
 // sample: L, V, N, T (xyz; w unused). params.info.x = sample count.
-struct Params { info: vec4<u32>, data: array<vec4<f32>, 8> }
+struct Params { info: vec4<u32>, data: array<vec4<f32>, 4> }
 @group(0) @binding(0) var<storage, read> samples: array<vec4<f32>>;
 @group(0) @binding(1) var<storage, read_write> result: array<vec4<f32>>;
 @group(0) @binding(2) var<uniform> params: Params;
@@ -102,5 +102,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let N = samples[base + 2u].xyz;
     let T = samples[base + 3u].xyz;
     let B = cross(N, T);
-    result[i] = vec4<f32>(brdf(L, V, N, T, B, params.data[0].x, params.data[1].xyz, params.data[2].x, params.data[3].xyz, params.data[4].x, params.data[5].x, params.data[6].xyz, params.data[7].xyz), 0.0);
+    result[i] = vec4<f32>(brdf(L, V, N, T, B, params.data[0].w, params.data[0].xyz, params.data[1].w, params.data[1].xyz, params.data[2].w, params.data[3].w, params.data[2].xyz, params.data[3].xyz), 0.0);
 }

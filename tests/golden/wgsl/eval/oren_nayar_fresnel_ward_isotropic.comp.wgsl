@@ -8,7 +8,7 @@
 
 // Eval kernel: f_r (bare BRDF, 1/sr) for each sample. Samples are vec4s, 3 per
 // sample: L, V, N (xyz; w unused). params.info.x = sample count.
-struct Params { info: vec4<u32>, data: array<vec4<f32>, 4> }
+struct Params { info: vec4<u32>, data: array<vec4<f32>, 2> }
 @group(0) @binding(0) var<storage, read> samples: array<vec4<f32>>;
 @group(0) @binding(1) var<storage, read_write> result: array<vec4<f32>>;
 @group(0) @binding(2) var<uniform> params: Params;
@@ -65,5 +65,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let L = samples[base].xyz;
     let V = samples[base + 1u].xyz;
     let N = samples[base + 2u].xyz;
-    result[i] = vec4<f32>(brdf(L, V, N, params.data[0].xyz, params.data[1].x, params.data[2].xyz, params.data[3].x), 0.0);
+    result[i] = vec4<f32>(brdf(L, V, N, params.data[0].xyz, params.data[0].w, params.data[1].xyz, params.data[1].w), 0.0);
 }

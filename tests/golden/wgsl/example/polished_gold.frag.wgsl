@@ -18,9 +18,9 @@
 struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;
 
-struct Lights { data: array<vec4<f32>, 9> }
+struct Lights { data: array<vec4<f32>, 8> }
 @group(0) @binding(1) var<uniform> lights: Lights;
-struct Material { data: array<vec4<f32>, 2> }
+struct Material { data: array<vec4<f32>, 1> }
 @group(1) @binding(0) var<uniform> material: Material;
 @group(0) @binding(2) var l0_shadow_map: texture_2d<f32>;
 @group(0) @binding(3) var _smp_l0_shadow_map: sampler;
@@ -126,5 +126,5 @@ fn main(@location(0) v_position: vec3<f32>, @location(1) v_normal: vec3<f32>) ->
     let P = v_position;
     let Ng = normalize(v_normal);
     let V = normalize(frame.camera_pos.xyz - P);
-    return shade(P, Ng, V, material.data[0].x, material.data[1].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4x4<f32>(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, lights.data[7].xyz, lights.data[8].xyz, l0_shadow_map, _smp_l0_shadow_map);
+    return shade(P, Ng, V, material.data[0].w, material.data[0].xyz, lights.data[0].xyz, lights.data[1].xyz, mat4x4<f32>(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[0].w, lights.data[6].xyz, lights.data[7].xyz, l0_shadow_map, _smp_l0_shadow_map);
 }

@@ -16,7 +16,7 @@ struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 
 struct Lights { data: array<vec4<f32>, 4> }
 @group(0) @binding(1) var<uniform> lights: Lights;
-struct Material { data: array<vec4<f32>, 3> }
+struct Material { data: array<vec4<f32>, 2> }
 @group(1) @binding(0) var<uniform> material: Material;
 
 fn lambert_diffuse(rho_d: vec3<f32>) -> vec3<f32> {
@@ -81,5 +81,5 @@ fn main(@location(0) v_position: vec3<f32>, @location(1) v_normal: vec3<f32>) ->
     let P = v_position;
     let Ng = normalize(v_normal);
     let V = normalize(frame.camera_pos.xyz - P);
-    return shade(P, Ng, V, material.data[0].xyz, material.data[1].x, material.data[2].xyz, lights.data[0].xyz, lights.data[1].xyz, lights.data[2].xyz, lights.data[3].xyz);
+    return shade(P, Ng, V, material.data[0].xyz, material.data[0].w, material.data[1].xyz, lights.data[0].xyz, lights.data[1].xyz, lights.data[2].xyz, lights.data[3].xyz);
 }

@@ -40,7 +40,7 @@ struct Draw { material: vec4<i32> }
 
 struct MaterialEntry {
     ids: vec4<i32>,
-    data: array<vec4<f32>, 3>,
+    data: array<vec4<f32>, 2>,
 }
 
 struct LightEntry {
@@ -306,19 +306,19 @@ fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, T: vec3<f32>, B: vec3<f32>, 
             var f: vec3<f32> = vec3<f32>(0.0f);
             switch me.ids.x {
                 case 0i: {
-                    f = brdf_lit_0(L, V, N, me.data[0i].xyz, me.data[1i].x, me.data[2i].xyz);
+                    f = brdf_lit_0(L, V, N, me.data[0i].xyz, me.data[0i].w, me.data[1i].xyz);
                 }
                 case 1i: {
-                    f = brdf_lit_1(L, V, N, me.data[0i].x, me.data[1i].xyz);
+                    f = brdf_lit_1(L, V, N, me.data[0i].w, me.data[0i].xyz);
                 }
                 case 2i: {
-                    f = brdf_lit_2(L, V, N, me.data[0i].xyz, me.data[1i].x, me.data[2i].xyz);
+                    f = brdf_lit_2(L, V, N, me.data[0i].xyz, me.data[0i].w, me.data[1i].xyz);
                 }
                 case 3i: {
-                    f = brdf_lit_3(L, V, N, p_rho_d, me.data[1i].x, me.data[2i].xyz);
+                    f = brdf_lit_3(L, V, N, p_rho_d, me.data[0i].w, me.data[1i].xyz);
                 }
                 case 4i: {
-                    f = brdf_lit_4(L, V, N, p_rho_d, me.data[1i].x, me.data[2i].xyz);
+                    f = brdf_lit_4(L, V, N, p_rho_d, me.data[0i].w, me.data[1i].xyz);
                 }
                 default: {
                 }

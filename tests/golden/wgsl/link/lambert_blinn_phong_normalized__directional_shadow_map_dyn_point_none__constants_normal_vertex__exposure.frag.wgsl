@@ -16,16 +16,15 @@
 struct Frame { view_proj: mat4x4<f32>, camera_pos: vec4<f32> }
 @group(0) @binding(0) var<uniform> frame: Frame;
 
-struct Lights { data: array<vec4<f32>, 7> }
+struct Lights { data: array<vec4<f32>, 6> }
 @group(0) @binding(1) var<uniform> lights: Lights;
-struct Material { data: array<vec4<f32>, 4> }
+struct Material { data: array<vec4<f32>, 2> }
 @group(1) @binding(0) var<uniform> material: Material;
 @group(0) @binding(2) var l0_shadow_map: texture_2d<f32>;
 @group(0) @binding(3) var _smp_l0_shadow_map: sampler;
 
 struct LightData1 {
-    position: vec4<f32>,
-    color: vec4<f32>,
+    data: array<vec4<f32>, 2>,
 }
 
 @group(0) @binding(4) var<storage, read> light_buffer1: array<LightData1>;
@@ -93,10 +92,10 @@ fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, m_rho_d: vec3<f32>, m_n: f32
         Lo += (((3.141592653589793f * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     for (var k1: u32 = 0u; k1 < arrayLength(&light_buffer1); k1++) {
-        var L1: vec3<f32> = point_light_dir(P, light_buffer1[k1].position.xyz);
+        var L1: vec3<f32> = point_light_dir(P, light_buffer1[k1].data[0i].xyz);
         var NdotL1: f32 = dot(N, L1);
         if (NdotL1 > 0.0f) {
-            var c1: vec3<f32> = point_light_radiance(P, light_buffer1[k1].position.xyz, light_buffer1[k1].color.xyz);
+            var c1: vec3<f32> = point_light_radiance(P, light_buffer1[k1].data[0i].xyz, light_buffer1[k1].data[1i].xyz);
             var s1: f32 = none_shadow(P);
             Lo += (((3.141592653589793f * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
         }
@@ -110,5 +109,5 @@ fn main(@location(0) v_position: vec3<f32>, @location(1) v_normal: vec3<f32>) ->
     let P = v_position;
     let Ng = normalize(v_normal);
     let V = normalize(frame.camera_pos.xyz - P);
-    return shade(P, Ng, V, material.data[0].xyz, material.data[1].x, material.data[2].xyz, material.data[3].x, lights.data[0].xyz, lights.data[1].xyz, mat4x4<f32>(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[6].x, l0_shadow_map, _smp_l0_shadow_map);
+    return shade(P, Ng, V, material.data[0].xyz, material.data[0].w, material.data[1].xyz, material.data[1].w, lights.data[0].xyz, lights.data[1].xyz, mat4x4<f32>(lights.data[2], lights.data[3], lights.data[4], lights.data[5]), lights.data[0].w, l0_shadow_map, _smp_l0_shadow_map);
 }

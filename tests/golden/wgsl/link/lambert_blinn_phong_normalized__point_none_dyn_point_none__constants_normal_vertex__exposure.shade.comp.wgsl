@@ -16,7 +16,7 @@
 // (T.w: the bitangent's sign). info.x = sample count. Result: shade()'s vec4.
 struct Info { info: vec4<u32> }
 struct Lights { data: array<vec4<f32>, 2> }
-struct Material { data: array<vec4<f32>, 4> }
+struct Material { data: array<vec4<f32>, 2> }
 @group(0) @binding(0) var<storage, read> samples: array<vec4<f32>>;
 @group(0) @binding(1) var<storage, read_write> result: array<vec4<f32>>;
 @group(0) @binding(2) var<uniform> params: Info;
@@ -24,8 +24,7 @@ struct Material { data: array<vec4<f32>, 4> }
 @group(0) @binding(4) var<uniform> material: Material;
 
 struct LightData1 {
-    position: vec4<f32>,
-    color: vec4<f32>,
+    data: array<vec4<f32>, 2>,
 }
 
 @group(0) @binding(5) var<storage, read> light_buffer1: array<LightData1>;
@@ -77,10 +76,10 @@ fn shade(P: vec3<f32>, Ng: vec3<f32>, V: vec3<f32>, m_rho_d: vec3<f32>, m_n: f32
         Lo += (((3.141592653589793f * brdf_lit(L0, V, N, m_rho_d, m_n, m_f0)) * c0) * (NdotL0 * s0));
     }
     for (var k1: u32 = 0u; k1 < arrayLength(&light_buffer1); k1++) {
-        var L1: vec3<f32> = point_light_dir(P, light_buffer1[k1].position.xyz);
+        var L1: vec3<f32> = point_light_dir(P, light_buffer1[k1].data[0i].xyz);
         var NdotL1: f32 = dot(N, L1);
         if (NdotL1 > 0.0f) {
-            var c1: vec3<f32> = point_light_radiance(P, light_buffer1[k1].position.xyz, light_buffer1[k1].color.xyz);
+            var c1: vec3<f32> = point_light_radiance(P, light_buffer1[k1].data[0i].xyz, light_buffer1[k1].data[1i].xyz);
             var s1: f32 = none_shadow(P);
             Lo += (((3.141592653589793f * brdf_lit(L1, V, N, m_rho_d, m_n, m_f0)) * c1) * (NdotL1 * s1));
         }
@@ -99,5 +98,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let P = samples[base].xyz;
     let Ng = normalize(samples[base + 1u].xyz);
     let V = normalize(samples[base + 2u].xyz);
-    result[i] = shade(P, Ng, V, material.data[0].xyz, material.data[1].x, material.data[2].xyz, material.data[3].x, lights.data[0].xyz, lights.data[1].xyz);
+    result[i] = shade(P, Ng, V, material.data[0].xyz, material.data[0].w, material.data[1].xyz, material.data[1].w, lights.data[0].xyz, lights.data[1].xyz);
 }
