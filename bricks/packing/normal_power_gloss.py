@@ -23,7 +23,7 @@ BRICK = {
     "kind": "packing",
     "cite": "Hoffman & Baker 2006, Texture Management (normal xy + power + gloss in one texture); Lazarov 2011 (n = 8192^p)",
     "params": {"n_max": {"type": "float", "range": [1.0, 10000.0], "default": 8192.0, "doc": "the exponent at B = 1 (n = n_max^B)"}},
-    "textures": {"normal_map": {"srgb": False, "doc": "linear RGBA; RG: normal xy as (t + 1) / 2; B: specular power p (n = n_max^p); A: gloss (f0 scale)"}},
+    "textures": {"normal_map": {"srgb": False, "holds": "normal_xy", "doc": "linear RGBA; RG: normal xy as (t + 1) / 2; B: specular power p (n = n_max^p); A: gloss (f0 scale)"}},
     "slots": {"normal": {"kind": "normal", "default": "normal_map_xy"}},
 }
 

@@ -34,7 +34,8 @@ BRICK = {
         "lod": {"type": "float", "range": [0.0, 16.0], "default": 0.0, "doc": "the MIP level the reduction assumes (explicit: no LOD query in the brick language); 16 levels: a 65536² map"},
         "toksvig_weight": {"type": "float", "range": [0.0, 1.0], "default": 1.0, "doc": "scale of Toksvig's variance (1: Toksvig 2005; 0: off, the course's reduction alone)"},
     },
-    "textures": {"normal_map": {"srgb": False, "doc": "linear RGB: tangent-space normal as (t + 1) / 2, MIP-mapped with a box filter, not renormalized"}},
+    "textures": {"normal_map": {"srgb": False, "holds": "normal", "keep_length": True,
+                                "doc": "linear RGB: tangent-space normal as (t + 1) / 2, MIP-mapped with a box filter, not renormalized"}},
     "slots": {"normal": {"kind": "normal", "default": "normal_map"}},
 }
 

@@ -109,10 +109,11 @@ def build(scene: Scene, out: Path, ctx: BuildContext, depfile=None, keep_removed
 
 
 def _deps(scene: Scene, lib: Library, out: Path) -> list[str]:
-    """Every file the build read: the scene, every brick the library loaded, every template composed with
-    (recorded by this build, and by the last ones for what it kept)."""
+    """Every file the build read: the scene, the images its materials name, every brick the library loaded,
+    every template composed with (recorded by this build, and by the last ones for what it kept)."""
+    from .texture_outputs import image_files
     templates = state.read(out).get("templates", [])
-    return [shown(scene.path), *(shown(b.path) for b in lib.bricks.values()),
+    return [shown(scene.path), *(shown(f) for f in image_files(scene)), *(shown(b.path) for b in lib.bricks.values()),
             *(shown(template_file(t)) for t in sorted(templates))]
 
 
@@ -220,6 +221,8 @@ class _Build:
         tables = write_tables(out, self.ctx.library, res.manifest, self.writer.count, previous, self.base)
         if tables:
             res.manifest["tables"] = tables
+        from .texture_outputs import collect_textures, write_textures  # the materials' images, as KTX2 with mips
+        write_textures(out, self.scene, res.manifest, self.writer.count, previous, self.base)
         if self.pack:  # written before the manifest that names them (content-named: the old ones stay until after it)
             from .pack import write_packs
             res.manifest["packs"] = write_packs(out, res.manifest, self.writer.count)
@@ -234,6 +237,7 @@ class _Build:
         from .tables import collect_tables
         collect_packs(out, res.manifest)
         collect_tables(out, res.manifest)
+        collect_textures(out, res.manifest)
         state.record(out, res.manifest, text, self.keys, res.kept + self.uber_kept,  # units kept, not composed
                      res.templates)  # last: the no-op check trusts it
 

@@ -13,6 +13,7 @@ from pathlib import Path
 from ..io import atomic_write, sha256
 from .keys import Keys
 from .platforms import platform_files
+from .texture_outputs import texture_files
 
 STATE = ".shadermatrix-state.json"
 
@@ -31,7 +32,8 @@ def record(out: Path, manifest: dict, text: bytes, keys: Keys, kept: int, templa
              "scene": keys.scene,
              "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in items(e)}
              | {p["path"]: p["size"] for p in manifest.get("packs", [])}
-             | {t["path"]: t["bytes"] for t in manifest.get("tables", [])},
+             | {t["path"]: t["bytes"] for t in manifest.get("tables", [])}
+             | texture_files(manifest),
              "templates": sorted(templates)}
     atomic_write(out / STATE, (json.dumps(state, sort_keys=True) + "\n").encode())
 

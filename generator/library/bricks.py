@@ -246,6 +246,11 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         if "table" in t and t.get("srgb"):
             raise _meta_error(shown, loc, f"table texture '{tname}' is marked sRGB",
                               "baked tables hold linear values: remove \"srgb\": True")
+        if (t.get("srgb") and t.get("holds", "color") != "color") or \
+                (t.get("keep_length") and t.get("holds") not in ("normal", "normal_xy")):
+            raise _meta_error(shown, loc, f"texture '{tname}' is marked {'sRGB' if t.get('srgb') else 'keep_length'} "
+                              f"but holds {t.get('holds', 'data')!r}",
+                              "only colour is sRGB-encoded, and only a normal map keeps its filtered length")
     _refuse_input_names(shown, loc, positions, params, textures)
     externals = {}
     for sname, s in slots.items():

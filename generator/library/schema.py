@@ -43,6 +43,10 @@ BRICK_SCHEMA = {
         "textures": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
             "type": "object", "additionalProperties": False,
             "properties": {"srgb": {"type": "boolean"}, "doc": {"type": "string"},
+                           # what a scene's image holds, which decides how its mip chain is filtered
+                           # (assemble/textures.py); keep_length: normals averaged, not renormalized
+                           "holds": {"enum": ["color", "data", "normal", "normal_xy"]},
+                           "keep_length": {"type": "boolean"},
                            # a lookup table the generator bakes (generator/reference/tables.py), its size
                            # [W, H] (a cube: [S, S]) and stored format, chosen by measured error
                            "table": IDENT,

@@ -33,7 +33,8 @@ Its packing follows the textures present (each changes the shader, so each chang
     GltfMaterial and on every object too.
   - texCoord ≠ 0 in a textureInfo is an error (the bricks read one UV set, TEXCOORD_0).
   - every material is mapped and checked, used or not (as a TOML scene's materials); only the ones
-    objects use make permutations. Texture images are not read (their presence is what the key needs).
+    objects use make permutations. Each texture a material binds gets its image and sampler read from the
+    file (scene/gltf_images.py): a missing, unreadable or corrupt image is an error at /images/N.
 Tangents. A primitive whose material has a normal map and whose mesh has no TANGENT gets per-vertex
 tangents generated on import from the UV gradients (Lengyel 2001: per-triangle ∂P/∂u, ∂P/∂v summed
 per vertex, Gram-Schmidt against N, w = handedness) — NOT MikkTSpace-exact (MikkTSpace splits vertices
@@ -106,7 +107,7 @@ ACCEPTED_EXTENSIONS = {  # do not change the shader (or are mapped here): accept
     "KHR_lights_punctual": "mapped to the scene's lights",
     "KHR_mesh_quantization": "quantized attributes are decoded on import",
     "KHR_materials_emissive_strength": "emissiveStrength scales the emissive parameter",
-    "KHR_texture_basisu": "an image encoding: the sampled values, not the shader, change",
+    "KHR_texture_basisu": "an image encoding: a texture's core source image is read (Basis KTX2 is not)",
     "KHR_xmp_json_ld": "metadata",
     "KHR_animation_pointer": "animation, not shading",
 }
@@ -591,6 +592,8 @@ def load_gltf(path, lib: Library) -> Scene:
     gen = sorted({o["name"] for o in scene.objects if o["tangents"] == "generated"})
     if gen:
         notes.append(f"tangents generated from UV gradients (Lengyel; not MikkTSpace-exact) for: {', '.join(gen)}")
+    from .gltf_images import bind_images  # every material's texture images and samplers, read and checked
+    bind_images(rd, lib, scene, text, binary is not None or path.suffix.lower() == ".glb", notes)
     scene.notes = list(dict.fromkeys(notes))
     return scene
 
@@ -666,6 +669,7 @@ def _check_extensions(rd: _Reader, notes: list) -> list[str]:
         walk(rd.raw, "")
     except RecursionError:
         raise rd.err("", "the JSON nests too deeply to read", "check the file") from None
+    found = set(used)  # where an extension's object appears (KHR_mesh_quantization has none: its accessors use it)
     required = rd.get(rd.raw, "extensionsRequired", "", "arr", [])
     declared = rd.get(rd.raw, "extensionsUsed", "", "arr", [])
     for key, lst in (("extensionsRequired", required), ("extensionsUsed", declared)):
@@ -689,6 +693,10 @@ def _check_extensions(rd: _Reader, notes: list) -> list[str]:
     accepted = sorted(n for n in set(used) | {d for d in declared} if n in ACCEPTED_EXTENSIONS)
     for n in accepted:
         notes.append(f"extension {n} accepted: {ACCEPTED_EXTENSIONS[n]}")
+    for i, n in enumerate(declared):
+        if n not in found and n != "KHR_mesh_quantization":
+            notes.append(f"extension {n} is declared in extensionsUsed (/extensionsUsed/{i}) but used nowhere "
+                         "in the file")
     for n in sorted((set(used) | set(declared)) - set(ACCEPTED_EXTENSIONS) - set(required)):
         if not n.startswith("KHR_"):
             notes.append(f"extension {n} ignored (not required by the file)")

@@ -4,7 +4,9 @@ Schema (docs/guide/scenes.md, every key):
     [scene]            name, output (default "linear"), precision (default "fp32")
     [materials.NAME]   brdf = spec, packing = spec (default "constants"), params = {...},
                        alpha = "opaque"|"mask"|"blend", double_sided, vertex_color = true|false,
-                       emissive = "none"|"factor"|"texture" (the surface state: spec/surface.py)
+                       emissive = "none"|"factor"|"texture" (the surface state: spec/surface.py),
+                       textures = { TEXTURE = "path.png" }, samplers = { TEXTURE = { filter, … } }
+                       (the images and samplers of the packing's textures: scene/textures.py)
     [lights.NAME]      type = light brick, shadow = spec (default "none"), params = {...}
     [light_sets]       NAME = [light names, in order]
     [[objects]]        name, material = NAME, lights = light set NAME
@@ -25,6 +27,7 @@ from ..spec.permutation import PRECISIONS, LightKey, Permutation, SpecError, can
 from ..spec.resolve import Resolved, check_packing, light_params, resolve
 from ..spec.surface import DEFAULT as DEFAULT_SURFACE, Surface
 from ..spec.where import Origin, Where
+from .textures import declared, toml_bindings
 
 
 class Locator:
@@ -105,6 +108,9 @@ class Material:
     packing: str
     params: dict
     surface: Surface = DEFAULT_SURFACE  # what of alpha, sidedness, vertex colours and emission the shader does
+    # texture name -> TextureBinding (scene/textures.py): every texture the material binds, with its image
+    # (named, or generated) and sampler
+    images: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -184,6 +190,7 @@ def load_scene(path, lib: Library) -> Scene:
 
     # where each part of a permutation key was asked for (spec/where.py): errors resolving or linking it point there
     parts: dict[str, tuple] = {}
+    image_cache: dict = {}  # resolved path -> DecodedImage: a file several materials name is read once
     for name, m in _table(loc, data, "materials").items():
         where = loc.find(f"materials.{name}")
         if not isinstance(m, dict) or "brdf" not in m:
@@ -210,7 +217,9 @@ def load_scene(path, lib: Library) -> Scene:
         problem, todo = check_packing(r)
         if problem:
             raise loc.error(loc.find(f"materials.{name}", "packing"), f"material '{name}': {problem}", todo)
-        scene.materials[name] = Material(name, brdf, packing, params, surface)
+        images = toml_bindings(loc, f"materials.{name}", m, declared(r.packing, surface), path.parent, image_cache,
+                               scene.notes)
+        scene.materials[name] = Material(name, brdf, packing, params, surface, images)
 
     for name, li in _table(loc, data, "lights").items():
         where = loc.find(f"lights.{name}")

@@ -15,6 +15,7 @@ import itertools
 import re
 
 from ..spec.surface import ALPHA_MODES, EMISSIVE
+from .textures import FILTERS, MIPMAPS, WRAPS
 
 NAME = {"type": "string", "minLength": 1, "maxLength": 256,
         "pattern": r"^[^\x00-\x1f\x7f\u0085\u2028\u2029]*(?!\n)$"}  # (?!\n): Python's $ also matches before a final \n
@@ -24,6 +25,15 @@ VECTOR = {"type": "array", "items": NUMBER, "minItems": 1, "maxItems": 64}
 # a number, a vector, or an array parameter's elements ("count": N in the brick: [[…], […]]); check_value does the rest
 PARAMS = {"type": "object", "propertyNames": NAME, "additionalProperties": {"anyOf": [
     NUMBER, VECTOR, {"type": "array", "items": {"anyOf": [NUMBER, VECTOR]}, "minItems": 1, "maxItems": 64}]}}
+# per material: texture name -> image path; texture name -> sampler (scene/textures.py checks names and ranges)
+TEXTURES = {"type": "object", "propertyNames": NAME, "additionalProperties": {"type": "string", "minLength": 1,
+                                                                              "maxLength": 4096}}
+SAMPLERS = {"type": "object", "propertyNames": NAME, "additionalProperties": {
+    "type": "object", "additionalProperties": False,
+    "properties": {**{k: {"type": "string", "enum": list(FILTERS)} for k in ("filter", "mag_filter", "min_filter")},
+                   "mipmap": {"type": "string", "enum": list(MIPMAPS)},
+                   **{k: {"type": "string", "enum": list(WRAPS)} for k in ("wrap", "wrap_u", "wrap_v")},
+                   "anisotropy": NUMBER, "lod_bias": NUMBER}}}
 SCENE_SCHEMA = {
     "$schema": "https://json-schema.org/draft/2020-12/schema",
     "title": "shadermatrix scene",
@@ -38,7 +48,8 @@ SCENE_SCHEMA = {
                            # the surface state (spec/surface.py); absent = the default, the key unchanged
                            "alpha": {"type": "string", "enum": list(ALPHA_MODES)},
                            "double_sided": {"type": "boolean"}, "vertex_color": {"type": "boolean"},
-                           "emissive": {"type": "string", "enum": list(EMISSIVE)}}}},
+                           "emissive": {"type": "string", "enum": list(EMISSIVE)},
+                           "textures": TEXTURES, "samplers": SAMPLERS}}},
         "lights": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type"],
             "properties": {"type": NAME, "shadow": SPEC, "params": PARAMS}}},

@@ -58,8 +58,9 @@ class Doc:
         self.d["accessors"].append(acc)
         return len(self.d["accessors"]) - 1
 
-    def texture(self, uri):
-        self.d["images"].append({"uri": uri})  # never read: the key depends on a texture's presence only
+    def texture(self, name):
+        """A texture of a 2 × 2 PNG embedded as a data URI (every image a material binds is read)."""
+        self.d["images"].append({"name": name, "uri": png_data_uri()})
         self.d["textures"].append({"source": len(self.d["images"]) - 1, "sampler": 0})
         return len(self.d["textures"]) - 1
 
@@ -104,6 +105,21 @@ class Doc:
         d, b = self.finish()
         path.write_bytes(glb(json.dumps(d).encode(), b))
         return path
+
+
+def png_bytes(texels=((200, 100, 50, 255), (20, 40, 60, 255), (0, 0, 0, 255), (255, 255, 255, 255)),
+              size=(2, 2)) -> bytes:
+    import io
+
+    from PIL import Image
+    buf = io.BytesIO()
+    Image.frombytes("RGBA", size, bytes(c for px in texels for c in px)).save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def png_data_uri(data: bytes | None = None) -> str:
+    import base64
+    return "data:image/png;base64," + base64.b64encode(png_bytes() if data is None else data).decode()
 
 
 def glb(js: bytes, b: bytes) -> bytes:

@@ -5,7 +5,7 @@ Blinn 1978 (bump mapping); Peercy, Airey & Cabral 1997 (tangent-space normal map
 BRICK = {
     "kind": "normal",
     "cite": "Blinn 1978; Peercy et al. 1997 tangent-space normal maps",
-    "textures": {"normal_map": {"srgb": False, "doc": "tangent-space normal, RGB = (t + 1) / 2"}},
+    "textures": {"normal_map": {"srgb": False, "holds": "normal", "doc": "tangent-space normal, RGB = (t + 1) / 2"}},
 }
 
 

@@ -17,7 +17,7 @@ unit for an interpolated, not orthonormal, frame, as `normal_map` does.
 BRICK = {
     "kind": "normal",
     "cite": "Hoffman & Baker 2006 (normals as x and y only); ATI 2005 3Dc; Peercy et al. 1997 tangent-space normal maps",
-    "textures": {"normal_map": {"srgb": False, "doc": "linear; RG: tangent-space normal xy as (t + 1) / 2; z reconstructed; BA not read"}},
+    "textures": {"normal_map": {"srgb": False, "holds": "normal_xy", "doc": "linear; RG: tangent-space normal xy as (t + 1) / 2; z reconstructed; BA not read"}},
 }
 
 

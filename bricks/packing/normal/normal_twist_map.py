@@ -47,7 +47,7 @@ BRICK = {
     "kind": "normal",
     "cite": "Hoffman & Baker 2006, Anisotropic BRDF with Normal and Twist Maps (Gram-Schmidt T against the "
             "perturbed N); ATI 2005 3Dc (xy normals); Peercy et al. 1997 tangent-space normal maps",
-    "textures": {"normal_map": {"srgb": False, "doc": "linear RGBA; RG: normal xy as (t + 1) / 2, z reconstructed; "
+    "textures": {"normal_map": {"srgb": False, "holds": "normal_xy", "doc": "linear RGBA; RG: normal xy as (t + 1) / 2, z reconstructed; "
                                                       "BA: twist direction in the tangent plane as (w + 1) / 2"}},
 }
 
