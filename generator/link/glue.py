@@ -326,19 +326,33 @@ def surface_output(b: Builder, bind: _Binder, r: Resolved, shaded: ir.Expr) -> l
     sf = r.surface
     if sf.alpha == "opaque":
         return [b.ret(shaded)]
+    cov = coverage(b, bind, r)
+    stmts = [b.decl("shaded", shaded), b.decl("coverage", cov)]
+    a = coverage_alpha(b, sf)
+    rgb = ir.Swizzle(VEC3, b.here(), b.var("shaded", VEC4), "xyz")
+    return stmts + [b.ret(b.construct(VEC4, rgb, a))]
+
+
+def coverage(b: Builder, bind: _Binder, r: Resolved) -> ir.Expr:
+    """m_base_alpha [· the packing's base colour texture's A at uv] [· COLOR_0's A]: glTF's coverage, the one
+    expression shade() and the mask depth stage (link/depth.py) both read."""
     cov = b.var("m_base_alpha", FLOAT, "param")
     tex = coverage_texture(r.packing)
     if tex:
         cov = b.arith("*", cov, ir.Swizzle(FLOAT, b.here(), _sample(b, bind, f"t_{tex}", tex, True), "w"))
-    if sf.vertex_color:
+    if r.surface.vertex_color:
         cov = b.arith("*", cov, ir.Swizzle(FLOAT, b.here(), b.var(VERTEX_COLOR, VEC4, "param"), "w"))
-    stmts = [b.decl("shaded", shaded), b.decl("coverage", cov)]
+    return cov
+
+
+def coverage_alpha(b: Builder, sf) -> ir.Expr:
+    """The alpha of a declared `coverage`: itself (BLEND), or 1 where it reaches m_alpha_cutoff and 0 elsewhere
+    (MASK)."""
     a = b.var("coverage", FLOAT)
     if sf.alpha == "mask":  # glTF 3.9.4: fully opaque where coverage ≥ alphaCutoff, else not drawn
         a = ir.Select(FLOAT, b.here(), b.compare(">=", a, b.var("m_alpha_cutoff", FLOAT, "param")),
                       b.const(1.0), b.const(0.0))
-    rgb = ir.Swizzle(VEC3, b.here(), b.var("shaded", VEC4), "xyz")
-    return stmts + [b.ret(b.construct(VEC4, rgb, a))]
+    return a
 
 
 def has_tangent(normal: Node) -> bool:
