@@ -14,18 +14,19 @@ translate, scale, rotate_y; an optional camera); without one, each object is a u
 the objects stand in a row along x, 2.5 apart, in scene order, and the camera looks at the row's
 centre from above and in front (:func:`camera`, :func:`placement`).
 
-Shadows: for every light whose shadow filter samples a texture (shadow_map), a depth pass
-before the first frame renders every object's depth from the light into a
-:class:`~.graphics.DepthTarget` (``shadow_size`` square, vertex stage only: the compiled vertex
-shader with the most vertex inputs, its Frame.view_proj = the light's shadow matrix). A
-directional light's matrix is an orthographic projection along its direction fitted to the
-placed objects' bounds (:func:`~.graphics.directional_shadow_matrix`), a point light's a
-perspective one from its position (:func:`~.graphics.point_shadow_matrix`); the matrix is
-written into the light's shadow_matrix parameter of both paths (the specialized Lights
-blocks and the ubershader's LightEntry data), and the depth map is bound as the light's
-shadow map (pcf: a `pcf_texel` the scene leaves unset is written as 1 / shadow_size, in both
-paths too) — or, for a brick texture named `shadow_moments` (vsm), the depth's moments (d, d²),
-box-filtered on the host (:func:`moments_map`) and uploaded as an RGBA32F image. A `texture2d_shadow`
+Shadows: for every light whose shadow filter samples a texture (shadow_map, pcf, pcf_hardware, vsm), a
+depth pass before the first frame draws every object from the light with the generated depth shaders
+(compose/depth.py), as the light's depth pass description says (runtime/shadow_pass.py, depth_pass: the
+manifest's ``lights.<name>.depth_pass``, here for the Vulkan platform and a ``shadow_size`` square map;
+runtime/depth_passes.py draws it): a masked material's objects through its mask unit (its coverage cuts
+holes in the shadow), every other one through the position-only vertex stage; for a brick texture named
+`shadow_moments` (vsm) the moments stage writes (d, d², 0, 1) into an RGBA32F target and the blur unit's two
+fullscreen passes box-filter it on the GPU. The light's matrix is fitted to the placed objects' bounds
+(shadow_pass.fit_shadow_matrix: a directional light's orthographic projection along its direction, a point
+light's perspective one from its position) and written into the light's shadow_matrix parameter of both
+paths (the specialized Lights blocks and the ubershader's LightEntry data); the depth map is bound as the
+light's shadow map (pcf: a `pcf_texel` the scene leaves unset is written as 1 / shadow_size, in both paths
+too), the blurred moments as its `shadow_moments`. A `texture2d_shadow`
 (pcf_hardware) reads the depth pass's D32_SFLOAT image itself through a comparison sampler
 (runtime/depth_images.py: linear, compareOp LESS_OR_EQUAL), where no map is drawn a lit 1×1 depth image
 (depth 1.0); a device that cannot linearly filter D32_SFLOAT is refused for it. Other textures
@@ -33,7 +34,7 @@ are generated: an sRGB albedo checker, a normal map of known bumps. The surface 
 (spec/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
 pipelines blend source-over and are drawn after the opaque ones (not sorted by depth), the back faces of
 what a glTF file calls single-sided are culled (TOML objects keep cull mode none); the ubershader implements
-none of it (it stands in for the BRDF, packing and output only), and the depth pass ignores coverage. Pipelines are created through
+none of it (it stands in for the BRDF, packing and output only). Pipelines are created through
 a persisted pipeline cache (runtime/pipeline_cache.py), and when the render opens its own device,
 Mesa's shader disk cache lives in out/shader_cache and the driver's hit and miss counts go into the
 report (runtime/shader_cache.py).
@@ -48,9 +49,9 @@ from pathlib import Path
 import numpy as np
 
 from .placement import load_placement, make_mesh
+from .shadow_pass import MOMENTS, PCF_TEXEL, SHADOW_SIZE, moments_map, shadow_textures  # noqa: F401 (re-exported)
 
 MODES = ("specialized", "ubershader", "hybrid")
-SHADOW_SIZE = 512
 
 
 @dataclass
@@ -132,56 +133,6 @@ class _TestTextures(dict):
 
 # ------------------------------------------------------------------ shadows
 
-def shadow_textures(resolved) -> dict[str, tuple[str, ...]]:
-    """The textures each shadow filter spec of resolved permutations (spec.resolve values) samples, by spec
-    (() for "none"): what the spec stage found, not the spec parsed again."""
-    return {lk.shadow: lt.textures for r in resolved for lk, lt in zip(r.perm.lights, r.lights)}
-
-
-def shadow_matrix(light, values: dict, points) -> np.ndarray:
-    """World → light clip space (row-major) of a scene light, fitted to `points`; `values` its parameters."""
-    from ..lang.errors import UserError
-    from . import graphics as gx
-
-    if light.type == "directional":
-        if not np.linalg.norm(np.asarray(values["direction"], np.float64)) > 0.0:
-            raise UserError(f"light '{light.name}': direction {list(values['direction'])} has no length, so its "
-                            "shadow map has no view — give the direction to the light, e.g. [0.3, 0.9, 0.3]")
-        return gx.directional_shadow_matrix(values["direction"], points)
-    if light.type == "point":
-        return gx.point_shadow_matrix(values["position"], points)
-    raise UserError(f"light '{light.name}': the renderer has no shadow projection for light type '{light.type}' "
-                    "— use shadow = \"none\" for it")
-
-
-PCF_TEXEL = "pcf_texel"  # a shadow parameter of this name the scene leaves unset is 1 / shadow_size (pcf)
-MOMENTS = "shadow_moments"  # a shadow brick texture of this name gets the depth pass's moments (vsm)
-MOMENTS_BOX = 5  # the moments' prefilter: a box of this many texels a side
-
-
-def moments_map(depth: np.ndarray, box: int = MOMENTS_BOX) -> np.ndarray:
-    """(H, W, 4) float32 (E[d], E[d²], 0, 1) of a depth map, box-filtered over box × box texels (box odd; edges
-    clamped). The variance shadow map's contents (bricks/shadow/vsm.py): moments, unlike depths, may be
-    filtered. Computed in float64 and rounded once."""
-    if box < 1 or box % 2 == 0:
-        raise ValueError(f"moments box {box}: use an odd number of texels")
-    d = np.asarray(depth, np.float64)
-    m = np.stack([d, d * d], -1)
-    r = box // 2
-    if r > 0:
-        for axis in (0, 1):
-            pad = [(0, 0)] * 3
-            pad[axis] = (r, r)
-            c = np.cumsum(np.pad(m, pad, mode="edge"), axis=axis)
-            c = np.concatenate([np.zeros_like(np.take(c, [0], axis=axis)), c], axis=axis)
-            n = m.shape[axis]
-            m = (np.take(c, np.arange(2 * r + 1, 2 * r + 1 + n), axis=axis) - np.take(c, np.arange(n), axis=axis)) / box
-    out = np.zeros(d.shape + (4,), np.float32)
-    out[..., :2] = m
-    out[..., 3] = 1.0
-    return out
-
-
 def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict, texels: dict | None = None) -> bytes:
     """A specialized Lights block with each shadowed light's l<i>_shadow_matrix slot replaced (and its
     l<i>_pcf_texel, for the lights in `texels`)."""
@@ -214,13 +165,17 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..lang.errors import UserError
     from ..toolchain import CompileJob, compile_many
     from . import graphics as gx
-    from .compute import UNIFORM
     from .device import Device, validation_requested
     from ..link.uber import SPEC_VARIANT
     from ..spec.resolve import resolve
     from .pipeline_cache import PipelineCacheFile
     from .depth_images import ComparisonSampler, DepthImage
     from . import shader_cache
+    from ..compose.depth import compose_depth_units
+    from ..link import link_permutation
+    from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
+    from .shadow_pass import (VULKAN_CONVENTIONS, depth_pass, depth_plan, fit_shadow_matrix, pass_units,
+                              shadowed_lights)
 
     if mode not in MODES:
         raise UserError(f"unknown mode {mode!r} — use one of {', '.join(MODES)}")
@@ -233,11 +188,17 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     out.mkdir(parents=True, exist_ok=True)
     W, H = size
     perms = dict(sorted(scene.permutations.items()))
-    composed = {h: compose_permutation(p, lib, (language,)) for h, p in perms.items()}
+    resolved = {h: resolve(p, lib) for h, p in perms.items()}
+    linked = {h: link_permutation(r, lib) for h, r in resolved.items()}
+    composed = {h: compose_permutation(lp, lib, (language,)) for h, lp in linked.items()}
     spec_ids = uber_ids == "specialization"
     uber, u = compose_ubershader(list(perms.values()), lib, (language,), specialized=spec_ids)
+    # The depth passes' units (compose/depth.py): what the build writes for an engine, compiled here with the rest.
+    shadowed_textures = shadowed_lights(scene, resolved.values())
+    plan = depth_plan(shadowed_textures, linked)
+    depth_units = compose_depth_units(plan, lib, (language,))
     jobs = {}
-    for tag, c in [*composed.items(), ("ubershader", uber)]:
+    for tag, c in [*composed.items(), ("ubershader", uber), *depth_units.items()]:
         for s in c.sources:
             jobs[(tag, s.stage)] = CompileJob(f"{tag}.{s.stage}.{language}", language, s.stage, s.text,
                                               line_map=tuple(map(tuple, s.line_map)))
@@ -256,10 +217,10 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     points = placed.points()
     light_vals = {ln: {k: L.params.get(k, sp.default) for k, sp in _light_specs(lib, L).items()}
                   for ln, L in scene.lights.items()}
-    used = {ln for o in scene.objects for ln in o["lights"]}
-    sampled = shadow_textures(resolve(p, lib) for p in perms.values())  # a used light's filter is among them
-    shadowed = [ln for ln, L in scene.lights.items() if ln in used and sampled[L.shadow]]
-    matrices = {ln: gx.column_major(shadow_matrix(scene.lights[ln], light_vals[ln], points)) for ln in shadowed}
+    sampled = shadow_textures(resolved.values())  # a used light's filter is among them
+    shadowed = list(shadowed_textures)
+    matrices = {ln: gx.column_major(fit_shadow_matrix(scene.lights[ln].type, light_vals[ln], points, ln))
+                for ln in shadowed}
     for ln in shadowed:
         light_vals[ln]["shadow_matrix"] = matrices[ln]
     # pcf's tap spacing: one texel of the map this render makes, unless the scene says otherwise
@@ -267,6 +228,10 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
               if PCF_TEXEL in light_vals[ln] and PCF_TEXEL not in scene.lights[ln].params}
     for ln, v in texels.items():
         light_vals[ln][PCF_TEXEL] = v
+    # what the build writes as each light's depth_pass, for the Vulkan platform and this render's map size
+    passes_of = {ln: depth_pass(scene.lights[ln], shadowed_textures[ln], light_vals[ln],
+                                pass_units(plan, MOMENTS in shadowed_textures[ln]), [], shadow_size,
+                                {"vulkan": VULKAN_CONVENTIONS}) for ln in shadowed}
 
     own_device = device is None
     if own_device:  # lavapipe's compiled shaders persist under out/, and the driver counts its hits
@@ -328,33 +293,30 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         # False); a TOML scene's objects keep cull mode none, as they were always drawn (spec/surface.py).
         single_sided = {o["permutation"] for o in scene.objects if o.get("double_sided") is False}
 
-        # Depth passes: one DepthTarget per shadowed light, every object drawn by a vertex-only pipeline.
+        # Depth passes: every object drawn from each shadowed light by the generated depth units, as its
+        # depth_pass description says (runtime/depth_passes.py).
         shadow_maps, moments = {}, {}
         if shadowed:
-            ifaces = [(tag, composed[tag].interface) for tag in composed] + [("ubershader", uber.interface)]
-            vtag, viface = max(ifaces, key=lambda x: len(x[1].vertex_inputs))  # all read the same Frame / Object
-            fb, ob = viface.block("Frame"), viface.block("Object")
-            layouts = {fb.set: {fb.binding: UNIFORM}}
-            layouts.setdefault(ob.set, {})[ob.binding] = UNIFORM
+            passes = DepthPasses(device, spv, {n: c.interface for n, c in depth_units.items()}, owned, cache)
+            casters = []
+            for i, obj in enumerate(scene.objects):
+                h, res = obj["permutation"], {}
+                if h in plan.masked:  # its material's Material block and coverage texture, as its colour pass binds them
+                    up = next(x for x in uploads(scene, h, composed[h]) if x["material"] == obj["material"])
+                    res = mask_resources(mask_interface(depth_units, h), buf(bytes.fromhex(up["Material"]), U),
+                                         textures, sampler)
+                casters.append(Caster(mesh_of[i], object_bufs[i], h, res))
             for ln in shadowed:
-                dt = gx.DepthTarget(device, shadow_size, shadow_size)
-                owned.append(dt)
-                t0 = time.perf_counter()
-                pipe = gx.GraphicsPipeline(device, dt, spv[(vtag, "vert")], None, viface.vertex_inputs, layouts,
-                                           cache=cache)
-                owned.append(pipe)
-                pipe_ms = (time.perf_counter() - t0) * 1e3
-                m = np.asarray(matrices[ln], np.float64).reshape(4, 4).T  # back to row-major
-                frame_l = buf(gx.frame_bytes(m, np.append(points.mean(0), 1.0)), U)
-                gpu = dt.draw([gx.DrawItem(pipe, mesh_of[i], {(fb.set, fb.binding): frame_l,
-                                                               (ob.set, ob.binding): object_bufs[i]})
-                               for i in range(len(placed.objects))])
-                shadow_maps[ln] = dt
-                if MOMENTS in sampled[scene.lights[ln].shadow]:  # vsm: (d, d²), prefiltered
-                    moments[ln] = device.image(moments_map(dt.read()))
-                    owned.append(moments[ln])
-                report.shadow_maps[ln] = {"size": [shadow_size, shadow_size], "gpu_ms": gpu, "sampled": dt.sampled,
-                                          "pipeline_ms": pipe_ms, "vertex_shader": vtag,
+                desc = passes_of[ln]
+                m = np.asarray(desc["matrix"]["premultiply"]["vulkan"]) @ np.asarray(matrices[ln]).reshape(4, 4).T
+                drawn = passes.draw(desc, m, np.append(points.mean(0), 1.0), casters)
+                if drawn.depth is not None:
+                    shadow_maps[ln] = drawn.depth
+                if drawn.moments is not None:
+                    moments[ln] = drawn.moments
+                report.shadow_maps[ln] = {"size": desc["size"], "gpu_ms": drawn.gpu_ms,
+                                          "sampled": drawn.depth.sampled if drawn.depth is not None else "moments",
+                                          "pipeline_ms": drawn.pipeline_ms, "depth_units": drawn.units,
                                           "shadow_matrix": matrices[ln]}
 
         eye, vp = placed.camera(W, H)
