@@ -19,6 +19,8 @@ from ..link import EvalProgram, Interface, LinkedPermutation, Slot, eval_program
 from ..spec.permutation import Permutation
 from ..backends import LANGUAGES, TEMPLATE_PACKAGES, Language, language, template_file
 from ..backends.base import Emitted
+from ..backends.clike.records import FunctionRecords
+
 
 class _TemplateLoader(jinja2.PrefixLoader):
     """Templates by name: "glsl/fragment.glsl.j2" is fragment.glsl.j2 in the templates/ folder of the back end
@@ -30,8 +32,30 @@ class _TemplateLoader(jinja2.PrefixLoader):
     load = jinja2.BaseLoader.load
 
 
+class _CompiledTemplates(jinja2.BytecodeCache):
+    """Compiled templates by their name and the sha1 of their source (Jinja checks it on every load, and compiles
+    again when the file changed): what a Templates' environment compiles, a later one loads instead of compiling
+    (200 ms for the 21 templates). Content-addressed, so it changes no output and nothing of one build reaches
+    another; every environment using it is made by jinja_env, with the same settings."""
+
+    def __init__(self):
+        self._code: dict[str, bytes] = {}
+
+    def load_bytecode(self, bucket) -> None:
+        code = self._code.get(bucket.key)
+        if code is not None:
+            bucket.bytecode_from_string(code)  # a checksum that differs resets the bucket: compiled again
+
+    def dump_bytecode(self, bucket) -> None:
+        self._code[bucket.key] = bucket.bytecode_to_string()
+
+
+_COMPILED = _CompiledTemplates()
+
+
 def jinja_env() -> jinja2.Environment:
-    """The one Jinja environment (StrictUndefined: a missing value is an error, not an empty string)."""
+    """A Jinja environment over the back ends' templates (StrictUndefined: a missing value is an error, not an
+    empty string)."""
     return jinja2.Environment(
         loader=_TemplateLoader({folder: jinja2.PackageLoader(package, "templates")
                                  for folder, package in TEMPLATE_PACKAGES.items()}),
@@ -40,17 +64,44 @@ def jinja_env() -> jinja2.Environment:
         lstrip_blocks=True,
         keep_trailing_newline=True,
         autoescape=False,
+        bytecode_cache=_COMPILED,
     )
 
 
-_ENV = None
+class Templates:
+    """The templates units are rendered from: one Jinja environment, which loads (through PackageLoader) and
+    compiles each template once, however many units render it."""
+
+    def __init__(self):
+        self.env = jinja_env()
+
+    def render(self, name: str, **ctx) -> str:
+        return self.env.get_template(name).render(**ctx)
 
 
-def env() -> jinja2.Environment:
-    global _ENV
-    if _ENV is None:
-        _ENV = jinja_env()
-    return _ENV
+@dataclass
+class Composing:
+    """What composition keeps between the units of one library: its templates, and the C-like emitters' records
+    of the linked functions they emitted (a linked brick function is shared by every program of a library, so
+    an emitter replays it instead of walking it again: backends/clike/records.py).
+
+    Held in the library's memo (composing(lib)), so it lives exactly as long as the library: a build composes
+    with its own, a build worker (which gets the bricks without the memo) with one of its own, and nothing of
+    one library's composition is seen by another."""
+
+    templates: Templates = field(default_factory=Templates)
+    records: FunctionRecords = field(default_factory=FunctionRecords)
+
+
+_COMPOSING = ("compose", "state")  # its key in Library.memo
+
+
+def composing(lib: Library) -> Composing:
+    """The composition state of library `lib` (made on its first unit)."""
+    state = lib.memo.get(_COMPOSING)
+    if state is None:
+        state = lib.memo[_COMPOSING] = Composing()
+    return state
 
 
 @dataclass
@@ -93,9 +144,15 @@ def _function(prog, name: str):
     return next(f for f in prog.functions if f.name == name)
 
 
-def _render(template: str, target, ctx: dict, emitted, name: str) -> Source:
-    """Render one template; `name` is the generated file's name for #line resets."""
-    text = env().get_template(template).render(target=target, functions=emitted.text, **ctx)
+def _emit(lib: Library, target, prog, globals_: bool = True):
+    """The program's structs, globals (unless not `globals_`) and functions in `target`, replaying what this
+    library's units emitted before (Composing.records)."""
+    return target.emit(prog.structs, prog.functions, prog.globals if globals_ else (), records=composing(lib).records)
+
+
+def _render(lib: Library, template: str, target, ctx: dict, emitted, name: str) -> Source:
+    """Render one template with the library's Templates; `name` is the generated file's name for #line resets."""
+    text = composing(lib).templates.render(template, target=target, functions=emitted.text, **ctx)
     lines = text.split("\n")
     for i, line in enumerate(lines):
         if line.strip() == LINE_RESET:
@@ -130,7 +187,7 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram |
     sources = []
     for lang in map(language, languages):
         target = lang.target(precision)
-        emitted = target.emit(prog.structs, prog.functions)
+        emitted = _emit(lib, target, prog, globals_=False)
         emitted, entry = target.entry32(emitted, _function(prog, ep.entry))  # fp16: a 32-bit wrapper
         tname = lang.template("eval")
         used = _templates_used(lang, tname)
@@ -139,7 +196,7 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram |
                "params": ep.slots, "param_vec4s": max(ep.param_vec4s, 1), "tangent": ep.tangent,
                "brdf": entry, "switch": ep.entry == "brdf_switch",
                "textures": ep.interface.textures}
-        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
+        sources.append(_render(lib, tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
     return Composed(canon, h, sources, bricks, templates, ep.interface)
 
 
@@ -174,7 +231,7 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
     templates, sources = {}, []
     for lang in map(language, languages):
         target = lang.target(perm.precision)
-        emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted = _emit(lib, target, prog)
         emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
         tname = lang.template("shade")
         used = _templates_used(lang, tname)
@@ -183,7 +240,7 @@ def compose_shade_kernel(perm: Permutation, lib: Library, languages=LANGUAGES) -
                "inputs": surface, "samples": layout_, "call_args": _call_args(lp), "shade": shade,
                "material_vec4s": iface.block("Material").members[-1]["size"] // 16,
                "light_vec4s": iface.block("Lights").members[-1]["size"] // 16, "uber": False}
-        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
+        sources.append(_render(lib, tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
     return Composed(perm.canonical(), h, sources, bricks, templates, iface, material=lp.material, lights=lp.lights)
 
 
@@ -199,21 +256,21 @@ def compose_permutation(perm: Permutation | LinkedPermutation, lib: Library, lan
     templates = {}
     sources = []
     for lang in languages:
-        sources += _stage_sources(perm, lp, language(lang), "permutation", bricks, templates)
+        sources += _stage_sources(lib, lp, language(lang), "permutation", bricks, templates)
     extra = []
     for d in dialects:  # the platform dialects (GL's: gl/templates/, with the Vulkan GLSL's macros)
-        extra += _stage_sources(perm, lp, language(d), f"permutation ({d})", bricks, templates)
+        extra += _stage_sources(lib, lp, language(d), f"permutation ({d})", bricks, templates)
     return Composed(perm.canonical(), perm.hash, sources, bricks, templates, iface, material=lp.material,
                     lights=lp.lights, dialects=extra)
 
 
-def _stage_sources(perm, lp, lang: Language, label: str, bricks, templates) -> list[Source]:
+def _stage_sources(lib: Library, lp: LinkedPermutation, lang: Language, label: str, bricks, templates) -> list[Source]:
     """A permutation's vertex and fragment shaders in language or dialect `lang` (sources named
     <hash>.<vert|frag>.<lang.name>); the templates used and their hashes go into `templates`."""
-    prog, iface, h = lp.program, lp.interface, perm.hash
+    perm, prog, iface, h = lp.perm, lp.program, lp.interface, lp.perm.hash
     mat, lights = iface.block("Material"), iface.block("Lights")
     target = lang.target(perm.precision, iface)
-    emitted = target.emit(prog.structs, prog.functions, prog.globals)
+    emitted = _emit(lib, target, prog)
     emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
     call_args = _call_args(lp)
     out = []
@@ -226,6 +283,6 @@ def _stage_sources(perm, lp, lang: Language, label: str, bricks, templates) -> l
                "light_vec4s": lights.members[-1]["size"] // 16 if lights else 0,
                "textures": iface.textures, "call_args": call_args, "shade": shade, "surface": perm.surface,
                "iface": iface, **lang.context()}
-        out.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
+        out.append(_render(lib, tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                            f"{h}.{'frag' if stage == 'fragment' else 'vert'}.{lang.name}"))
     return out

@@ -8,7 +8,7 @@ from ..link.uber import Uber, link_ubershader
 from ..spec.permutation import Permutation
 from ..backends import LANGUAGES, language
 from ..backends.base import Emitted
-from . import Composed, _function, _provenance, _render, _templates_used
+from . import Composed, _emit, _function, _provenance, _render, _templates_used
 
 
 def uber_key(perms: list[Permutation]) -> str:
@@ -50,7 +50,7 @@ def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAG
     precision = _precision(perms)
     for lang in map(language, languages):
         target = lang.target(precision)
-        emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted = _emit(lib, target, prog)
         emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
         for stage, tname in (("vertex", lang.template("vertex")), ("fragment", lang.template("ubershader"))):
             used = _templates_used(lang, tname)
@@ -58,7 +58,7 @@ def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAG
             ctx = {"provenance": _provenance("ubershader", f"{len(perms)} permutations", h, bricks, used),
                    "inputs": iface.surface, "textures": iface.textures, "shade": shade,
                    "call_args": _call_args(u, lang.material_index), "iface": iface, **lang.context()}
-            sources.append(_render(tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
+            sources.append(_render(lib, tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"ubershader.{'frag' if stage == 'fragment' else 'vert'}.{lang.name}"))
     return Composed(key, h, sources, bricks, templates, iface), u
 
@@ -80,7 +80,7 @@ def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUA
     precision = _precision(perms)
     for lang in map(language, languages):
         target = lang.target(precision)
-        emitted = target.emit(prog.structs, prog.functions, prog.globals)
+        emitted = _emit(lib, target, prog)
         emitted, shade = target.entry32(emitted, _function(prog, "shade"))  # fp16: a 32-bit wrapper
         tname = lang.template("shade")
         used = _templates_used(lang, tname)
@@ -88,5 +88,5 @@ def compose_uber_kernel(perms: list[Permutation], lib: Library, languages=LANGUA
         ctx = {"provenance": _provenance("ubershader kernel", f"{len(perms)} permutations", h, bricks, used),
                "inputs": u.surface, "samples": layout_, "call_args": _call_args(u, None), "shade": shade,
                "material_vec4s": 1, "light_vec4s": 1, "uber": True}
-        sources.append(_render(tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
+        sources.append(_render(lib, tname, target, ctx, emitted, f"{h}.comp.{lang.name}"))
     return Composed(key, h, sources, bricks, templates, iface), u

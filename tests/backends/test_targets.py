@@ -270,19 +270,23 @@ def test_wgsl_line_map_covers_functions_and_statements(module):
 
 def test_emitters_keep_their_records_of_functions_not_the_ir(module):
     """A C-like emitter replays a function it emitted before (linked functions are shared by every program of
-    a library) from its own records: the IR functions hold only their fields, and the replay is the same text."""
-    from generator.backends.clike.walk import CLikeTarget
+    a library) from the records its caller holds: the IR functions hold only their fields, the replay is the
+    same text, and an emitter given no records (or other records) replays nothing of them."""
+    from generator.backends.clike.records import FunctionRecords
     functions = list(module.functions.values())
+    structs = list(module.structs.values())
+    records = FunctionRecords()
     for lang in LANGS:
-        first = emit(module, lang)
-        again = emit(module, lang)
-        assert (again.text, again.line_map) == (first.text, first.line_map)
+        first = get_target(lang).emit(structs, functions, records=records)
+        again = get_target(lang).emit(structs, functions, records=records)
+        assert (again.text, again.line_map) == (first.text, first.line_map) == dataclasses.astuple(emit(module, lang))
     fields = {f.name for f in dataclasses.fields(ir.Function)}
     for f in functions:
         assert set(vars(f)) == fields, sorted(set(vars(f)) - fields)
-    assert all(CLikeTarget.records.of(f) for f in functions)  # each function was recorded, by the emitters
+    assert all(records.of(f) for f in functions)  # each function was recorded, in the caller's store
+    assert not any(FunctionRecords().of(f) for f in functions)  # another store has seen none of them
     copy = ir.clone(functions[0])
-    assert not CLikeTarget.records.of(copy)  # a copy is another function: it has no record of its own yet
+    assert not records.of(copy)  # a copy is another function: it has no record of its own yet
 
 
 def test_reserved_words_are_renamed_identically_in_every_target(module):

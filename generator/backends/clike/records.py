@@ -1,9 +1,10 @@
-"""The C-like emitters' record of what they emitted for each linked function, held by the emitters.
+"""The C-like emitters' record of what they emitted for each linked function, held by whoever emits.
 
 Linked brick functions are shared by every program of a library and never change once linked
 (link/program.py), so an emitter that meets one again from the same writer state replays its lines
-instead of walking it. The record is kept here, keyed by the function's identity, not written into the
-IR node: IR stays the link stage's value (a copy of a node copies no emitter state, a validator or a dump
+instead of walking it. The caller owns the store and passes it to CLikeTarget.emit (composition keeps one
+per library: compose.Composing), so a replay never crosses from one library, or one build, into another.
+The record is kept here, keyed by the function's identity, not written into the IR node: IR stays the link stage's value (a copy of a node copies no emitter state, a validator or a dump
 sees only IR), and an entry goes when its function is collected. IR nodes compare by value and are not
 hashable, hence identity keys and a weak reference that checks the identity is still that function's.
 """

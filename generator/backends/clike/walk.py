@@ -83,10 +83,6 @@ class CLikeTarget(ControlMixin, ResourceMixin):
     # *Half subclasses); what crosses the interface (uniforms, buffers, samples, textures, stage
     # inputs and outputs) stays 32-bit and is converted where brick code meets it (from32/to32).
     precision = "fp32"
-    # What every C-like emitter emitted for each linked function (records.py), keyed by emitter class and writer
-    # state: one store for all of them, so a dialect emitter made per program replays what an earlier one of its
-    # class emitted.
-    records = FunctionRecords()
 
     # ---- tables a subclass fills in
     SCALARS: dict[str, str] = {}    # brick scalar -> spelling
@@ -240,8 +236,14 @@ class CLikeTarget(ControlMixin, ResourceMixin):
             return self.array_type(t)
         raise AssertionError(f"no {self.name} spelling for type {t}")
 
-    def emit(self, structs: list[Type], functions: list[ir.Function], globals: list[ir.Global] = ()) -> Emitted:
-        """Structs, then the declarations of `globals` (buffers, textures), then functions."""
+    def emit(self, structs: list[Type], functions: list[ir.Function], globals: list[ir.Global] = (),
+             records: FunctionRecords | None = None) -> Emitted:
+        """Structs, then the declarations of `globals` (buffers, textures), then functions.
+
+        `records`: the caller's store of what C-like emitters emitted for each linked function (records.py),
+        keyed by emitter class and writer state; a function met again is replayed from it, and what is walked is
+        recorded there. One store serves every emitter, so a dialect emitter made per program replays what an
+        earlier one of its class emitted. Without one, every function is walked."""
         w = Writer(self.line_directives)
         for s in structs:
             self.struct_decl(w, s)
@@ -257,16 +259,19 @@ class CLikeTarget(ControlMixin, ResourceMixin):
                 w.line(text)
             w.line("")
         for f in functions:
-            self._function_cached(w, f)
+            if records is None:
+                self.function(w, f)
+            else:
+                self._function_cached(w, f, records)
             w.line("")
         return Emitted(w.text(), w.line_map)
 
-    def _function_cached(self, w: Writer, f: ir.Function) -> None:
-        """self.function(w, f), replayed from this emitter class's record of `f` when it has emitted it before
-        from the same writer state (linked brick functions are shared by every program of a library, and never
-        change: link/program.py); the bytes are the same, the walk is skipped."""
+    def _function_cached(self, w: Writer, f: ir.Function, records: FunctionRecords) -> None:
+        """self.function(w, f), replayed from the record of `f` an emitter of this class made from the same writer
+        state (linked brick functions are shared by every program of a library, and never change:
+        link/program.py); the bytes are the same, the walk is skipped."""
         key = (type(self), w.directives, w._next, w.depth)
-        memo = self.records.of(f)
+        memo = records.of(f)
         hit = memo.get(key)
         if hit is not None:
             lines, mapped, end = hit
