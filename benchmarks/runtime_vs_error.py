@@ -286,9 +286,10 @@ class Timer:
     """Paired timing of kernels against baselines, kernels compiled once per language."""
 
     def __init__(self, lib, samples: int, repeats: int):
-        from generator.runtime.eval_kernel import shared_device
+        from generator.runtime.eval_kernel import EvalSession
         self.lib, self.repeats = lib, repeats
-        self.device = shared_device()
+        self.session = EvalSession()  # closed by measure() when it is done
+        self.device = self.session.device
         self.vecs = timing_samples(samples, seed=2)
 
     def kernel(self, spec: str, lang: str, params: dict):
@@ -297,7 +298,7 @@ class Timer:
         from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params, resolve_textures
         from generator.runtime.eval_kernel import Texture
         ep = program(spec, self.lib)
-        k = gpu_kernel(spec, lang, self.lib, self.device)
+        k = gpu_kernel(spec, lang, self.lib, self.session)
         textures = [Texture(np.asarray(x), bool(d.get("srgb")))
                     for x, (_n, _t, d) in zip(resolve_textures(ep, None), ep.textures)]
         k.load(self.vecs, _param_block(ep, resolve_params(ep, own_params(spec, params, self.lib))),
@@ -331,9 +332,9 @@ def _max_rel(f, ref) -> float:
     return float(np.max(np.abs(f - ref) / np.maximum(np.abs(ref), REL_FLOOR)))
 
 
-def errors(spec: str, exact, params: dict, lib, k: int, lang: str) -> dict:
-    """The kernel (lavapipe, float32) and its float64 emission against `exact`: a spec whose reference is the
-    exact model, or a function (L, V, N) -> f."""
+def errors(spec: str, exact, params: dict, lib, k: int, lang: str, session) -> dict:
+    """The kernel (lavapipe, float32, on the EvalSession `session`) and its float64 emission against `exact`: a
+    spec whose reference is the exact model, or a function (L, V, N) -> f."""
     from generator.eval.evaluate import evaluate
     from generator.reference import reference_brdf
 
@@ -348,7 +349,7 @@ def errors(spec: str, exact, params: dict, lib, k: int, lang: str) -> dict:
     mine = own_params(spec, params, lib)
     out = {}
     for name, target, dtype in (("gpu", lang, "float32"), ("model", "numpy", "float64")):
-        f = evaluate(spec, L, V, N, T, params=mine, target=target, dtype=dtype, lib=lib)
+        f = evaluate(spec, L, V, N, T, params=mine, target=target, dtype=dtype, lib=lib, session=session)
         out[name] = {"rel_rms": _rel_rms(f, ref, w), "max_rel": _max_rel(f, ref)}
     return out
 
@@ -386,7 +387,7 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
                 bar.set_description(f"{st.name} {lang} {label}")
                 row["time"][lang] = timer.ratio(spec, st.baseline, lang, st.params)
                 bar.update()
-            row["errors"] = errors(spec, exact, st.params, lib, k, langs[0])
+            row["errors"] = errors(spec, exact, st.params, lib, k, langs[0], timer.session)
             rows.append(row)
         pts = [{"error": r["errors"]["gpu"]["rel_rms"], **r["time"][langs[0]]} for r in rows]
         for r, on in zip(rows, front(pts)):
@@ -400,10 +401,12 @@ def measure(lib, langs, samples, repeats, k, progress) -> dict:
             bar.set_description(f"{lang} {spec}")
             row["time"][lang] = timer.ratio(spec, LAMBERT, lang, {})
             bar.update()
-        row["errors"] = errors(spec, spec, {}, lib, k, langs[0])
+        row["errors"] = errors(spec, spec, {}, lib, k, langs[0], timer.session)
         bricks.append(row)
     bar.close()
-    return {"device": timer.device.name, "studies": out_studies, "bricks": bricks, "notes": notes}
+    name = timer.device.name
+    timer.session.close()
+    return {"device": name, "studies": out_studies, "bricks": bricks, "notes": notes}
 
 
 # ------------------------------------------------------------------ reporting

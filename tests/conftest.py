@@ -45,6 +45,21 @@ def _own_compile_cache(tmp_path_factory):
     os.environ["SHADERMATRIX_CACHE_DIR"] = str(tmp_path_factory.mktemp("compile-cache"))
 
 
+@pytest.fixture(scope="session")
+def eval_session():
+    """The EvalSession GPU evaluations of this test session run on (pass it as `session=`), with the validation
+    layer on; its device opens when a lavapipe test first uses it (tests/lavapipe.py: `device`), and closes
+    when the session ends, saying nothing then too."""
+    from generator.runtime.eval_kernel import EvalSession
+
+    session = EvalSession(validation=True)
+    yield session
+    dev = session.device if session.opened else None
+    session.close()
+    if dev is not None:
+        assert dev.messages == [], "while closing: " + "\n".join(map(str, dev.messages))
+
+
 @pytest.fixture(autouse=True)
 def _test_tier(request, monkeypatch):
     """Tiers do not leak: only `toolchain` tests run external tools, only `lavapipe` ones open a device.

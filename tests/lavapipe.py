@@ -27,20 +27,21 @@ def _report(messages) -> str:
 
 
 @pytest.fixture(scope="module")
-def device():
-    """The process-wide device that generator.evaluate uses, reopened with validation on."""
+def device(eval_session):
+    """The device of the test session's EvalSession (tests/conftest.py: validation on), which the tests pass to
+    what they evaluate; at the module's end its kernels free their buffers and the layer has said nothing."""
     for t in COMPILERS:
         require_tool(t)
     from generator.runtime.device import VulkanUnavailable
-    from generator.runtime.eval_kernel import close_shared, shared_device
 
     try:
-        dev = shared_device(validation=True)
+        dev = eval_session.device
     except VulkanUnavailable as exc:
         require(False, str(exc))
     yield dev
-    close_shared()
-    assert dev.messages == [], "while closing: " + _report(dev.messages)
+    eval_session.release()
+    found, dev.messages[:] = list(dev.messages), []
+    assert found == [], "at the module's end: " + _report(found)
 
 
 @pytest.fixture(autouse=True)

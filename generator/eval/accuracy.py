@@ -383,37 +383,39 @@ def default_targets() -> list[str]:
     return ["numpy"] + (list(GPU_TARGETS) if lavapipe_present() else [])
 
 
-def runs(targets, dtypes) -> list[tuple[str, str]]:
+def runs(targets, dtypes, session=None) -> list[tuple[str, str]]:
     """(target, dtype) pairs to measure: numpy in each dtype asked; GPU languages in float32, and in float16
-    (their fp16 kernels) where the device reports shaderFloat16 (gpu_fp16(); skipped_runs() says why not)."""
+    (their fp16 kernels) where the device of `session` reports shaderFloat16 (gpu_fp16(); skipped_runs() says
+    why not)."""
     out = []
     for t in targets:
         for d in dtypes:
             if t == "numpy" or (t in GPU_TARGETS and d == "float32"):
                 out.append((t, d))
-            elif t in GPU_TARGETS and d == "float16" and gpu_fp16()[0]:
+            elif t in GPU_TARGETS and d == "float16" and gpu_fp16(session)[0]:
                 out.append((t, d))
     return out
 
 
-def skipped_runs(targets, dtypes) -> list[dict]:
+def skipped_runs(targets, dtypes, session=None) -> list[dict]:
     """The (target, dtype) pairs asked for that runs() leaves out, each with the reason."""
     out = []
     for t in targets:
         for d in dtypes:
             if t in GPU_TARGETS and d == "float64":
                 out.append({"run": f"{t}/{d}", "why": "GPU targets compute in float32 or float16"})
-            elif t in GPU_TARGETS and d == "float16" and not gpu_fp16()[0]:
-                out.append({"run": f"{t}/{d}", "why": gpu_fp16()[1]})
+            elif t in GPU_TARGETS and d == "float16" and not gpu_fp16(session)[0]:
+                out.append({"run": f"{t}/{d}", "why": gpu_fp16(session)[1]})
     return out
 
 
-def gpu_fp16() -> tuple[bool, str]:
-    """(whether the GPU targets run float16 here, why not): the shared device must report shaderFloat16
-    (asked of the process-wide device each time: opening it is cached there, not the answer)."""
-    from .evaluate import gpu_fp16_status
+def gpu_fp16(session=None) -> tuple[bool, str]:
+    """(whether the GPU targets run float16 here, why not): the device of `session` (an EvalSession; None: one
+    opened for the question alone) must report shaderFloat16."""
+    from .evaluate import gpu_fp16_status, own_session
     try:
-        return gpu_fp16_status()
+        with own_session(session) as own:
+            return gpu_fp16_status(own)
     except Exception as exc:  # no Vulkan device at all (or none may be opened here)
         return False, f"no Vulkan device ({exc})"
 
@@ -449,24 +451,36 @@ def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:
     return [x.astype(dtype).astype(np.float64) for x in (s.L, s.V, s.N, s.T)]
 
 
-def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12, params: dict | None = None) -> dict:
+def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12, params: dict | None = None,
+            session=None) -> dict:
     """Errors of every (target, dtype) against the reference for one spec: {set: {"target/dtype": Errors}}.
 
     params: a material's parameter values (`accuracy SCENE`): the hemisphere and the stress geometries
-    are evaluated at them, instead of at the defaults and the parameter sweeps.
+    are evaluated at them, instead of at the defaults and the parameter sweeps. session: the EvalSession the
+    GPU targets run on (None: one for this measure alone).
     """
+    from .evaluate import own_session
+
+    if not any(t in GPU_TARGETS for t in targets):
+        return _measure(spec, targets, dtypes, lib, hemisphere_k, params, session)
+    with own_session(session) as own:
+        return _measure(spec, targets, dtypes, lib, hemisphere_k, params, own)
+
+
+def _measure(spec: str, targets, dtypes, lib, hemisphere_k: int, params: dict | None, session) -> dict:
     from .evaluate import evaluate, gpu_kernel
     from ..reference import reference_brdf
 
     declared = declared_params(spec, lib)
     sets = {"hemisphere": [hemisphere(hemisphere_k, params=params)], "stress": stress_sets(declared, params)}
+    todo = runs(targets, dtypes, session)
     out: dict = {}
     for set_name, batches in sets.items():
-        stats = {f"{t}/{d}": Errors() for t, d in runs(targets, dtypes)}
+        stats = {f"{t}/{d}": Errors() for t, d in todo}
         for s in batches:
             exact = reference_brdf(spec, s.L, s.V, s.N, s.T, s.params, lib=lib)
             refs: dict = {}
-            for t, d in runs(targets, dtypes):
+            for t, d in todo:
                 given = rounded_inputs(s, d)
                 if d not in refs:
                     ref = reference_brdf(spec, *given, s.params, lib=lib)
@@ -474,12 +488,12 @@ def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12, params: dic
                         moved = np.abs(ref - exact) > ILL_CONDITIONED * np.maximum(np.abs(exact), REL_FLOOR)
                     refs[d] = ref, ~moved.any(axis=1)
                 with np.errstate(all="ignore"):  # float16 overflows (n = 1e5) are what we count
-                    got = evaluate(spec, *given, s.params, target=t, dtype=d, lib=lib)
+                    got = evaluate(spec, *given, s.params, target=t, dtype=d, lib=lib, session=session)
                 stats[f"{t}/{d}"].add(got, refs[d][0], s.labels, s.params, refs[d][1])
         out[set_name] = stats
-    for t, d in sorted({(t, d) for t, d in runs(targets, dtypes) if t in GPU_TARGETS}):  # float32 and float16
-        gpu_kernel(spec, t, lib, precision="fp16" if d == "float16" else "fp32").release()  # buffers of the
-        # largest batch's size; the pipeline stays
+    for t, d in sorted({(t, d) for t, d in todo if t in GPU_TARGETS}):  # float32 and float16
+        gpu_kernel(spec, t, lib, session, precision="fp16" if d == "float16" else "fp32").release()  # buffers
+        # of the largest batch's size; the pipeline stays
     return out
 
 
@@ -487,29 +501,39 @@ DEFAULT_TOL = 1e-3  # float32 hemisphere max relative error a spec may have and 
 
 
 def run(specs, targets, dtypes, lib, hemisphere_k: int = 12, tol: float = DEFAULT_TOL,
-        materials: dict | None = None) -> dict:
+        materials: dict | None = None, session=None) -> dict:
     """The accuracy report of several specs as a JSON-ready dict, with a verdict per spec (see verdicts()).
 
     materials: {label: (spec, params)} — an entry of `specs` that is a label there is measured as
     that BRDF at those parameter values (a scene's material: `accuracy SCENE`); its results carry
-    the label as "spec" and the BRDF as "brdf".
+    the label as "spec" and the BRDF as "brdf". session: the EvalSession the GPU targets run on (None:
+    one for this run alone, when a GPU target is asked for).
     """
+    from .evaluate import own_session
+
+    if not any(t in GPU_TARGETS for t in targets):
+        return _run(specs, targets, dtypes, lib, hemisphere_k, tol, materials or {}, session)
+    with own_session(session) as own:
+        return _run(specs, targets, dtypes, lib, hemisphere_k, tol, materials or {}, own)
+
+
+def _run(specs, targets, dtypes, lib, hemisphere_k: int, tol: float, materials: dict, session) -> dict:
     from tqdm import tqdm
 
     from ..io import show_progress
-    materials = materials or {}
     results = []
     for label in tqdm(specs, disable=not show_progress(), unit="spec", leave=False):
         spec, params = materials.get(label, (label, None))
         extra = {"brdf": spec, "params": _plain(params)} if label in materials else {}
-        for set_name, stats in measure(spec, targets, dtypes, lib, hemisphere_k, params).items():
+        for set_name, stats in measure(spec, targets, dtypes, lib, hemisphere_k, params, session).items():
             for key, e in stats.items():
                 t, d = key.split("/")
                 results.append({"spec": label, **extra, "set": set_name, "target": t, "dtype": d, **asdict(e)})
     bad = [r for r in results if r["dtype"] == "float32" and (r["nan"] or r["inf"])]
-    return {"rel_floor": REL_FLOOR, "specs": list(specs), "runs": [f"{t}/{d}" for t, d in runs(targets, dtypes)],
+    return {"rel_floor": REL_FLOOR, "specs": list(specs),
+            "runs": [f"{t}/{d}" for t, d in runs(targets, dtypes, session)],
             "results": results, "float32_finite": not bad, "tolerance": tol,
-            "verdicts": verdicts(results, specs, tol, lib), "skipped": skipped_runs(targets, dtypes)}
+            "verdicts": verdicts(results, specs, tol, lib), "skipped": skipped_runs(targets, dtypes, session)}
 
 
 def verdicts(results: list[dict], specs, tol: float, lib=None) -> list[dict]:

@@ -13,14 +13,17 @@ used as given (nothing is normalized unless a brick does it).
   precision "fp16": the BRDF and glue compute in half; samples, parameters and
   the result stay 32-bit and are converted at the kernel's entry and exit) and
   needs a device reporting shaderFloat16 (EvalError otherwise; lavapipe has it).
-  The device, compiled pipelines and loaded NumPy programs are cached per
-  process, so sweeps pay for compilation once.
+  The GPU targets run on the device of `session` (runtime.eval_kernel.EvalSession),
+  which keeps the kernels it compiled, so a sweep that passes one session pays for
+  compilation once; without one, a call opens a device of its own and closes it
+  when it returns. Loaded NumPy programs are kept in the library's memo.
 
 Parameters default to the bricks' defaults; a scalar for a vector parameter
 splats. Every bad input raises :class:`EvalError` ("what — what to do").
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 
 import numpy as np
 
@@ -216,49 +219,60 @@ def _run_numpy(ep: EvalProgram, lib, vecs, values, dtype: str, n: int, texels=()
     return np.broadcast_to(np.asarray(out, np.float64), (n, 3)).copy()
 
 
-def gpu_kernel(spec: str, language: str, lib=None, device=None, precision: str = "fp32"):
-    """The cached EvalKernel of a spec in one language on `device` (default: the shared lavapipe device);
+@contextmanager
+def own_session(session):
+    """`session`, or where it is None an EvalSession made for this call alone, closed when the call ends."""
+    if session is not None:
+        yield session
+        return
+    from ..runtime.eval_kernel import EvalSession
+    with EvalSession() as own:
+        yield own
+
+
+def gpu_kernel(spec: str, language: str, lib, session, precision: str = "fp32"):
+    """The EvalKernel of a spec in one language on the device of `session` (an EvalSession, which keeps it);
     precision "fp16" gives the half kernel (the device must report shaderFloat16)."""
-    from ..runtime.eval_kernel import compile_kernel, shared_device
+    from ..runtime.eval_kernel import compile_kernel
 
     lib = library_or_builtin(lib)
     ep = program(spec, lib)
-    device = device or shared_device()
     key = ("eval", lib.serial, ep.spec, language) + ((precision,) if precision != "fp32" else ())
-    if key not in device.cache:  # kernels live on their device
+    if key not in session.kernels:
         src = compose_eval(ep.spec, lib, (language,), ep=ep, precision=precision).sources[0]
-        device.cache[key] = compile_kernel(src, device, ep.tangent, ep.param_vec4s, textures=len(ep.textures))
-    return device.cache[key]
+        session.kernels[key] = compile_kernel(src, session.device, ep.tangent, ep.param_vec4s,
+                                              textures=len(ep.textures))
+    return session.kernels[key]
 
 
-def gpu_fp16_status(device=None) -> tuple[bool, str]:
-    """(whether fp16 eval kernels run on the device, why not): the device must report shaderFloat16."""
-    from ..runtime.eval_kernel import shared_device
-
-    device = device or shared_device()
+def gpu_fp16_status(session) -> tuple[bool, str]:
+    """(whether fp16 eval kernels run on the device of `session`, why not): it must report shaderFloat16."""
+    device = session.device
     if device.fp16:
         return True, ""
     return False, f"{device.name} does not report shaderFloat16 and 16-bit storage access"
 
 
-def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, texels=(), dtype: str = "float32") -> np.ndarray:
+def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, texels, dtype: str, session) -> np.ndarray:
     from ..runtime.eval_kernel import Texture
 
     if dtype == "float16":
-        ok, why = gpu_fp16_status()
+        ok, why = gpu_fp16_status(session)
         if not ok:
             from ..runtime.device import Fp16Unsupported
             raise Fp16Unsupported(f"target {language} cannot run float16 here: {why} — evaluate float32 on the "
                                   "GPU, or float16 with --target numpy")
-    kernel = gpu_kernel(ep.spec, language, lib, precision="fp16" if dtype == "float16" else "fp32")
+    kernel = gpu_kernel(ep.spec, language, lib, session, precision="fp16" if dtype == "float16" else "fp32")
     f32 = [v.astype(np.float32) for v in vecs]
     textures = [Texture(np.asarray(x), bool(d.get("srgb"))) for x, (_, _, d) in zip(texels, ep.textures)]
     return kernel.run(f32, _param_block(ep, values), textures=textures or None).astype(np.float64)
 
 
 def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str = "reference",
-             dtype: str | None = None, lib=None, textures: dict | None = None) -> np.ndarray:
+             dtype: str | None = None, lib=None, textures: dict | None = None, session=None) -> np.ndarray:
     """f_r (N, 3) float64 of BRDF `spec` for unit vectors L, V, N (and T) of shape (N, 3).
+
+    session: the runtime.eval_kernel.EvalSession a GPU target runs on (None: one for this call alone).
 
     textures: {name: texels (H, W, 4)} for a BRDF that samples lookup tables; the GPU samples
     them bilinearly with clamp-to-edge at level 0 (runtime.images.Sampler) and the NumPy target
@@ -299,5 +313,6 @@ def evaluate(spec: str, L, V, N, T=None, params: dict | None = None, target: str
         return _run_reference(ep, vecs, values, n)
     if target == "numpy":
         return _run_numpy(ep, lib, vecs, values, dtype, n, texels)
-    return _run_gpu(ep, lib, target, vecs, values, texels, dtype)
+    with own_session(session) as s:
+        return _run_gpu(ep, lib, target, vecs, values, texels, dtype, s)
 

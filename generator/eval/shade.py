@@ -5,7 +5,9 @@ normal, the light loop (static lights and storage-buffer lights alike) and the o
 exactly as the fragment shader computes them, in a compute kernel
 (compose.compose_shade_kernel) so no graphics pipeline is needed. Values are given by the
 glue's names (`m_rho_d`, `l0_color`, `o_ev`; the bricks' defaults otherwise); the lights of
-dynamic light i are `buffers={i: {"position": (n, 3), "color": (n, 3)}}`.
+dynamic light i are `buffers={i: {"position": (n, 3), "color": (n, 3)}}`. A GPU target runs on the
+device of `session` (runtime.eval_kernel.EvalSession, which keeps each kernel's SPIR-V; None: one
+for the call alone).
 """
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ import numpy as np
 
 from .. import GPU_TARGETS
 from ..library.bricks import library_or_builtin
-from .evaluate import EvalError
+from .evaluate import EvalError, own_session
 
 
 def _values(c, values: dict | None) -> dict:
@@ -44,7 +46,7 @@ def _buffer_fields(slots, given: dict, n: int) -> dict[str, np.ndarray]:
 
 
 def shade_samples(perm, P, Ng, V, T=None, uv=None, values: dict | None = None, buffers: dict | None = None,
-                  target: str = "numpy", lib=None) -> np.ndarray:
+                  target: str = "numpy", lib=None, session=None) -> np.ndarray:
     """shade()'s vec4 (N, 4) float64 for each sample; see the module docstring."""
     from ..compose import compose_shade_kernel
 
@@ -64,7 +66,9 @@ def shade_samples(perm, P, Ng, V, T=None, uv=None, values: dict | None = None, b
         return _numpy(lp, P, Ng, V, T, uv, vals, fields, globs)
     if target not in GPU_TARGETS:
         raise EvalError(f"unknown target {target!r}", f"use numpy or one of {', '.join(GPU_TARGETS)}")
-    return _gpu(c.sources[0], c, n, P, Ng, V, T, uv, vals, fields, globs)
+    rows = [P, Ng, V] + ([np.asarray(T)[:, :4]] if T is not None else []) + ([uv] if uv is not None else [])
+    with own_session(session) as own:
+        return _run(own, c.sources[0], _samples(rows, n), _blocks(c, vals, fields, globs), what="shade kernel")
 
 
 def _linked(perm, lib):
@@ -89,16 +93,16 @@ def _numpy(lp, P, Ng, V, T, uv, vals, fields, globs) -> np.ndarray:
     return np.broadcast_to(np.asarray(shade(*args), np.float64), (len(P), 4)).copy()
 
 
-def _gpu(source, c, n, P, Ng, V, T, uv, vals, fields, globs) -> np.ndarray:
+def _blocks(c, vals, fields, globs) -> list:
+    """The shade kernel's Lights and Material blocks and its light buffers, as _run binds them."""
     from ..link.interface import pack
     from ..runtime.compute import STORAGE, UNIFORM
 
-    rows = [P, Ng, V] + ([np.asarray(T)[:, :4]] if T is not None else []) + ([uv] if uv is not None else [])
     blocks = [(UNIFORM, pack([s for ls in c.lights for s in ls], vals, c.interface.block("Lights").size // 16)),
               (UNIFORM, pack(c.material, vals, c.interface.block("Material").size // 16))]
     for i in sorted(globs):  # (n, vec4s, 4): LightData.data of each light
         blocks.append((STORAGE, fields[i]["data"].astype(np.float32)))
-    return _run(source, _samples(rows, n), blocks, what="shade kernel")
+    return blocks
 
 
 def _surface(P, Ng, V, T=None, uv=None) -> dict:
@@ -126,30 +130,28 @@ def _samples(rows, n: int) -> np.ndarray:
     return sample
 
 
-_SPIRV: dict = {}  # (language, source, overrides) -> SPIR-V: each kernel compiled once per process
-
-
-def _run(source, sample: np.ndarray, blocks: list, spec: dict | None = None, what: str = "kernel") -> np.ndarray:
-    """Compile (once) and dispatch a shade-style kernel: set 0 = samples, result, Info, then `blocks`
-    ((STORAGE | UNIFORM, bytes or array) each); returns the (n, 4) results as float64."""
+def _run(session, source, sample: np.ndarray, blocks: list, spec: dict | None = None,
+         what: str = "kernel") -> np.ndarray:
+    """Compile (once per session) and dispatch a shade-style kernel on the session's device: set 0 = samples,
+    result, Info, then `blocks` ((STORAGE | UNIFORM, bytes or array) each); returns the (n, 4) results as float64."""
     from ..runtime.compute import STORAGE, UNIFORM, ComputePipeline
-    from ..runtime.eval_kernel import KernelError, shared_device
+    from ..runtime.eval_kernel import KernelError
     from ..toolchain import CompileJob, compile_many
 
     # WebGPU keys an override declared with @id(N) by N; GLSL/HLSL keep the SpecId for the pipeline
     over = tuple((str(i), v) for i, v in spec.items()) if spec and source.language == "wgsl" else ()
     key = (source.language, source.text, over)
-    if key not in _SPIRV:
+    if key not in session.spirv:
         job = CompileJob(f"{what.replace(' ', '-')}.comp.{source.language}", source.language, "comp", source.text,
                          line_map=tuple(map(tuple, source.line_map)), overrides=over)
         res = compile_many([job])[job.key]
         if not res.ok:
             raise KernelError(f"the {source.language} {what} does not compile: " + "; ".join(res.errors()))
-        _SPIRV[key] = res.spirv
-    device = shared_device()
+        session.spirv[key] = res.spirv
+    device = session.device
     vk = device.vk
     n = len(sample)
-    pipe = ComputePipeline(device, _SPIRV[key], (STORAGE, STORAGE, UNIFORM) + tuple(k for k, _ in blocks),
+    pipe = ComputePipeline(device, session.spirv[key], (STORAGE, STORAGE, UNIFORM) + tuple(k for k, _ in blocks),
                            specialization=spec if source.language != "wgsl" else None)
     usage = {STORAGE: vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, UNIFORM: vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT}
     raw = [sample, np.zeros((n, 4), np.float32), np.array([n, 0, 0, 0], np.uint32)]
@@ -204,13 +206,14 @@ def _values_of(slots, values: dict) -> dict:
 
 
 def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "numpy", lib=None,
-                 variant: int | None = None, T=None, uv=None) -> np.ndarray:
+                 variant: int | None = None, T=None, uv=None, session=None) -> np.ndarray:
     """The ubershader kernel's shade() (N, 4): sample i shaded as material material[i] under `lights`.
 
     materials: (variant index, {glue name: value}); lights: (light type, shadow, {param: value}), looped over
     with a runtime count. variant: run the specialization-constant ubershader with its variant set to this
     (a pipeline of its own: SpecId 0 in GLSL/HLSL, naga's override in WGSL) instead of reading ids.x.
     T: (N, 4) tangents (w: the bitangent's sign) and uv: (N, 2), when the ubershader reads them.
+    session: the EvalSession a GPU target runs on (None: one for this call alone).
     """
     from ..compose.uber import compose_uber_kernel
     from ..link.uber import SPEC_VARIANT
@@ -242,4 +245,5 @@ def uber_samples(perms, P, Ng, V, material, materials, lights, target: str = "nu
     sample = _samples(rows, n)
     sample[:, 0, 3] = material  # P.w: the material index (backends/*/templates/shade.*.j2 with `uber`)
     blocks = [(STORAGE, entry_bytes(lts["ids"], lts["data"])), (STORAGE, entry_bytes(mat["ids"], mat["data"]))]
-    return _run(c.sources[0], sample, blocks, spec, what="ubershader kernel")
+    with own_session(session) as own:
+        return _run(own, c.sources[0], sample, blocks, spec, what="ubershader kernel")

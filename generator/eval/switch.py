@@ -14,7 +14,8 @@ import numpy as np
 from .. import DTYPES, GPU_TARGETS
 from ..library.bricks import library_or_builtin
 from ..link import EvalProgram, switch_program
-from .evaluate import EvalError, _numpy_arg, _numpy_texels, _param_block, _vectors, resolve_params, resolve_textures
+from .evaluate import (EvalError, _numpy_arg, _numpy_texels, _param_block, _vectors, own_session, resolve_params,
+                       resolve_textures)
 
 
 def switch_kernel_program(specs: list[str], lib=None) -> EvalProgram:
@@ -45,8 +46,9 @@ def _switch_values(ep: EvalProgram, params: dict | None) -> dict:
 
 
 def evaluate_switch(specs: list[str], ids, L, V, N, T=None, params: dict | None = None, target: str = "numpy",
-                    dtype: str | None = None, lib=None, textures: dict | None = None) -> np.ndarray:
-    """f_r (N, 3) float64: sample i evaluated with BRDF specs[ids[i]] through one switch program."""
+                    dtype: str | None = None, lib=None, textures: dict | None = None, session=None) -> np.ndarray:
+    """f_r (N, 3) float64: sample i evaluated with BRDF specs[ids[i]] through one switch program (a GPU target on
+    the device of `session`, a runtime.eval_kernel.EvalSession; None: one for this call alone)."""
     lib = library_or_builtin(lib)
     ep = switch_kernel_program(specs, lib)
     values = resolve_params(ep, _switch_values(ep, params))
@@ -58,7 +60,8 @@ def evaluate_switch(specs: list[str], ids, L, V, N, T=None, params: dict | None 
     if target in GPU_TARGETS:
         if dtype not in (None, "float32"):
             raise EvalError(f"target {target} runs in float32 on lavapipe, not {dtype}", "pass dtype float32 or none")
-        return _run_gpu(ep, lib, target, vecs, values, ids, texels)
+        with own_session(session) as own:
+            return _run_gpu(ep, lib, target, vecs, values, ids, texels, own)
     if target != "numpy":
         raise EvalError(f"target {target!r} has no switch program", "use numpy, glsl, hlsl or wgsl")
     if (dtype or "float64") not in DTYPES:
@@ -78,15 +81,15 @@ def evaluate_switch(specs: list[str], ids, L, V, N, T=None, params: dict | None 
     return np.broadcast_to(np.asarray(out, np.float64), (len(ids), 3)).copy()
 
 
-def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, ids, texels) -> np.ndarray:
+def _run_gpu(ep: EvalProgram, lib, language: str, vecs, values, ids, texels, session) -> np.ndarray:
     from ..compose import compose_eval
-    from ..runtime.eval_kernel import Texture, compile_kernel, shared_device
+    from ..runtime.eval_kernel import Texture, compile_kernel
 
-    device = shared_device()
     key = ("switch", lib.serial, ep.spec, language)
-    if key not in device.cache:
+    if key not in session.kernels:
         src = compose_eval(ep.spec, lib, (language,), ep=ep).sources[0]
-        device.cache[key] = compile_kernel(src, device, ep.tangent, ep.param_vec4s, textures=len(ep.textures))
+        session.kernels[key] = compile_kernel(src, session.device, ep.tangent, ep.param_vec4s,
+                                              textures=len(ep.textures))
     f32 = [v.astype(np.float32) for v in vecs]
     tex = [Texture(np.asarray(x), bool(d.get("srgb"))) for x, (_, _, d) in zip(texels, ep.textures)]
-    return device.cache[key].run(f32, _param_block(ep, values), ids=ids, textures=tex or None).astype(np.float64)
+    return session.kernels[key].run(f32, _param_block(ep, values), ids=ids, textures=tex or None).astype(np.float64)

@@ -173,7 +173,6 @@ class Device:
         self.features: dict[str, bool] = {}  # fp16 features the device reports (filled in by _open)
         self.handle = self.instance = self._messenger = self.command_pool = self.fence = None
         self._owned: list = []  # objects with destroy(), released in reverse order by close()
-        self.cache: dict = {}  # objects callers keep per device (compiled eval kernels)
         self._user = vk.ffi.cast("void *", id(self))
         _DEVICES[id(self)] = self
         try:
@@ -378,7 +377,6 @@ class Device:
             for obj in reversed(list(self._owned)):
                 obj.destroy()
             self._owned.clear()
-            self.cache.clear()
             if self.fence is not None:
                 vk.vkDestroyFence(self.handle, self.fence, None)
             if self.command_pool is not None:
@@ -401,5 +399,5 @@ class Device:
 
 
 def validation_requested() -> bool:
-    """SHADERMATRIX_VALIDATION=1 turns the validation layer on for the process-wide device."""
+    """SHADERMATRIX_VALIDATION=1 turns the validation layer on for the devices eval sessions and renders open."""
     return os.environ.get("SHADERMATRIX_VALIDATION", "").strip().lower() in ("1", "true", "yes")

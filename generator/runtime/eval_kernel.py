@@ -12,9 +12,9 @@ covers at most maxComputeWorkGroupCount[0] workgroups of 64, and each storage
 buffer at most maxStorageBufferRange bytes (lavapipe: 128 MiB, 2.8 M samples),
 so larger inputs run in chunks.
 
-One process-wide device (:func:`shared_device`) carries a cache of kernels per
-(language, source text), so repeated evaluations compile and create each
-pipeline once.
+Kernels run on the device of an :class:`EvalSession`, which whoever evaluates
+makes and closes; it keeps the kernels it compiled, so repeated evaluations
+compile and create each pipeline once.
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ import numpy as np
 
 from ..lang.errors import UserError
 from .compute import SAMPLED_IMAGE, SAMPLER, STORAGE, UNIFORM, ComputePipeline
-from .device import Device, validation_requested  # noqa: F401
+from .device import Device, validation_requested
 from .images import Image, texels
 
 WORKGROUP = 64  # local_size_x of backends/*/templates/eval.*.j2
@@ -274,26 +274,55 @@ def compile_kernel(source, device: Device, tangent: bool, param_vec4s: int, text
     return EvalKernel(device, res.spirv, tangent, param_vec4s, textures)  # ComputePipeline fits its capabilities
 
 
-_SHARED: Device | None = None
+class EvalSession:
+    """The device eval kernels run on, and what is compiled for it: owned by whoever evaluates on the GPU (the
+    `eval` and `accuracy` commands make one per run, a test session one for its tests) and closed by it.
 
-
-def shared_device(validation: bool | None = None) -> Device:
-    """The process-wide lavapipe device (opened on first use; reopened if `validation` changes).
-
-    ``validation=None`` keeps the open device, or opens one with the layer on
-    when SHADERMATRIX_VALIDATION=1.
+    The device opens on first use (a session that runs nothing on the GPU opens none), with the validation layer
+    on when `validation` is True (None: when SHADERMATRIX_VALIDATION=1). Kernels are kept per key (`kernels`,
+    the EvalKernel of a spec in a language, which lives on this device), and SPIR-V per source (`spirv`), so
+    repeated evaluations compile and create each pipeline once; closing the session destroys them with the
+    device. Use as a context manager, or call close().
     """
-    global _SHARED
-    if _SHARED is not None and (validation is None or _SHARED.validation == validation):
-        return _SHARED
-    close_shared()
-    _SHARED = Device(validation=validation_requested() if validation is None else validation)
-    return _SHARED
 
+    def __init__(self, validation: bool | None = None):
+        self.validation = validation_requested() if validation is None else validation
+        self.kernels: dict = {}  # key -> EvalKernel on self.device
+        self.spirv: dict = {}  # (language, source text, overrides) -> SPIR-V of a shade-style kernel
+        self._device: Device | None = None
+        self.closed = False
 
-def close_shared() -> None:
-    """Close the process-wide device and forget its kernels."""
-    global _SHARED
-    if _SHARED is not None:
-        _SHARED.close()
-        _SHARED = None
+    @property
+    def device(self) -> Device:
+        """This session's device (opened now if it is not yet: VulkanUnavailable without one)."""
+        if self.closed:
+            raise RuntimeError("this eval session is closed: make a new EvalSession")
+        if self._device is None:
+            self._device = Device(validation=self.validation)
+        return self._device
+
+    @property
+    def opened(self) -> bool:
+        """Whether the device is open (a session that ran nothing on the GPU has none)."""
+        return self._device is not None
+
+    def release(self) -> None:
+        """Free what the kept kernels hold between runs (sample and result buffers, uploaded images): their
+        pipelines stay, the next run allocates again."""
+        for k in self.kernels.values():
+            if isinstance(k, EvalKernel):
+                k.release(textures=True)
+
+    def close(self) -> None:
+        """Destroy the kernels and close the device (its tear-down's validation messages stay in its messages)."""
+        self.kernels.clear()  # their buffers and pipelines are the device's: it destroys them
+        self.spirv.clear()
+        if self._device is not None:
+            self._device.close()
+        self.closed = True
+
+    def __enter__(self) -> EvalSession:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

@@ -154,8 +154,8 @@ def test_float16_is_reported_not_required():
 
 @pytest.mark.lavapipe
 @pytest.mark.toolchain  # compiles eval kernels
-def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device):
-    rep = accuracy.run(SPECS, list(accuracy.GPU_TARGETS), ["float32"], LIB, hemisphere_k=6)
+def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device, eval_session):
+    rep = accuracy.run(SPECS, list(accuracy.GPU_TARGETS), ["float32"], LIB, hemisphere_k=6, session=eval_session)
     for r in rep["results"]:
         assert r["nan"] == 0 and r["inf"] == 0, (r["spec"], r["target"], r["set"])
         if r["set"] == "hemisphere":  # defaults: kappa <= 64 (n = 64) -> 64 ulp (1 + 64/16)
@@ -167,11 +167,11 @@ def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device):
 
 @pytest.mark.lavapipe
 @pytest.mark.toolchain  # compiles eval kernels
-def test_measure_releases_the_kernel_buffers_after_each_spec(device):
+def test_measure_releases_the_kernel_buffers_after_each_spec(device, eval_session):
     from generator.eval.evaluate import gpu_kernel
 
-    accuracy.measure("lambert", ["numpy", "glsl"], ["float32"], LIB, hemisphere_k=3)
-    kernel = gpu_kernel("lambert", "glsl", LIB)
+    accuracy.measure("lambert", ["numpy", "glsl"], ["float32"], LIB, hemisphere_k=3, session=eval_session)
+    kernel = gpu_kernel("lambert", "glsl", LIB, eval_session)  # the one measure ran, kept by the session
     assert kernel.samples is None and kernel.result is None and kernel.capacity == 0
 
 # ------------------------------------------------------------------ the command

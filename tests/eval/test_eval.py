@@ -131,7 +131,7 @@ def assert_close(got, want, kappa, what):
 @pytest.mark.parametrize("params", list(PARAM_SETS), ids=list(PARAM_SETS))
 @pytest.mark.parametrize("spec", ALU_SPECS)
 @pytest.mark.toolchain  # compiles eval kernels
-def test_gpu_kernels_agree_with_numpy(device, samples, spec, params):
+def test_gpu_kernels_agree_with_numpy(device, eval_session, samples, spec, params):
     from generator.eval.evaluate import evaluate, program, resolve_params
 
     ep = program(spec)
@@ -145,7 +145,7 @@ def test_gpu_kernels_agree_with_numpy(device, samples, spec, params):
     assert_close(want32, want64, kappa, f"numpy float32 vs float64 ({spec}, {params})")
     zero = want64 == 0.0
     for lang in LANGS:
-        got = evaluate(spec, L, V, N, T, params=p, target=lang)
+        got = evaluate(spec, L, V, N, T, params=p, target=lang, session=eval_session)
         assert got.shape == (SAMPLES, 3) and got.dtype == np.float64
         assert np.isfinite(got).all(), f"{lang}: NaN/Inf for {spec} ({params})"
         assert (got[zero] == 0.0).all(), f"{lang}: nonzero f_r where the numpy emission gives exactly 0"
@@ -162,14 +162,14 @@ def probe_lib():
 
 @pytest.mark.parametrize("target", ("numpy",) + LANGS)
 @pytest.mark.toolchain  # compiles eval kernels
-def test_tangent_frame_and_parameter_layout(device, samples, probe_lib, target):
+def test_tangent_frame_and_parameter_layout(device, eval_session, samples, probe_lib, target):
     """T is read from the fourth vec4 with B = cross(N, T); float, vec3 and mat4 parameters land in place."""
     from generator.eval.evaluate import evaluate
 
     L, V, N, T = (x[:256] for x in samples)
     w, c, m = -1.5, [0.25, -2.0, 4.0], [float(i) / 8.0 - 1.0 for i in range(16)]  # m: columns, column-major
     got = evaluate("tangent_probe", L, V, N, T, params={"w": w, "c": c, "m": m},
-                   target=target, dtype="float32", lib=probe_lib)
+                   target=target, dtype="float32", lib=probe_lib, session=eval_session)
     B = np.cross(N, T)
     M = np.asarray(m).reshape(4, 4).T
     want = np.stack([np.sum(T * L, 1), np.sum(B * V, 1), np.full(len(L), w)], 1) * c
@@ -237,7 +237,7 @@ def save(path, a):
 
 
 @pytest.mark.toolchain  # compiles eval kernels
-def test_cli_round_trip_matches_the_python_function(tmp_path, samples):
+def test_cli_round_trip_matches_the_python_function(tmp_path, samples, eval_session):
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
     from generator.eval.evaluate import evaluate
@@ -259,7 +259,7 @@ def test_cli_round_trip_matches_the_python_function(tmp_path, samples):
         f = np.load(out)
         assert f.dtype == np.float64 and f.shape == (300, 3)
         want = evaluate(spec, L, V, N, T, params={"alpha": 0.2, "f0": [0.9, 0.6, 0.3], "rho_d": 0.5},
-                        target=target, dtype=dtype)
+                        target=target, dtype=dtype, session=eval_session)
         np.testing.assert_array_equal(f, want)
         assert list(tmp_path.glob(".*.tmp")) == []
 

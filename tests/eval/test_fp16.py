@@ -283,29 +283,23 @@ def test_build_warns_for_an_fp16_unsafe_brick(tmp_path):
 
 # ------------------------------------------------------------------ lavapipe
 
-def _fp16_device():
-    """The shared validated device, skipping (failing under CI=true) where it lacks shaderFloat16."""
+@pytest.fixture(scope="module")
+def fp16_device(eval_session):
+    """The test session's validated eval device (tests/conftest.py), skipping (failing under CI=true) where it
+    lacks shaderFloat16; at the module's end the layer has said nothing."""
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
     from generator.runtime.device import VulkanUnavailable
-    from generator.runtime.eval_kernel import shared_device
 
     try:
-        dev = shared_device(validation=True)
+        dev = eval_session.device
     except VulkanUnavailable as exc:
         require(False, str(exc))
     require(dev.fp16, f"{dev.name} does not report shaderFloat16: no fp16 evaluation here")
-    return dev
-
-
-@pytest.fixture(scope="module")
-def fp16_device():
-    from generator.runtime.eval_kernel import close_shared
-
-    dev = _fp16_device()
     yield dev
-    close_shared()
-    assert dev.messages == [], "\n".join(map(str, dev.messages))
+    eval_session.release()
+    found, dev.messages[:] = list(dev.messages), []
+    assert found == [], "\n".join(map(str, found))
 
 
 @pytest.mark.lavapipe
@@ -317,14 +311,14 @@ def test_device_reports_fp16_features(fp16_device):
 @pytest.mark.lavapipe
 @pytest.mark.toolchain
 @pytest.mark.parametrize("lang", LANGS)
-def test_fp16_kernel_computes_in_half(fp16_device, lang):
+def test_fp16_kernel_computes_in_half(fp16_device, eval_session, lang):
     """lambert at rho_d = 1: the half kernel returns 1/π rounded to half (0.318359375), not float32's 0.31830987."""
     from generator.eval.evaluate import evaluate
 
     L = V = N = np.array([[0.0, 0.0, 1.0]])
-    got = evaluate("lambert", L, V, N, params={"rho_d": 1.0}, target=lang, dtype="float16")
+    got = evaluate("lambert", L, V, N, params={"rho_d": 1.0}, target=lang, dtype="float16", session=eval_session)
     assert got[0, 0] == float(np.float16(1.0 / np.pi)) == 0.318359375
-    full = evaluate("lambert", L, V, N, params={"rho_d": 1.0}, target=lang, dtype="float32")
+    full = evaluate("lambert", L, V, N, params={"rho_d": 1.0}, target=lang, dtype="float32", session=eval_session)
     assert full[0, 0] == pytest.approx(1.0 / np.pi, rel=1e-7)
     assert fp16_device.messages == []
 
@@ -332,7 +326,7 @@ def test_fp16_kernel_computes_in_half(fp16_device, lang):
 @pytest.mark.lavapipe
 @pytest.mark.toolchain
 @pytest.mark.parametrize("spec", SPECS)
-def test_fp16_eval_agrees_with_reference(fp16_device, spec):
+def test_fp16_eval_agrees_with_reference(fp16_device, eval_session, spec):
     """Every language's fp16 kernel on lavapipe against the float64 reference on the hemisphere (defaults)."""
     from generator.eval.accuracy import hemisphere, rounded_inputs
     from generator.eval.evaluate import evaluate
@@ -345,7 +339,7 @@ def test_fp16_eval_agrees_with_reference(fp16_device, spec):
     rtol = KAPPA_RTOL if spec in SHARP else FP16_RTOL
     atol = FP16_ATOL_SCALE * float(np.abs(ref).max())
     for lang in LANGS:
-        got = evaluate(spec, L, V, N, T, target=lang, dtype="float16", lib=lib)
+        got = evaluate(spec, L, V, N, T, target=lang, dtype="float16", lib=lib, session=eval_session)
         bad = ~np.isfinite(got)
         if spec in KNOWN_NONFINITE:  # only where the true value is below half's reach anyway
             assert (np.abs(ref[bad]) <= atol).all(), f"{spec} {lang}: NaN/Inf where the reference is not tiny"
@@ -361,15 +355,15 @@ def test_fp16_eval_agrees_with_reference(fp16_device, spec):
 
 @pytest.mark.lavapipe
 @pytest.mark.toolchain
-def test_accuracy_reports_fp16_columns(fp16_device):
+def test_accuracy_reports_fp16_columns(fp16_device, eval_session):
     """`accuracy` runs the GPU targets in float16 where the device has it, and reports the fp16 verdict and the
     parameter limits (GGX: small alpha overflows or underflows half) beside the float32 verdict."""
     from generator.eval import accuracy
 
     lib = _lib()
-    assert ("glsl", "float16") in accuracy.runs(["glsl"], ["float32", "float16"])
+    assert ("glsl", "float16") in accuracy.runs(["glsl"], ["float32", "float16"], eval_session)
     report = accuracy.run(["microfacet(ndf=ggx)", "lambert"], ["numpy", "glsl"], ["float32", "float16"], lib,
-                          hemisphere_k=5)
+                          hemisphere_k=5, session=eval_session)
     assert "glsl/float16" in report["runs"] and report["skipped"] == []
     v = {x["spec"]: x for x in report["verdicts"]}
     assert v["lambert"]["fp16_pass"] and v["lambert"]["fp16_limits"] == {}

@@ -108,13 +108,13 @@ def test_buffer_whose_memory_fails_leaks_nothing(monkeypatch, fails):
 
 
 @pytest.mark.toolchain  # compiles eval kernels
-def test_eval_kernel_chunks_large_inputs(device):
+def test_eval_kernel_chunks_large_inputs(device, eval_session):
     """Inputs beyond one dispatch's workgroup limit run in chunks with the same results."""
     from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
 
     spec = "lambert+blinn_phong_normalized"
     ep = program(spec)
-    kernel = gpu_kernel(spec, "glsl", device=device)
+    kernel = gpu_kernel(spec, "glsl", None, eval_session)
     rng = np.random.default_rng(3)
     vecs = [rng.normal(size=(1000, 3)).astype(np.float32) for _ in range(3)]
     block = _param_block(ep, resolve_params(ep, {"n": 20.0}))
@@ -128,7 +128,7 @@ def test_eval_kernel_chunks_large_inputs(device):
 
 
 @pytest.mark.toolchain  # compiles eval kernels
-def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
+def test_eval_kernel_chunks_respect_max_storage_buffer_range(device, eval_session):
     """A chunk's samples and results each fit one storage descriptor (lavapipe: 128 MiB, 2.8 M samples)."""
     from types import SimpleNamespace
 
@@ -140,7 +140,7 @@ def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
     groups = int(device.limits.maxComputeWorkGroupCount[0])
     probes = load_library([REPO / "tests" / "bricks" / "eval"])
     for spec, lib, vec4s in (("lambert", None, 3), ("tangent_probe", probes, 4)):  # (L, V, N), (L, V, N, T)
-        kernel = gpu_kernel(spec, "glsl", lib, device)
+        kernel = gpu_kernel(spec, "glsl", lib, eval_session)
         assert kernel.vec4s_per_sample == vec4s
         assert kernel.max_samples == min(groups * WORKGROUP, limit // (16 * vec4s))
         assert 16 * vec4s * kernel.max_samples <= limit and 16 * kernel.max_samples <= limit
@@ -151,12 +151,12 @@ def test_eval_kernel_chunks_respect_max_storage_buffer_range(device):
 
 
 @pytest.mark.toolchain  # compiles eval kernels
-def test_eval_kernel_times_loaded_samples_and_releases_buffers(device):
+def test_eval_kernel_times_loaded_samples_and_releases_buffers(device, eval_session):
     from generator.eval.evaluate import _param_block, gpu_kernel, program, resolve_params
 
     spec = "lambert"
     ep = program(spec)
-    kernel = gpu_kernel(spec, "wgsl", device=device)
+    kernel = gpu_kernel(spec, "wgsl", None, eval_session)
     block = _param_block(ep, resolve_params(ep, {}))
     vecs = [np.tile(np.float32([0.0, 0.0, 1.0]), (4096, 1))] * 3
     kernel.load(vecs, block)

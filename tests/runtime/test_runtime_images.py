@@ -173,20 +173,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 
-def kernel(device, text: str, textures: int, language: str = "glsl"):
-    """compile_kernel on a hand-written Source, cached on the device per text."""
+def kernel(session, text: str, textures: int, language: str = "glsl"):
+    """compile_kernel on a hand-written Source, on the eval session's device, kept by the session per text."""
     from generator.runtime.eval_kernel import compile_kernel
 
     key = ("test_runtime_images", language, text)
-    if key not in device.cache:
+    if key not in session.kernels:
         src = types.SimpleNamespace(text=text, language=language, line_map=())
-        device.cache[key] = compile_kernel(src, device, False, 1, textures=textures)
-    return device.cache[key]
+        session.kernels[key] = compile_kernel(src, session.device, False, 1, textures=textures)
+    return session.kernels[key]
 
 
-def kernel_2d(device, expr: str, cube: bool = False):
+def kernel_2d(session, expr: str, cube: bool = False):
     decls = (TEXCUBE if cube else TEX2D).format(b=3, s=4, k=0)
-    return kernel(device, GLSL.format(decls=decls, expr=expr), 1)
+    return kernel(session, GLSL.format(decls=decls, expr=expr), 1)
 
 
 BLOCK = np.zeros(4, np.float32)
@@ -226,9 +226,9 @@ def lv(uv: np.ndarray) -> np.ndarray:
 
 @pytest.mark.parametrize("call", ["texture", "textureLod"])
 @pytest.mark.parametrize("w, h", [(7, 5), (256, 128)])
-def test_float_texture_is_bilinear_clamp_to_edge(device, call, w, h):
+def test_float_texture_is_bilinear_clamp_to_edge(device, eval_session, call, w, h):
     rng = np.random.default_rng(w)
-    k = kernel_2d(device, "texture(sampler2D(t0, s0), L.xy)" if call == "texture"
+    k = kernel_2d(eval_session, "texture(sampler2D(t0, s0), L.xy)" if call == "texture"
                   else "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     img = rng.uniform(0, 1, (h, w, 4)).astype(np.float32)
     uv = uv_points(w, h, rng)
@@ -244,19 +244,19 @@ def test_float_texture_is_bilinear_clamp_to_edge(device, call, w, h):
         np.testing.assert_allclose(got[i], texel, atol=FLOAT_TOL(w, h), rtol=0)
 
 
-def test_float_filter_agreement_on_contrast(device):
+def test_float_filter_agreement_on_contrast(device, eval_session):
     """A 0/1 checkerboard (maximal texel contrast) at 200 000 uv: measured max 4.2e-7."""
     rng = np.random.default_rng(7)
-    k = kernel_2d(device, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
+    k = kernel_2d(eval_session, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     img = np.repeat((np.indices((5, 7)).sum(0) % 2)[..., None], 4, -1).astype(np.float32)
     uv = rng.uniform(-0.2, 1.2, (200_000, 2)).astype(np.float32)
     err = np.abs(run_raw(k, lv(uv), textures=[img]) - bilinear(img, uv)).max()
     assert err <= FLOAT_TOL(7, 5), err
 
 
-def test_fewer_channels_expand_like_vulkan(device):
+def test_fewer_channels_expand_like_vulkan(device, eval_session):
     """(H, W, C<4) textures get 0 for missing colour channels and alpha 1, as Vulkan expands formats."""
-    k = kernel_2d(device, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
+    k = kernel_2d(eval_session, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     img = np.float32([[[0.25, 0.5], [0.75, 1.0]]])  # (1, 2, 2): two channels
     got = run_raw(k, lv(np.float32([[0.25, 0.5], [0.75, 0.5]])), textures=[img])
     np.testing.assert_allclose(got, [[0.25, 0.5, 0, 1], [0.75, 1.0, 0, 1]], atol=1e-6)
@@ -264,9 +264,9 @@ def test_fewer_channels_expand_like_vulkan(device):
 
 # ---------------------------------------------------------------- (b) uint8: UNORM and sRGB
 
-def test_unorm8_texture_filters_within_one_step(device):
+def test_unorm8_texture_filters_within_one_step(device, eval_session):
     rng = np.random.default_rng(8)
-    k = kernel_2d(device, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
+    k = kernel_2d(eval_session, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     img = rng.integers(0, 256, (5, 7, 4), dtype=np.uint8)
     uv = uv_points(7, 5, rng, 200_000)
     got = run_raw(k, lv(uv), textures=[img])
@@ -275,8 +275,8 @@ def test_unorm8_texture_filters_within_one_step(device):
     np.testing.assert_allclose(got[:35].reshape(5, 7, 4), img / 255.0, atol=1e-6, rtol=0)
 
 
-def test_srgb_texture_decodes_with_the_eotf_before_filtering(device):
-    k = kernel_2d(device, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
+def test_srgb_texture_decodes_with_the_eotf_before_filtering(device, eval_session):
+    k = kernel_2d(eval_session, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     code = np.arange(256, dtype=np.uint8)
     img = np.stack([code, 255 - code, code[::-1] // 2, code], -1).reshape(16, 16, 4)  # every code, alpha = code
     c = (np.arange(16) + 0.5) / 16
@@ -308,11 +308,11 @@ def test_srgb_texture_decodes_with_the_eotf_before_filtering(device):
 
 # ---------------------------------------------------------------- (c) cube
 
-def test_cube_texture_samples_the_face_of_the_direction(device):
+def test_cube_texture_samples_the_face_of_the_direction(device, eval_session):
     rng = np.random.default_rng(10)
     w = 8
     faces = rng.uniform(0, 1, (6, w, w, 4)).astype(np.float32)
-    k = kernel_2d(device, "textureLod(samplerCube(t0, s0), L.xyz, 0.0)", cube=True)
+    k = kernel_2d(eval_session, "textureLod(samplerCube(t0, s0), L.xyz, 0.0)", cube=True)
     # Interior points only (the bilinear footprint inside one face): Vulkan filters seamlessly
     # across face edges, the per-face reference does not.
     face = np.repeat(np.arange(6), 3000)
@@ -336,10 +336,10 @@ def test_cube_texture_samples_the_face_of_the_direction(device):
 
 
 @pytest.mark.parametrize("language", ["glsl", "hlsl", "wgsl"])
-def test_two_textures_at_bindings_3_4_and_5_6(device, language):
+def test_two_textures_at_bindings_3_4_and_5_6(device, eval_session, language):
     """A 2D image + sampler at 3, 4 and a cube image + sampler at 5, 6, in every language."""
     rng = np.random.default_rng(11)
-    k = kernel(device, TWO[language], 2, language)
+    k = kernel(eval_session, TWO[language], 2, language)
     assert k.pipeline.bindings == ("storage", "storage", "uniform", "sampled_image", "sampler",
                                    "sampled_image", "sampler")
     img = rng.uniform(0, 1, (5, 7, 4)).astype(np.float32)
@@ -362,8 +362,8 @@ def test_two_textures_at_bindings_3_4_and_5_6(device, language):
 IDS = GLSL.format(decls="", expr="vec4(L.w, float(int(L.w)), L.x, float(i))")
 
 
-def test_ids_travel_in_L_w(device):
-    k = kernel(device, IDS, 0)
+def test_ids_travel_in_L_w(device, eval_session):
+    k = kernel(eval_session, IDS, 0)
     n = 1000
     rng = np.random.default_rng(12)
     ids = rng.integers(-50, 50, n)
@@ -394,10 +394,10 @@ def test_ids_travel_in_L_w(device):
 
 # ---------------------------------------------------------------- uploads, binding and lifetime
 
-def test_uploads_are_cached_per_content(device):
+def test_uploads_are_cached_per_content(device, eval_session):
     from generator.runtime.eval_kernel import Texture
 
-    k = kernel_2d(device, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
+    k = kernel_2d(eval_session, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     rng = np.random.default_rng(13)
     img = rng.integers(0, 256, (4, 4, 4), dtype=np.uint8)
     L = lv(np.float32([[0.125, 0.125]]))
@@ -424,10 +424,10 @@ def test_uploads_are_cached_per_content(device):
     assert k.uploads == before + 4
 
 
-def test_bind_checks_resource_kinds(device):
+def test_bind_checks_resource_kinds(device, eval_session):
     from generator.runtime.compute import SAMPLED_IMAGE, SAMPLER, ComputePipeline
 
-    k = kernel_2d(device, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
+    k = kernel_2d(eval_session, "textureLod(sampler2D(t0, s0), L.xy, 0.0)")
     pipe = k.pipeline
     img = device.image(np.zeros((2, 2, 4), np.float32))
     with pytest.raises(TypeError, match="binding 3 is sampled_image"):

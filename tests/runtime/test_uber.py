@@ -102,7 +102,7 @@ def surface():
 
 @pytest.mark.parametrize("target", ["numpy"] + [pytest.param(x, marks=[pytest.mark.lavapipe, pytest.mark.toolchain])
                                                 for x in LANGS])
-def test_ubershader_shades_every_permutation_like_its_specialized_shader(lib, surface, target):
+def test_ubershader_shades_every_permutation_like_its_specialized_shader(lib, surface, target, eval_session):
     """Per sample, the ubershader's shade() (material and lights from buffers, switches) equals the
     specialized permutation's: on lavapipe within 2 float32 ulp (the optimizer may contract a
     multiply-add differently inside a switch), in NumPy within the float32 rounding of the
@@ -119,8 +119,9 @@ def test_ubershader_shades_every_permutation_like_its_specialized_shader(lib, su
     for k, perm in enumerate(PERMS):
         assert u.variants[k].key == (perm.brdf, perm.packing, perm.output)
         lights, static = _case(perm)
-        got = uber_samples(PERMS, P, Ng, V, np.zeros(len(P), int), [(k, {"o_ev": 0.5})], lights, target=target, lib=lib)
-        want = shade_samples(perm, P, Ng, V, values=static, target=target, lib=lib)
+        got = uber_samples(PERMS, P, Ng, V, np.zeros(len(P), int), [(k, {"o_ev": 0.5})], lights, target=target, lib=lib,
+                           session=eval_session)
+        want = shade_samples(perm, P, Ng, V, values=static, target=target, lib=lib, session=eval_session)
         rtol = 2 * 2.0 ** -23 if target != "numpy" else 1e-6
         np.testing.assert_allclose(got, want, rtol=rtol, atol=rtol * np.abs(want).max(), err_msg=f"{target} {k}")
         assert np.abs(want[:, :3]).max() > 0.0
@@ -142,7 +143,7 @@ def test_one_dispatch_shades_samples_of_different_materials(lib, surface):
 
 @pytest.mark.parametrize("target", ["numpy"] + [pytest.param(x, marks=[pytest.mark.lavapipe, pytest.mark.toolchain])
                                                 for x in LANGS])
-def test_specialization_constant_ubershader_matches_the_buffer_id_one(lib, surface, target):
+def test_specialization_constant_ubershader_matches_the_buffer_id_one(lib, surface, target, eval_session):
     """The variant as a specialization constant (one pipeline per variant from one module) shades like the
     ubershader that reads it from the material entry."""
     from generator.eval.shade import uber_samples
@@ -154,9 +155,10 @@ def test_specialization_constant_ubershader_matches_the_buffer_id_one(lib, surfa
     P, Ng, V = surface
     lights = [("point", "none", LIGHTS["point"][0]), ("directional", "none", LIGHTS["directional"][0])]
     for k in range(len(PERMS)):
-        by_id = uber_samples(PERMS, P, Ng, V, np.zeros(len(P), int), [(k, {})], lights, target=target, lib=lib)
+        by_id = uber_samples(PERMS, P, Ng, V, np.zeros(len(P), int), [(k, {})], lights, target=target, lib=lib,
+                             session=eval_session)
         spec = uber_samples(PERMS, P, Ng, V, np.zeros(len(P), int), [(k, {})], lights, target=target, lib=lib,
-                            variant=k)
+                            variant=k, session=eval_session)
         np.testing.assert_allclose(spec, by_id, rtol=2 * 2.0 ** -23, atol=1e-7, err_msg=f"{target} {k}")
 
 
@@ -180,7 +182,8 @@ def test_specialization_constant_ubershader_keeps_one_module_in_glsl_and_hlsl(li
 
 @pytest.mark.parametrize("target", ["numpy"] + [pytest.param(x, marks=[pytest.mark.lavapipe, pytest.mark.toolchain])
                                                 for x in LANGS])
-def test_ubershader_with_a_tangent_frame_and_a_scalar_splat_matches_the_specialized_shader(lib, surface, target):
+def test_ubershader_with_a_tangent_frame_and_a_scalar_splat_matches_the_specialized_shader(lib, surface, target,
+                                                                                           eval_session):
     from generator.eval.shade import shade_samples, uber_samples
 
     if target != "numpy":
@@ -195,9 +198,9 @@ def test_ubershader_with_a_tangent_frame_and_a_scalar_splat_matches_the_speciali
     perm = Permutation("microfacet(ndf=aniso_ggx)", (LightKey("point", "none"),), "constants(normal=vertex_tangent)")
     light = {"position": [0.5, 2.0, 1.0], "color": 3.0}  # a scalar for a vec3 splats on both paths
     got = uber_samples([perm], P, Ng, V, np.zeros(len(P), int), [(0, {})], [("point", "none", light)],
-                       target=target, lib=lib, T=T)
+                       target=target, lib=lib, T=T, session=eval_session)
     want = shade_samples(perm, P, Ng, V, T=T, values={"l0_position": light["position"], "l0_color": [3.0] * 3},
-                         target=target, lib=lib)
+                         target=target, lib=lib, session=eval_session)
     rtol = 2 * 2.0 ** -23 if target != "numpy" else 1e-6
     np.testing.assert_allclose(got, want, rtol=rtol, atol=rtol * np.abs(want).max())
     assert np.abs(want[:, :3]).max() > 0.0

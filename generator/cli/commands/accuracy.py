@@ -82,6 +82,13 @@ def scene_materials(path: Path, lib) -> dict:
 
 
 def run(args) -> int:
+    from ...runtime.eval_kernel import EvalSession
+
+    with EvalSession() as session:  # the GPU targets' device and kernels, for this run (opened on first use)
+        return _run(args, session)
+
+
+def _run(args, session) -> int:
     from ...eval import accuracy
     from ...library.bricks import load_library
     from ...io import atomic_write
@@ -117,11 +124,12 @@ def run(args) -> int:
             specs = list(materials)
         else:
             specs = args.specs or accuracy.default_specs(lib, full=args.all_combinations)
-        if not accuracy.runs(targets, dtypes):
+        if not accuracy.runs(targets, dtypes, session):
             raise UsageError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
                              "GPU targets run float32 and float16; add float32 or the numpy target")
         tol = accuracy.DEFAULT_TOL if args.fail_above is None else args.fail_above
-        report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples, tol=tol, materials=materials)
+        report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples, tol=tol, materials=materials,
+                              session=session)
     except (EvalError, SpecError, ReferenceMissing) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1

@@ -136,6 +136,7 @@ def run(args) -> int:
     from ...library.bricks import load_library
     from ...io import atomic_write
     from ...eval.evaluate import EvalError, evaluate
+    from ...runtime.eval_kernel import EvalSession
     from ...spec.permutation import SpecError
 
     params = parse_params(args.param)  # a usage error: the CLI's exit 2
@@ -143,8 +144,9 @@ def run(args) -> int:
         s = load_samples(args.input, checked=not args.unchecked)
         lib = load_library(args.bricks or ())
         T = s[:, 9:12] if s.shape[1] == 12 else None
-        f = evaluate(args.spec, s[:, 0:3], s[:, 3:6], s[:, 6:9], T=T, params=params,
-                     target=args.target, dtype=args.dtype, lib=lib)
+        with EvalSession() as session:  # the device, opened only for a GPU target, closed before the output is written
+            f = evaluate(args.spec, s[:, 0:3], s[:, 3:6], s[:, 6:9], T=T, params=params,
+                         target=args.target, dtype=args.dtype, lib=lib, session=session)
     except (_BadInput, EvalError, SpecError) as exc:  # in the inputs: exit 1 (no device: the CLI's exit 3)
         print(f"error: {exc}", file=sys.stderr)
         return 1
