@@ -18,8 +18,8 @@ from __future__ import annotations
 import os
 import pickle
 import shutil
-import sys
 import tempfile
+import threading
 from dataclasses import replace
 
 from ..io import Store, sha256
@@ -29,9 +29,6 @@ from .context import BuildContext
 from .loop import Compiled, compose_chunk
 from .workers import Workers
 
-# multiprocessing's resource tracker warns of "leaked semaphore objects" when a build is interrupted (the progress
-# bar's lock), which it then removes itself. Noise to whoever pressed Ctrl-C: its process starts with this filter.
-_QUIET_TRACKER = "ignore::UserWarning:multiprocessing.resource_tracker"
 _PRELOAD = ["generator.assemble.parallel", "generator.compose", "generator.analysis", "jinja2"]
 _CONTEXT: list[BuildContext] = []  # in a worker: the build's context (set once, by _start)
 
@@ -44,6 +41,12 @@ def chunk_size(permutations: int, workers: int) -> int:
 def _start(ctx_bytes: bytes, env: dict, store_root: str | None) -> None:
     os.environ.clear()
     os.environ.update(env)  # the build's (PATH and the settings its tools read), not the forkserver's
+    # A worker's progress bars never draw (BuildContext.for_workers), so their lock is a thread's: tqdm's default, a
+    # multiprocessing lock, is here (the forkserver's start method) a named semaphore registered with the build's
+    # resource tracker, which a worker killed by an interrupt leaves behind, and the tracker then warns of it
+    # after the build's one line.
+    from tqdm import tqdm
+    tqdm.set_lock(threading.RLock())
     ctx = pickle.loads(ctx_bytes)
     lib = type(ctx.library)(bricks=ctx.library.bricks, errors=ctx.library.errors)  # this process's own caches
     _CONTEXT.append(replace(ctx, library=lib, store=Store(store_root) if store_root else None))
@@ -96,8 +99,6 @@ def compile_in_workers(ctx: BuildContext, items: list, extra: list, on_done, sta
     # compiled once whichever chunks have it (the in-process build's memo); named like the toolchain's temp dirs, a
     # killed build's is removed by the next
     private = None if ctx.store is not None else tempfile.mkdtemp(prefix=f"shadermatrix-{os.getpid()}-build-")
-    if _QUIET_TRACKER not in sys.warnoptions:  # read when multiprocessing starts its resource tracker
-        sys.warnoptions.append(_QUIET_TRACKER)
     init = (pickle.dumps(ctx.for_workers()), dict(os.environ), str(ctx.store.root) if ctx.store else private)
     # the ubershader's large shaders first, one task each: they spread over the workers
     tasks = [([], [job]) for job in extra] + [(chunk, []) for chunk in chunks]
