@@ -184,6 +184,8 @@ class _Build:
             "ubershader": uber,
             **scene_tables(scene, compiled.composed, self.previous),
         }
+        from .depth import write_depth_passes  # the shadowed lights' depth passes: their shaders, their descriptions
+        write_depth_passes(self)
         self._finish()
         return res
 

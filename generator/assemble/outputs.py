@@ -95,7 +95,8 @@ def clean_leftovers(out: Path) -> int:
 def named(manifest: dict) -> set[str]:
     """Every file a manifest names (relative paths)."""
     out = set()
-    for e in [*manifest.get("permutations", []), *manifest.get("removed", []), manifest.get("ubershader") or {}]:
+    for e in [*manifest.get("permutations", []), *manifest.get("removed", []), manifest.get("ubershader") or {},
+              *(manifest.get("depth_shaders") or {}).values()]:
         for stages in e.get("languages", {}).values():
             for item in stages.values():
                 out.update(item[k] for k in ("source", "spirv") if k in item)

@@ -27,7 +27,8 @@ def record(out: Path, manifest: dict, text: bytes, keys: Keys, kept: int, templa
         templates.update(read(out).get("templates", []))
     ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
         (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
-    entries = [*manifest["permutations"], *manifest.get("removed", []), manifest.get("ubershader") or {}]
+    entries = [*manifest["permutations"], *manifest.get("removed", []), manifest.get("ubershader") or {},
+               *(manifest.get("depth_shaders") or {}).values()]
     state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys.permutations, "ubershader": keys.ubershader,
              "scene": keys.scene,
              "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in items(e)}
