@@ -4,9 +4,9 @@ Donnelly & Lauritzen 2006, "Variance shadow maps". The map holds (E[d], E[d²]) 
 for a receiver at depth t > E[d], Chebyshev's one-tailed inequality bounds the lit fraction,
 p_max = σ² / (σ² + (t - E[d])²) with σ² = E[d²] - E[d]², and t <= E[d] is lit (1). Because moments
 (unlike depth compares) filter linearly, the map can be blurred once and sampled bilinearly: soft
-edges at one tap. The renderer's depth pass writes the moments for the texture `shadow_moments`
-(RGBA32F: d, d², 0, 1 from the D32 depth, box-filtered over 5 × 5 texels on the host;
-generator/runtime/renderer.py, `moments_map`), declared as an ordinary filterable float texture2d
+edges at one tap. The depth pass writes the moments for the texture `shadow_moments`
+(RGBA32F: d, d², 0, 1, the moments stage of the generated depth shaders, box-filtered over 5 × 5 texels
+by their blur pass; generator/runtime/shadow_pass.py), declared as an ordinary filterable float texture2d
 in every language (GLSL texture2D + sampler, HLSL Texture2D + SamplerState, WGSL texture_2d<f32> +
 sampler) and sampled bilinearly. Vulkan filters R32G32B32A32_SFLOAT linearly on lavapipe; WebGPU
 needs the float32-filterable feature for it (16-bit moments would lose E[d²] - E[d]² to rounding;
