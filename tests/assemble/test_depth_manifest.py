@@ -120,7 +120,10 @@ def test_the_matrix_convention_maps_the_brick_s_texel_on_every_platform(built):
     """A depth pass drawn with premultiply · shadow_matrix writes, on each platform, the framebuffer row and the
     window depth the brick reads back at uv = clip.xy / w · 0.5 + 0.5 and depth clip.z / w."""
     from generator.assemble.platforms import PLATFORM_TABLE
+    from generator.runtime.shadow_pass import VULKAN_CONVENTIONS
 
+    vk = PLATFORM_TABLE["vulkan"].conventions  # what the renderer (before the build stage) draws by
+    assert VULKAN_CONVENTIONS == (vk.depth_range, vk.ndc_y, vk.framebuffer_origin)
     out, m = built
     mat = m["lights"]["sun"]["depth_pass"]["matrix"]
     assert mat["parameter"] == "shadow_matrix" and mat["clip"] == "vulkan"
