@@ -151,7 +151,8 @@ def render_bricks() -> str:
                 out.append(f"- textures: {', '.join(code(t) for t in r['textures'])}\n")
             if r["slots"]:
                 out.append("\n" + table(["slot", "kind", "default", "fillers"],
-                                        [[code(s), v["kind"], code(v["default"]), ", ".join(code(f) for f in v["fillers"])]
+                                        [[code(s), v["kind"], code(v["default"]) if v["default"] else "none (optional: empty unless filled)",
+                                          ", ".join(code(f) for f in v["fillers"])]
                                          for s, v in r["slots"].items()]))
             if r["params"]:
                 out.append("\n" + table(["parameter", "type", "range", "default", "meaning"],

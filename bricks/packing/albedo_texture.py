@@ -8,7 +8,7 @@ BRICK = {
     "kind": "packing",
     "cite": "Hoffman & Baker 2006, shift-variant BRDFs (texture-mapped rho_d)",
     "textures": {"albedo_map": {"srgb": True, "doc": "diffuse albedo, sRGB-encoded RGB"}},
-    "slots": {"normal": {"kind": "normal", "default": "vertex"}},
+    "slots": {"normal": {"kind": "normal", "default": "vertex"}, "uv": {"kind": "uv", "optional": True}},
 }
 
 

@@ -5,5 +5,5 @@ Hoffman & Baker 2006, "shift-invariant" BRDFs: parameters constant over the surf
 BRICK = {
     "kind": "packing",
     "cite": "Hoffman & Baker 2006, shift-invariant BRDF parameters",
-    "slots": {"normal": {"kind": "normal", "default": "vertex"}},
+    "slots": {"normal": {"kind": "normal", "default": "vertex"}, "uv": {"kind": "uv", "optional": True}},
 }

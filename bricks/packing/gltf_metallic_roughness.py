@@ -31,7 +31,7 @@ BRICK = {
     },
     "textures": {"base_color_map": {"srgb": True, "doc": "sRGB RGB: base color; A not read"},
                  "orm_map": {"srgb": False, "doc": "linear; R: occlusion (not read, indirect light only); G: roughness; B: metallic"}},
-    "slots": {"normal": {"kind": "normal", "default": "vertex"}},
+    "slots": {"normal": {"kind": "normal", "default": "vertex"}, "uv": {"kind": "uv", "optional": True}},
 }
 
 

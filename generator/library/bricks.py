@@ -52,7 +52,7 @@ class Brick:
     display_path: str
     module: ir.Module
     params: dict[str, Param]
-    slots: dict[str, dict]  # slot name -> {"kind": k, "default": filler id}
+    slots: dict[str, dict]  # slot name -> {"kind": k, "default": filler id} or {"kind": k, "optional": True}
     textures: dict[str, dict]
     cite: str
     doc: str
@@ -344,9 +344,16 @@ def _slots(shown, loc, raw) -> dict[str, dict]:
     if not isinstance(raw, dict):
         raise _meta_error(shown, loc, "'slots' must be a dict", 'write "slots": {"ndf": {"kind": "ndf", "default": "ggx"}}')
     for name, s in raw.items():
-        if not isinstance(s, dict) or s.get("kind") not in KINDS or not isinstance(s.get("default"), str):
+        if not isinstance(s, dict) or s.get("kind") not in KINDS:
             raise _meta_error(shown, loc, f"slot '{name}' needs a kind and a default filler",
                               '"slots": {"ndf": {"kind": "ndf", "default": "ggx"}}')
+        # an optional slot has no default: left empty it is not in the key and nothing fills it
+        if s.get("optional") is True and "default" not in s:
+            continue
+        if not isinstance(s.get("default"), str) or "optional" in s:
+            raise _meta_error(shown, loc, f"slot '{name}' needs a default filler, or \"optional\": True and none",
+                              '"slots": {"ndf": {"kind": "ndf", "default": "ggx"}} or {"uv": {"kind": "uv", '
+                              '"optional": True}}')
     return raw
 
 

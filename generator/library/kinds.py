@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..lang.types import FLOAT, VEC3, VEC4, Type
+from ..lang.types import FLOAT, VEC2, VEC3, VEC4, Type
 
 
 @dataclass(frozen=True)
@@ -83,6 +83,11 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
     # the glue passes the shading normal N' (what `normal` returned) as Np and sets B' = N' × T' (link/glue.py)
     Kind("normal", (Entry("normal", VEC3), Entry("tangent", VEC3, (Arg("Np", VEC3, required=True),), optional=True)),
          "surface", doc="the shading normal (and, optionally, the shading tangent)"),
+    # `uv`: `map_uv` gives the texture coordinates every texture of the material is sampled at (KHR_texture_transform);
+    # it fills a packing's optional slot `uv`: the glue calls it once, before the packing, and binds what it returns
+    # wherever a later entry reads `uv` (link/glue.py uv_transform). An empty slot: the interpolated uv, no call.
+    Kind("uv", (Entry("map_uv", VEC2),), "surface",
+         doc="the texture coordinates the material's textures are sampled at (an optional slot of a packing)"),
     Kind("output", (Entry("output", VEC4, (Arg("color", VEC3, required=True),)),), "surface",
          doc="the output transform of the outgoing radiance"),
 )}

@@ -38,8 +38,8 @@ BRICK_SCHEMA = {
                            "range": {"type": "array", "items": NUMBER, "minItems": 2, "maxItems": 2},
                            "count": {"type": "integer", "minimum": 1}}}},
         "slots": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
-            "type": "object", "additionalProperties": False, "required": ["kind", "default"],
-            "properties": {"kind": {"type": "string"}, "default": IDENT}}},
+            "type": "object", "additionalProperties": False, "required": ["kind"],
+            "properties": {"kind": {"type": "string"}, "default": IDENT, "optional": {"const": True}}}},
         "textures": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
             "type": "object", "additionalProperties": False,
             "properties": {"srgb": {"type": "boolean"}, "doc": {"type": "string"},

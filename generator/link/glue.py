@@ -142,6 +142,7 @@ class _Binder:
         self.textures: list[Texture] = []
         self.params: dict[str, Type] = {}  # shade() parameters for values (m_*, l<i>_*, o_*)
         self.surface: set[str] = set()
+        self.uv: ir.Expr | None = None  # the packing's uv filler's result (uv_transform): what a read of uv gets
 
     def call(self, prog: Program, node: Node, fname: str, prefix: str, group: str, light: int | None,
              locals_: dict[str, Type], args: dict[str, ir.Expr] | None = None) -> ir.Call:
@@ -162,6 +163,9 @@ class _Binder:
                 out.append(self.b.var("Ng", VEC3, "param"))  # surface bricks read the interpolated normal
             elif p.name in locals_:
                 out.append(self.b.var(p.name, locals_[p.name]))
+            elif p.name == "uv" and self.uv is not None:
+                self.surface.add("uv")
+                out.append(self.b.copy(self.uv))
             elif p.name in SURFACE:
                 self.surface.add(p.name)
                 out.append(self.b.var(p.name, SURFACE[p.name], "param"))
@@ -189,7 +193,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     lights = []
 
     def body():
-        stmts = []
+        stmts = uv_transform(prog, b, bind, r.packing)
         for f in r.packing.brick.entries:
             name = f.name[len("get_"):]
             call = bind.call(prog, r.packing, f.name, "m_", "material", None, {})
@@ -274,6 +278,21 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
 
 
 VERTEX_COLOR = "vertex_color"  # shade()'s parameter: COLOR_0, interpolated (the templates' local of that name)
+UV_LOCAL = "uv_t"  # shade()'s local: the texture coordinates after the packing's uv filler
+
+
+def uv_transform(prog: Program, b: Builder, bind: _Binder, packing: Node,
+                 args: dict[str, ir.Expr] | None = None) -> list[ir.Stmt]:
+    """`uv_t = <filler>_map_uv(uv, …)` when the packing's optional slot `uv` is filled (KHR_texture_transform:
+    bricks/packing/uv/), and from then on every entry reading uv, and the glue's own samples, get uv_t: one
+    transform for all the material's textures. [] when the slot is empty: nothing is declared and the shader
+    is the one without the slot. Called before anything that samples (shade(), a stage sampling the coverage)."""
+    node = dict(packing.fillers).get("uv")
+    if node is None:
+        return []
+    call = bind.call(prog, node, "map_uv", "m_", "material", None, {}, args)
+    bind.uv = b.var(UV_LOCAL, SURFACE["uv"])
+    return [b.decl(UV_LOCAL, call)]
 
 
 def surface_inputs(b: Builder, bind: _Binder, r: Resolved, bg: BrdfGlue, provided: dict) -> list[ir.Stmt]:
@@ -307,7 +326,8 @@ def _sample(b: Builder, bind: _Binder, tname: str, param: str, srgb: bool) -> ir
         bind.textures.append(Texture(tname, param, "material", srgb, "2d"))
     bind.surface.add("uv")
     tex = bind.b.var(tname, texture_type("2d"), "param")
-    return b.intrinsic("sample", VEC4, tex, b.var("uv", SURFACE["uv"], "param"))
+    uv = b.copy(bind.uv) if bind.uv is not None else b.var("uv", SURFACE["uv"], "param")
+    return b.intrinsic("sample", VEC4, tex, uv)
 
 
 def emission(b: Builder, bind: _Binder, sf) -> list[ir.Stmt]:

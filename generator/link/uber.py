@@ -32,6 +32,7 @@ from .glue import _Binder, brdf_glue, has_tangent, read_slot, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, layout
 from .irgen import Builder
 from .program import Program
+from .glue import UV_LOCAL  # the ubershader's variants share the specialized glue's uv local
 
 IVEC4 = vector("int", 4)
 
@@ -200,11 +201,20 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         stmts.append(b.decl("N", b.construct(VEC3, b.const(0.0))))
         if twisted:  # the BRDFs' frame: the interpolated T, B unless the variant's normal filler gives T'
             stmts += [b.decl("Ts", b.var("T", VEC3, "param")), b.decl("Bs", b.var("B", VEC3, "param"))]
+        uvs = [dict(pk.fillers).get("uv") for pk in packings]  # the variants' uv fillers (glue.uv_transform)
+        if any(uvs):  # uv_t: the interpolated uv, or in a variant with a filler what the filler returns
+            bind.surface.add("uv")
+            stmts.append(b.decl(UV_LOCAL, b.var("uv", SURFACE["uv"], "param")))
         cases = []
         for k, pk in enumerate(packings):
             args = material_args(k)
-            case = [b.assign(b.var(f"p_{f.name[len('get_'):]}", f.ret),
-                             bind.call(prog, pk, f.name, "m_", "material", None, {}, args)) for f in pk.brick.entries]
+            case = []
+            if uvs[k] is not None:
+                case.append(b.assign(b.var(UV_LOCAL, SURFACE["uv"]),
+                                     bind.call(prog, uvs[k], "map_uv", "m_", "material", None, {}, args)))
+                args = {**args, "uv": b.var(UV_LOCAL, SURFACE["uv"])}
+            case += [b.assign(b.var(f"p_{f.name[len('get_'):]}", f.ret),
+                              bind.call(prog, pk, f.name, "m_", "material", None, {}, args)) for f in pk.brick.entries]
             normal = dict(pk.fillers)["normal"]
             case.append(b.assign(b.var("N", VEC3), bind.call(prog, normal, normal.brick.entries[0].name, "m_",
                                                             "material", None, {}, args)))

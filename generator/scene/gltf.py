@@ -31,7 +31,12 @@ Its packing follows the textures present (each changes the shader, so each chang
     note). A primitive with COLOR_0 draws with vertex_color: its material is mapped a second time, as
     `<name>+COLOR_0`, since the shader differs. alphaMode, alphaCutoff and doubleSided stay recorded on
     GltfMaterial and on every object too.
-  - texCoord ≠ 0 in a textureInfo is an error (the bricks read one UV set, TEXCOORD_0).
+  - KHR_texture_transform → the packing's optional slot `uv=texture_transform` (uv_offset, uv_scale,
+    uv_rotation = offset, scale, rotation), one transform for all the textures the material samples; an
+    identity transform or none leaves the key as without it; textures with different transforms are an
+    error (scene/texture_transform.py).
+  - a texCoord ≠ 0 (the textureInfo's, or the KHR_texture_transform one that overrides it) is an error (the
+    bricks read one UV set, TEXCOORD_0).
   - every material is mapped and checked, used or not (as a TOML scene's materials); only the ones
     objects use make permutations. Each texture a material binds gets its image and sampler read from the
     file (scene/gltf_images.py): a missing, unreadable or corrupt image is an error at /images/N.
@@ -88,6 +93,7 @@ from ..lang.errors import read_bytes
 from ..library.bricks import Library
 from ..spec.permutation import LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
 from ..spec.resolve import check_packing, light_params, resolve
+from . import texture_transform
 from .jsonpos import origins
 from .load import Light, Material, Scene, surface_specs
 from ..spec.surface import EMISSIVE_MAP, Surface
@@ -101,13 +107,14 @@ SHADING_EXTENSIONS = {  # change what the shader computes; no brick implements t
     "KHR_materials_clearcoat", "KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_ior",
     "KHR_materials_specular", "KHR_materials_sheen", "KHR_materials_iridescence", "KHR_materials_anisotropy",
     "KHR_materials_dispersion", "KHR_materials_diffuse_transmission", "KHR_materials_unlit",
-    "KHR_materials_pbrSpecularGlossiness", "KHR_texture_transform", "KHR_materials_variants",
+    "KHR_materials_pbrSpecularGlossiness", "KHR_materials_variants",
 }
 ACCEPTED_EXTENSIONS = {  # do not change the shader (or are mapped here): accepted, listed in scene.notes
     "KHR_lights_punctual": "mapped to the scene's lights",
     "KHR_mesh_quantization": "quantized attributes are decoded on import",
     "KHR_materials_emissive_strength": "emissiveStrength scales the emissive parameter",
     "KHR_texture_basisu": "an image encoding: a texture's core source image is read (Basis KTX2 is not)",
+    "KHR_texture_transform": "mapped to the packing's uv slot (texture_transform), one transform per material",
     "KHR_xmp_json_ld": "metadata",
     "KHR_animation_pointer": "animation, not shading",
 }
@@ -709,10 +716,7 @@ def _texture_info(rd: _Reader, d: dict, key: str, ptr: str) -> dict | None:
         return None
     here = f"{ptr}/{key}"
     ti = rd.ref(info, "index", here, "textures")
-    tc = rd.get(info, "texCoord", here, "int", 0)
-    if tc != 0:
-        raise rd.err(f"{here}/texCoord", f"texture coordinate set {tc} is not supported: the bricks read TEXCOORD_0",
-                     "move the texture to UV set 0")
+    texture_transform.check_texcoord(rd, info, here)  # TEXCOORD_0 (KHR_texture_transform may choose the set)
     tex = rd.array("textures")[ti]
     src = rd.ref(tex, "source", _ptr("textures", ti), "images", None)
     if "sampler" in tex:
@@ -757,23 +761,27 @@ def _material(rd: _Reader, lib: Library, i, m: dict, name: str, notes: list, col
         notes.append(f"material '{name}': occlusionTexture is not read (it scales indirect light; "
                      "the light loop has direct lights only)")
     normal = "normal_map" if tex_n is not None else "vertex"
+    sampled = [(pbr, "baseColorTexture", pptr), (pbr, "metallicRoughnessTexture", pptr), (m, "normalTexture", ptr)]
+    sampled += [(m, "emissiveTexture", ptr)] if any(c * strength for c in emissive) else []
+    uv, uv_params = texture_transform.of_material(rd, sampled)  # KHR_texture_transform: the packing's uv slot
     r2 = roughness * roughness
     textures: dict = {}
     if tex_n is not None:
         textures["normal_map"] = tex_n
     if tex_base is None and tex_mr is None:
-        packing = f"constants(normal={normal})"
+        packing = f"constants(normal={normal}{uv})"
         params = {"rho_d": [c * (1.0 - metallic) for c in base[:3]],
                   "f0": [0.04 + (c - 0.04) * metallic for c in base[:3]], "alpha": r2}
     elif tex_mr is None and metallic == 0.0:
-        packing = f"albedo_texture(normal={normal})"
+        packing = f"albedo_texture(normal={normal}{uv})"
         params = {"rho_d": base[:3], "f0": [0.04, 0.04, 0.04], "alpha": r2}
         textures["albedo_map"] = tex_base
     else:
-        packing = f"gltf_metallic_roughness(normal={normal})"
+        packing = f"gltf_metallic_roughness(normal={normal}{uv})"
         params = {"base_color": base[:3], "metallic": metallic, "roughness": roughness}
         textures["base_color_map"] = tex_base or "white"
         textures["orm_map"] = tex_mr or "white"
+    params.update(uv_params)
     # the surface state (spec/surface.py): each part only where it changes what the shader computes
     lit = [c * strength for c in emissive]
     surface = Surface(alpha=alpha_mode.lower(), double_sided=double, vertex_color=colors,

@@ -4,8 +4,8 @@ A spec names bricks and their slot fillers:
     lambert+microfacet(ndf=ggx,fresnel=schlick,vis=smith_schlick)
     albedo_texture(normal=normal_map)
 Canonical form: every slot written out (defaults included) in the brick's
-declared slot order, no spaces. The hash of the canonical key names files;
-raw strings from users never do.
+declared slot order, no spaces; an optional slot (no default) only when filled.
+The hash of the canonical key names files; raw strings from users never do.
 """
 from __future__ import annotations
 
@@ -143,6 +143,8 @@ def parse_spec(spec: str, lib: Library, kinds) -> list[Node]:
         fillers = []
         for sname, s in brick.slots.items():
             node = given.get(sname)
+            if node is None and s.get("optional"):
+                continue  # an optional slot left empty: no filler, nothing in the key
             if node is None:
                 dflt = lib.get(s["kind"], s["default"])
                 if dflt is None:
@@ -165,6 +167,8 @@ def _default_fillers(brick: Brick, lib: Library, spec: str, col: int, chain: tup
     chain = (*chain, (brick.kind, brick.id))
     out = []
     for sname, s in brick.slots.items():
+        if s.get("optional"):
+            continue
         d = lib.get(s["kind"], s["default"])
         if d is None:
             raise SpecError(spec, col, f"default filler '{s['default']}' of slot '{sname}' is missing", "")

@@ -18,7 +18,7 @@ def rows(lib) -> list[dict]:
         out.append({
             "id": bid, "kind": kind, "path": b.display_path, "cite": b.cite,
             "summary": b.doc.splitlines()[0] if b.doc else "",
-            "slots": {s: {"kind": v["kind"], "default": v["default"],
+            "slots": {s: {"kind": v["kind"], "default": v.get("default"),  # None: an optional slot, empty unless filled
                           "fillers": [x.id for x in lib.of_kind(v["kind"])]} for s, v in b.slots.items()},
             "params": {p.name: {"type": str(p.ty), "range": list(p.range) if p.range else None,
                                 "default": p.default, "doc": p.doc} for p in b.params.values()},
@@ -37,7 +37,8 @@ def run(args) -> int:
         print(f"{r['kind']:<10} {r['id']:<24} {r['summary']}")
         print(f"{'':<35}cite: {r['cite']}")
         for s, v in r["slots"].items():
-            print(f"{'':<35}slot {s} ({v['kind']}, default {v['default']}): {', '.join(v['fillers'])}")
+            dflt = f"default {v['default']}" if v["default"] else "optional, empty by default"
+            print(f"{'':<35}slot {s} ({v['kind']}, {dflt}): {', '.join(v['fillers'])}")
         for name, p in r["params"].items():
             rng = f" in [{p['range'][0]}, {p['range'][1]}]" if p["range"] else ""
             print(f"{'':<35}param {name}: {p['type']}{rng}, default {p['default']}")
