@@ -104,6 +104,7 @@ def named(manifest: dict) -> set[str]:
         for p, d in (e.get("platforms") or {}).items():
             out.update(a["path"] for item in d.get("stages", {}).values() for a in item.values())
     out.update(t["path"] for t in manifest.get("tables", []))  # baked lookup tables (assemble/tables.py)
+    out.update(t["path"] for t in manifest.get("textures", []))  # the materials' images (assemble/texture_outputs.py)
     return out
 
 
