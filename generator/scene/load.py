@@ -64,8 +64,11 @@ class Locator:
 
     def find(self, header: str, *keys: str, nth: int = 0) -> tuple[int, int]:
         """(line, col) of header's key path (keys may continue inside an inline table)."""
-        if header and keys and header != "objects" and self._header(f"{header}.{keys[0]}") >= 0:
-            return self.find(f"{header}.{keys[0]}", *keys[1:])  # a sub-table: [materials.m.params]
+        if header and keys and header != "objects":
+            for j in range(len(keys), 0, -1):  # the deepest sub-table: [materials.m.params], [materials.m.samplers.t]
+                sub = ".".join((header, *keys[:j]))
+                if self._header(sub) >= 0:
+                    return self.find(sub, *keys[j:])
         start = self._header(header, nth) if header else -1
         if header and start < 0:
             return 1, 1

@@ -222,3 +222,33 @@ def test_holds_must_agree_with_the_declarations_colour_space(tmp_path):
     with pytest.raises(SourceError) as e:
         load_brick(tmp_path / "p.py", text.replace('"srgb": True, "holds": "normal"', '"keep_length": True'))
     assert "marked keep_length but holds 'data'" in str(e.value), str(e.value)
+
+
+def test_sub_tables_are_located_at_their_own_lines(tmp_path, lib):
+    """`[materials.m.textures]` and `[materials.m.samplers.t]` tables: errors at the key, not the material."""
+    mats = '''
+[materials.wood]
+brdf = "lambert+phong_normalized"
+packing = "albedo_texture(normal=normal_map)"
+
+[materials.wood.textures]
+albedo_map = "tex/wood.png"
+normal_map = "tex/gone.png"
+
+[materials.wood.samplers.albedo_map]
+wrap = "clamp"
+anisotropy = 2
+'''
+    path = write_scene(tmp_path, mats)
+    with pytest.raises(SourceError) as e:
+        load_scene(path, lib)
+    assert str(e.value).startswith(f"{path}:{_at(path.read_text(), 'normal_map = ')[0]}:1: image 'tex/gone.png'"), \
+        str(e.value)
+    path.write_text(path.read_text().replace("tex/gone.png", "tex/wood_n.png").replace("anisotropy = 2", "anisotropy = 99"))
+    with pytest.raises(SourceError) as e:
+        load_scene(path, lib)
+    assert str(e.value).startswith(f"{path}:{_at(path.read_text(), 'anisotropy = 99')[0]}:1: sampler 'albedo_map'"), \
+        str(e.value)
+    path.write_text(path.read_text().replace("anisotropy = 99", "anisotropy = 2"))
+    s = load_scene(path, lib).materials["wood"].images["albedo_map"].sampler
+    assert (s.wrap_u, s.wrap_v, s.anisotropy) == ("clamp", "clamp", 2)
