@@ -3,11 +3,12 @@
     .venv/bin/python scripts/gen_reference.py [DIR]     (`make reference`; DIR defaults to docs/reference)
 
 Every page is a pure function of the code it documents (the argparse parser of generator/cli/, what
-`shadermatrix bricks --json` prints, the tables of generator/lang/ and generator/library/, the manifest
-field descriptions of scripts/reference_manifest.py), so the output is deterministic: no times, no
+`shadermatrix bricks --json` prints, the tables of generator/lang/ and generator/library/, the manifest's
+JSON Schema generator/assemble/manifest.schema.json, rendered by scripts/reference_manifest.py and copied
+beside the page), so the output is deterministic: no times, no
 absolute paths, no terminal width. tests/project/test_docs_reference.py regenerates into a temporary directory and
 fails on any difference. Before the manifest page is written, scenes/example.toml is built (with --pack)
-into a temporary directory and every key of its manifest.json must be described (--no-build skips that
+into a temporary directory and its manifest.json must validate against the schema (--no-build skips that
 check, which needs the pinned tools).
 """
 from __future__ import annotations
@@ -22,10 +23,10 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import reference_manifest  # noqa: E402  (this script's sibling: the manifest's field descriptions)
+import reference_manifest  # noqa: E402  (this script's sibling: the manifest's schema as a page)
 
 COMMAND = "make reference"
-PAGES = ("README.md", "cli.md", "bricks.md", "language.md", "manifest.md")
+PAGES = ("README.md", "cli.md", "bricks.md", "language.md", "manifest.md", "manifest.schema.json")
 WIDTH = 100  # the usage lines' width: fixed, so the page does not depend on the terminal
 
 
@@ -298,21 +299,23 @@ def render_index() -> str:
                                            "citation"],
                 ["[language.md](language.md)", "the brick language: types, intrinsics, constants, kind contracts, "
                                                "shading and surface inputs, BRICK metadata"],
-                ["[manifest.md](manifest.md)", "every field of a build's manifest.json"]])
+                ["[manifest.md](manifest.md)", "every field of a build's manifest.json, from its JSON Schema "
+                                               "[manifest.schema.json](manifest.schema.json)"]])
             + f"\nRegenerate them with `{COMMAND}` after changing the code they describe.\n")
 
 
 def render_all() -> dict[str, str]:
     return {"README.md": render_index(), "cli.md": render_cli(), "bricks.md": render_bricks(),
             "language.md": render_language(),
-            "manifest.md": reference_manifest.render(header("manifest.json", "scripts/reference_manifest.py"))}
+            "manifest.md": reference_manifest.render(header("manifest.json", reference_manifest.SCHEMA_PATH)),
+            "manifest.schema.json": reference_manifest.schema_text()}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
     ap.add_argument("dir", nargs="?", default=str(REPO / "docs" / "reference"), help="where to write the pages")
     ap.add_argument("--no-build", action="store_true",
-                    help="skip building scenes/example.toml to check every manifest key is described")
+                    help="skip building scenes/example.toml to validate its manifest against the schema")
     args = ap.parse_args(argv)
     from generator.io import atomic_write
     pages = render_all()

@@ -60,6 +60,17 @@ def eval_session():
         assert dev.messages == [], "while closing: " + "\n".join(map(str, dev.messages))
 
 
+# Every manifest a test's build writes is validated against the shipped schema first (generator/assemble/manifest.py
+# reads this variable), in this process and in the commands a test starts: a field a build writes that the schema
+# does not describe fails the test that wrote it. tests/assemble/test_manifest_schema.py checks it is set.
+CHECK_MANIFEST_ENV = "SHADERMATRIX_CHECK_MANIFEST"
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _check_manifests():
+    os.environ[CHECK_MANIFEST_ENV] = "1"
+
+
 @pytest.fixture(autouse=True)
 def _test_tier(request, monkeypatch):
     """Tiers do not leak: only `toolchain` tests run external tools, only `lavapipe` ones open a device.

@@ -29,6 +29,7 @@ from . import state
 from .context import BuildContext
 from .keys import build_key, scene_keys
 from .loop import compile_permutations
+from .manifest import FORMAT_VERSION, check as check_manifest, material_states, render_state
 from .outputs import clean_leftovers, collect_garbage, locked, shown, write_depfile
 from .platforms import PLATFORMS
 from .reflection import scene_tables
@@ -175,6 +176,7 @@ class _Build:
         else:
             uber = self._ubershader(uber_unit, compiled.results, old_uber)
         res.manifest = {
+            "format_version": FORMAT_VERSION,
             "generator": f"shadermatrix {__version__}",
             "scene": scene.name,
             "tools": self.tools,
@@ -182,7 +184,7 @@ class _Build:
             "platforms": list(self.ctx.platforms),
             "permutations": entries,
             "ubershader": uber,
-            **scene_tables(scene, compiled.composed, self.previous),
+            **material_states(scene, scene_tables(scene, compiled.composed, self.previous)),
         }
         from .depth import write_depth_passes  # the shadowed lights' depth passes: their shaders, their descriptions
         write_depth_passes(self)
@@ -192,7 +194,7 @@ class _Build:
     def _head(self, h: str) -> dict:
         perm = self.scene.permutations[h]
         return {"id": perm.canonical(), "hash": h, "input_key": self.keys.permutations[h],
-                "objects": self.scene.users.get(h, []), "languages": {}}
+                "objects": self.scene.users.get(h, []), "languages": {}, "render_state": render_state(perm.surface)}
 
     def _written(self, pairs, part) -> None:
         """A compiled chunk: written and analysed while the next chunks compile."""
@@ -228,6 +230,7 @@ class _Build:
         if self.pack:  # written before the manifest that names them (content-named: the old ones stay until after it)
             from .pack import write_packs
             res.manifest["packs"] = write_packs(out, res.manifest, self.writer.count)
+        check_manifest(res.manifest)  # before it replaces the last one (SHADERMATRIX_CHECK_MANIFEST: the tests)
         if res.manifest == previous and (out / "manifest.json").is_file():  # nothing changed: not even re-encoded
             self.writer.count(False)
             text = (out / "manifest.json").read_bytes()
