@@ -23,15 +23,10 @@ from dataclasses import dataclass, field
 
 from ..lang.types import FLOAT, VEC4
 from ..library.inputs import SURFACE
-from .glue import VERTEX_COLOR, _Binder, coverage, coverage_alpha
+from .glue import VERTEX_COLOR, _Binder, coverage, coverage_alpha, uv_transform
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, INTERPOLANTS, Block, Interface, Location, Texture
 from .irgen import Builder
 from .program import Program
-
-try:  # the packing's uv filler (KHR_texture_transform): a glue without one reads uv as it is
-    from .glue import uv_transform as _uv_transform
-except ImportError:
-    _uv_transform = None
 
 DEPTH, BLUR = "depth", "blur"  # the units every scene with a shadowed light shares
 MASK, MASK_MOMENTS = "mask", "mask_moments"  # per masked permutation: "<hash>.mask", "<hash>.mask_moments"
@@ -108,9 +103,9 @@ def mask_program(lp, moments: bool = False, lib_memo: dict | None = None) -> Mas
     def body():
         stmts = []
         uv_node = dict(r.packing.fillers).get("uv")
-        if _uv_transform is not None and uv_node is not None:  # the colour pass's transformed uv, read alike
+        if uv_node is not None:  # the packing's uv filler (KHR_texture_transform): the colour pass's uv, read alike
             prog.link(uv_node)
-            stmts += _uv_transform(prog, b, bind, r.packing)
+            stmts += uv_transform(prog, b, bind, r.packing)
         cov = coverage(b, bind, r)
         return stmts + [b.decl("coverage", cov), b.ret(coverage_alpha(b, r.surface))]
 

@@ -117,6 +117,17 @@ def test_the_textured_mask_samples_the_albedo_and_the_vertex_colour_mask_reads_c
     assert kinds[True] == (["P", "color"], [])
 
 
+def test_the_textured_mask_reads_uv_through_the_packing_s_transform_as_the_colour_pass_does(units):
+    composed, _, _, masked = units
+    h, lp = next((h, lp) for h, lp in masked.items() if not lp.perm.surface.vertex_color)
+    glsl = next(s.text for s in composed[f"{h}.mask"].sources if s.language == "glsl" and s.stage == "frag")
+    colour = {s.name: s for s in lp.material}
+    for name in ("m_uv_offset", "m_uv_scale", "m_uv_rotation", "m_base_alpha", "m_alpha_cutoff"):
+        s = colour[name]  # read at the colour pass's slot of the same Material block
+        assert f"material.data[{s.index}]{s.swizzle}" in glsl, name
+    assert "texture_transform_map_uv(uv," in glsl and "uv_t).w" in glsl  # the coverage samples the transformed uv
+
+
 @pytest.mark.parametrize("lang", LANGS)
 def test_the_blur_reads_the_moments_texture_and_its_block_and_writes_moments(units, lang):
     _, results, _, _ = units
