@@ -5,11 +5,11 @@ to graphics: :class:`Device` owns the instance, the logical device, one queue
 (graphics+compute when the family has both), a command pool and the list of
 validation messages; :mod:`.compute` builds pipelines on top of it.
 
-Textures (runtime/images.py): :class:`Image` is a sampled 2D or cube image (level 0 only) uploaded
-from a NumPy array through a staging buffer; :class:`Sampler` is the one filter
-the project uses, exactly the one the NumPy target reproduces
+Textures (runtime/images.py): :class:`Image` is a sampled 2D or cube image (level 0, or a mip chain)
+uploaded from NumPy arrays through a staging buffer; :class:`Sampler` is by default the
+project's own filter, exactly the one the NumPy target reproduces
 (generator/backends/numpy/resources.py): bilinear, clamp-to-edge, texel centres
-at (i + 0.5) / W, level 0.
+at (i + 0.5) / W, level 0; or a sampler state a manifest spells for Vulkan.
 
 With ``validation=True`` the Khronos validation layer is enabled and a
 VK_EXT_debug_utils messenger (also chained into instance creation, so messages
@@ -171,6 +171,7 @@ class Device:
         self.compile_only = compile_only
         self.messages: list[ValidationMessage] = []
         self.features: dict[str, bool] = {}  # fp16 features the device reports (filled in by _open)
+        self.sampler_anisotropy = False  # samplerAnisotropy, enabled where the device has it (samplers may filter so)
         self.handle = self.instance = self._messenger = self.command_pool = self.fence = None
         self._owned: list = []  # objects with destroy(), released in reverse order by close()
         self._user = vk.ffi.cast("void *", id(self))
@@ -255,8 +256,13 @@ class Device:
             features = vk.VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR(pNext=f16,
                                                                                   pipelineExecutableInfo=vk.VK_TRUE)
         features = features if features is not None else f16
+        # anisotropic filtering is an optional feature: a scene's sampler asks for it (runtime/images.Sampler clamps
+        # the state to 1 where the device lacks it, and says so)
+        self.sampler_anisotropy = bool(vk.vkGetPhysicalDeviceFeatures(self.physical).samplerAnisotropy)
         self.handle = vk.vkCreateDevice(self.physical, vk.VkDeviceCreateInfo(
-            pNext=features, pQueueCreateInfos=[queue_info], pEnabledFeatures=vk.VkPhysicalDeviceFeatures(),
+            pNext=features, pQueueCreateInfos=[queue_info],
+            pEnabledFeatures=vk.VkPhysicalDeviceFeatures(samplerAnisotropy=vk.VK_TRUE if self.sampler_anisotropy
+                                                         else vk.VK_FALSE),
             ppEnabledExtensionNames=self.extensions), None)
         del features, f16, s16  # alive across the call
         if self.compile_only:

@@ -1,9 +1,11 @@
-"""Sampled images and the one sampler of the project, on a :class:`~.device.Device`.
+"""Sampled images and samplers, on a :class:`~.device.Device`.
 
-:class:`Image` is a sampled 2D or cube image (level 0 only) uploaded from a NumPy array
-through a staging buffer; :class:`Sampler` is the one filter the project uses, exactly the
-one the NumPy target reproduces (generator/backends/numpy/resources.py): bilinear,
-clamp-to-edge, texel centres at (i + 0.5) / W, level 0.
+:class:`Image` is a sampled 2D or cube image uploaded from NumPy arrays through a staging buffer: level 0,
+and optionally the rest of its mip chain (a texture artifact's levels, io/ktx2.decode_levels).
+:class:`Sampler` is by default the project's own filter, exactly the one the NumPy target reproduces
+(generator/backends/numpy/resources.py): bilinear, clamp-to-edge, texel centres at (i + 0.5) / W, level 0;
+given a state in Vulkan's words (a manifest's ``samplers[i].platforms.vulkan``, assemble/samplers.py) it is
+that state, with what the device cannot do clamped and said in :attr:`Sampler.notes`.
 """
 from __future__ import annotations
 
@@ -69,8 +71,15 @@ def texels(data, cube: bool | None = None) -> tuple[np.ndarray, bool]:
     return np.ascontiguousarray(a), bool(cube)
 
 
+def _level_shape(height: int, width: int, i: int) -> tuple[int, int]:
+    """Level i's (H, W) under the floor convention of Vulkan and KTX2: max(1, H >> i) × max(1, W >> i)."""
+    return max(1, height >> i), max(1, width >> i)
+
+
 class Image:
-    """A sampled image of level 0 only: 2D, or cube (6 layers, CUBE_COMPATIBLE, a CUBE view).
+    """A sampled image: 2D, or cube (6 layers, CUBE_COMPATIBLE, a CUBE view); level 0, and its further mip
+    levels when `mips` gives them (level i of max(1, H >> i) × max(1, W >> i) texels, same dtype and channels;
+    any number of levels up to the full chain; the view covers them all).
 
     Formats: float32 texels are VK_FORMAT_R32G32B32A32_SFLOAT, float16 R16G16B16A16_SFLOAT; uint8 texels are
     R8G8B8A8_UNORM, or R8G8B8A8_SRGB with ``srgb=True`` (sampling then decodes
@@ -83,39 +92,57 @@ class Image:
     """
 
     aspect = "VK_IMAGE_ASPECT_COLOR_BIT"  # the aspect that holds the texels (DepthImage: the depth aspect)
+    levels = 1  # mip levels (the subclasses that draw or upload depth have one)
 
-    def __init__(self, device: "Device", data, srgb: bool = False, cube: bool | None = None):
+    def __init__(self, device: "Device", data, srgb: bool = False, cube: bool | None = None, mips=()):
         vk = device.vk
         arr, self.cube = texels(data, cube)
         self.device, self.srgb = device, bool(srgb)
         self.layers, self.height, self.width = arr.shape[:3]
         self.dtype = arr.dtype
+        more = self._mip_levels(mips)
+        self.levels = 1 + len(more)
         self.format = _image_format(vk, arr.dtype, self.srgb)
         self.layout = vk.VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
-        self.nbytes = arr.nbytes
+        self.nbytes = arr.nbytes + sum(m.nbytes for m in more)
         feats = vk.vkGetPhysicalDeviceFormatProperties(device.physical, self.format).optimalTilingFeatures
         need = (vk.VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | vk.VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT
                 | FORMAT_FEATURE_TRANSFER_DST)
         if feats & need != need:
             raise VulkanUnavailable(f"{device.name} cannot sample format {self.format} with linear filtering "
                                     "from optimal tiling")
-        self._realize(arr)
+        self._realize(arr, more)
 
-    def _realize(self, arr: np.ndarray) -> None:
+    def _mip_levels(self, mips) -> list[np.ndarray]:
+        """Levels 1, 2, … as (layers, h, w, 4) arrays of this image's dtype, each checked against its size."""
+        out = []
+        full = max(self.width, self.height).bit_length()  # floor(log2(max(W, H))) + 1 levels down to 1 × 1
+        if len(mips) >= full:
+            raise ValueError(f"{1 + len(mips)} levels for a {self.width}x{self.height} image: its full chain has {full}")
+        for i, m in enumerate(mips, 1):
+            a, _ = texels(m, self.cube)
+            want = (self.layers, *_level_shape(self.height, self.width, i), 4)
+            if a.shape != want or a.dtype != self.dtype:
+                raise ValueError(f"mip level {i} is {a.shape[1:3]} {a.dtype}, not {want[1:3]} {self.dtype} "
+                                 f"(max(1, size >> {i}) texels of level 0's type)")
+            out.append(a)
+        return out
+
+    def _realize(self, arr: np.ndarray, mips=()) -> None:
         """Create the image, its memory and view from the attributes (format, width, height, layers, cube,
-        aspect, layout), upload `arr` (its texels already checked) and hand the image to its device; on
-        any failure release what was made (destroy) and re-raise."""
+        aspect, layout, levels), upload `arr` and its `mips` (the texels already checked) and hand the image
+        to its device; on any failure release what was made (destroy) and re-raise."""
         self.handle = self.memory = self.view = None
         try:
             self._create()
-            self._upload_staged(arr)
+            self._upload_staged(arr, mips)
         except BaseException:
             self.destroy()
             raise
         self.device.own(self)
 
     def _create(self) -> None:
-        """vkCreateImage (level 0, optimal tiling, SAMPLED | TRANSFER_DST; CUBE_COMPATIBLE for a cube),
+        """vkCreateImage (its levels, optimal tiling, SAMPLED | TRANSFER_DST; CUBE_COMPATIBLE for a cube),
         device-local memory and a 2D or CUBE view of the aspect; each handle is set as soon as it exists, so
         that destroy releases a partial creation."""
         vk, dev = self.device.vk, self.device.handle
@@ -123,7 +150,7 @@ class Image:
             flags=vk.VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT if self.cube else 0,
             imageType=vk.VK_IMAGE_TYPE_2D, format=self.format,
             extent=vk.VkExtent3D(width=self.width, height=self.height, depth=1),
-            mipLevels=1, arrayLayers=self.layers, samples=vk.VK_SAMPLE_COUNT_1_BIT,
+            mipLevels=self.levels, arrayLayers=self.layers, samples=vk.VK_SAMPLE_COUNT_1_BIT,
             tiling=vk.VK_IMAGE_TILING_OPTIMAL,
             usage=vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
             sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED), None)
@@ -139,24 +166,36 @@ class Image:
 
     def _range(self):
         vk = self.device.vk
-        return vk.VkImageSubresourceRange(aspectMask=getattr(vk, self.aspect), baseMipLevel=0, levelCount=1,
+        return vk.VkImageSubresourceRange(aspectMask=getattr(vk, self.aspect), baseMipLevel=0, levelCount=self.levels,
                                           baseArrayLayer=0, layerCount=self.layers)
 
-    def upload(self, data) -> None:
-        """Replace all texels (same shape and dtype) through a staging buffer; waits for the copy."""
+    def upload(self, data, mips=()) -> None:
+        """Replace all texels (same shape and dtype; `mips`: every further level the image has) through a
+        staging buffer; waits for the copy."""
         arr, _ = texels(data, self.cube)
         if arr.shape != (self.layers, self.height, self.width, 4) or arr.dtype != self.dtype:
             raise ValueError(f"upload of {arr.shape} {arr.dtype} into an image of "
                              f"{(self.layers, self.height, self.width, 4)} {self.dtype}")
-        self._upload_staged(arr)
+        more = self._mip_levels(mips)
+        if 1 + len(more) != self.levels:
+            raise ValueError(f"upload of {1 + len(more)} levels into an image of {self.levels}")
+        self._upload_staged(arr, more)
 
-    def _upload_staged(self, arr: np.ndarray) -> None:
-        """Copy `arr` (the bytes of every layer, tightly packed, already checked) into the image's aspect
-        through a staging buffer, UNDEFINED → TRANSFER_DST_OPTIMAL → :attr:`layout`; waits for the copy."""
+    def _upload_staged(self, arr: np.ndarray, mips=()) -> None:
+        """Copy `arr` (level 0: the bytes of every layer, tightly packed, already checked) and `mips` (levels
+        1, 2, …) into the image's aspect through one staging buffer, UNDEFINED → TRANSFER_DST_OPTIMAL →
+        :attr:`layout`; waits for the copy."""
         vk, device = self.device.vk, self.device
-        staging = device.buffer(arr.nbytes, vk.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
+        levels = [arr, *mips]
+        # each level at a multiple of 16 bytes: a copy's bufferOffset must be a multiple of the texel size
+        # (4, 8 or 16 here) and of 4
+        offsets = np.cumsum([0] + [-(-a.nbytes // 16) * 16 for a in levels])
+        staging = device.buffer(int(offsets[-1]), vk.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
         try:
-            staging.write(arr)
+            packed = np.zeros(int(offsets[-1]), np.uint8)
+            for a, at in zip(levels, offsets):
+                packed[at:at + a.nbytes] = np.frombuffer(np.ascontiguousarray(a).tobytes(), np.uint8)
+            staging.write(packed)
             rng = self._range()
             # Earlier submissions were waited for (Device.submit), so the first barrier needs no source
             # scope; UNDEFINED discards the old texels, all of which the copy replaces.
@@ -170,19 +209,21 @@ class Image:
                 oldLayout=vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, newLayout=self.layout,
                 srcQueueFamilyIndex=vk.VK_QUEUE_FAMILY_IGNORED, dstQueueFamilyIndex=vk.VK_QUEUE_FAMILY_IGNORED,
                 image=self.handle, subresourceRange=rng)
-            # Tightly packed layers one after another: one region covers them all.
-            region = vk.VkBufferImageCopy(
-                bufferOffset=0, bufferRowLength=0, bufferImageHeight=0,
-                imageSubresource=vk.VkImageSubresourceLayers(aspectMask=getattr(vk, self.aspect), mipLevel=0,
-                                                             baseArrayLayer=0, layerCount=self.layers),
-                imageOffset=vk.VkOffset3D(x=0, y=0, z=0),
-                imageExtent=vk.VkExtent3D(width=self.width, height=self.height, depth=1))
+            # Per level, its tightly packed layers one after another: one region covers them all.
+            regions = []
+            for i, at in enumerate(offsets[:-1]):
+                h, w = _level_shape(self.height, self.width, i)
+                regions.append(vk.VkBufferImageCopy(
+                    bufferOffset=int(at), bufferRowLength=0, bufferImageHeight=0,
+                    imageSubresource=vk.VkImageSubresourceLayers(aspectMask=getattr(vk, self.aspect), mipLevel=i,
+                                                                 baseArrayLayer=0, layerCount=self.layers),
+                    imageOffset=vk.VkOffset3D(x=0, y=0, z=0), imageExtent=vk.VkExtent3D(width=w, height=h, depth=1)))
 
             def record(cmd):
                 vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, vk.VK_PIPELINE_STAGE_TRANSFER_BIT,
                                         0, 0, None, 0, None, 1, [to_dst])
                 vk.vkCmdCopyBufferToImage(cmd, staging.handle, self.handle, vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                          1, [region])
+                                          len(regions), regions)
                 vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TRANSFER_BIT,
                                         vk.VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | vk.VK_PIPELINE_STAGE_VERTEX_SHADER_BIT
                                         | vk.VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, None, 0, None, 1, [to_read])
@@ -207,10 +248,16 @@ class Image:
         self.view = self.handle = self.memory = None
 
 
-class Sampler:
-    """The project's one sampler: exactly the filter the NumPy target reproduces.
+# the keys of a sampler state in Vulkan's words (assemble/samplers.py spells them so), as VkSamplerCreateInfo has them
+STATE_KEYS = ("magFilter", "minFilter", "mipmapMode", "addressModeU", "addressModeV", "addressModeW", "mipLodBias",
+              "anisotropyEnable", "maxAnisotropy", "compareEnable", "compareOp", "minLod", "maxLod")
 
-    VK_FILTER_LINEAR for min and mag (bilinear), mipmapMode NEAREST, minLod =
+
+class Sampler:
+    """A sampler: by default the project's one filter, exactly the one the NumPy target reproduces; or the
+    `state` given in Vulkan's words.
+
+    Default: VK_FILTER_LINEAR for min and mag (bilinear), mipmapMode NEAREST, minLod =
     maxLod = 0 (level 0 only), VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE on u, v and w,
     normalized coordinates (texel i's centre at (i + 0.5) / W), no anisotropy,
     no compare. generator/backends/numpy/resources.py computes the same bilinear
@@ -218,6 +265,12 @@ class Sampler:
     its sub-texel precision (see tests/runtime/test_runtime_images.py for lavapipe's).
     Cube views filter seamlessly across faces in Vulkan; the NumPy target clamps
     within a face, so they differ within half a texel of a face edge.
+
+    `state`: {VkSamplerCreateInfo member: value} for every key of :data:`STATE_KEYS`, enums by their names
+    (``"VK_SAMPLER_ADDRESS_MODE_REPEAT"``), as a manifest's ``samplers[i].platforms.vulkan`` spells them. What
+    the device cannot do is clamped, each change said in :attr:`notes`: anisotropy where the device has no
+    samplerAnisotropy feature (off: maxAnisotropy 1) or past its maxSamplerAnisotropy, a LOD bias past
+    maxSamplerLodBias. :attr:`state` is the state created.
     Owned by its device: released by Device.close unless destroyed earlier.
     """
 
@@ -225,19 +278,60 @@ class Sampler:
     compare_op: str | None = None
     border_color = "VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK"
 
-    def __init__(self, device: "Device"):
+    def __init__(self, device: "Device", state: dict | None = None):
         vk = device.vk
         self.device = device
-        clamp = vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
+        self.notes: list[str] = []
+        self.state = self._clamped(dict(state)) if state is not None else self._default()
+        st = self.state
+
+        def enum(key):
+            return getattr(vk, st[key])
+
         self.handle = vk.vkCreateSampler(device.handle, vk.VkSamplerCreateInfo(
-            magFilter=vk.VK_FILTER_LINEAR, minFilter=vk.VK_FILTER_LINEAR,
-            mipmapMode=vk.VK_SAMPLER_MIPMAP_MODE_NEAREST,
-            addressModeU=clamp, addressModeV=clamp, addressModeW=clamp, mipLodBias=0.0,
-            anisotropyEnable=vk.VK_FALSE, maxAnisotropy=1.0,
-            compareEnable=vk.VK_FALSE if self.compare_op is None else vk.VK_TRUE,
-            compareOp=getattr(vk, self.compare_op or "VK_COMPARE_OP_ALWAYS"), minLod=0.0, maxLod=0.0,
+            magFilter=enum("magFilter"), minFilter=enum("minFilter"), mipmapMode=enum("mipmapMode"),
+            addressModeU=enum("addressModeU"), addressModeV=enum("addressModeV"), addressModeW=enum("addressModeW"),
+            mipLodBias=float(st["mipLodBias"]),
+            anisotropyEnable=vk.VK_TRUE if st["anisotropyEnable"] else vk.VK_FALSE,
+            maxAnisotropy=float(st["maxAnisotropy"]),
+            compareEnable=vk.VK_TRUE if st["compareEnable"] else vk.VK_FALSE, compareOp=enum("compareOp"),
+            minLod=float(st["minLod"]), maxLod=float(st["maxLod"]),
             borderColor=getattr(vk, self.border_color), unnormalizedCoordinates=vk.VK_FALSE), None)
         device.own(self)
+
+    def _default(self) -> dict:
+        clamp = "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE"
+        return {"magFilter": "VK_FILTER_LINEAR", "minFilter": "VK_FILTER_LINEAR",
+                "mipmapMode": "VK_SAMPLER_MIPMAP_MODE_NEAREST", "addressModeU": clamp, "addressModeV": clamp,
+                "addressModeW": clamp, "mipLodBias": 0.0, "anisotropyEnable": False, "maxAnisotropy": 1.0,
+                "compareEnable": self.compare_op is not None, "compareOp": self.compare_op or "VK_COMPARE_OP_ALWAYS",
+                "minLod": 0.0, "maxLod": 0.0}
+
+    def _clamped(self, st: dict) -> dict:
+        """`st` checked for its keys and enum names, with what the device cannot do clamped (each change a note)."""
+        vk, limits = self.device.vk, self.device.limits
+        missing = [k for k in STATE_KEYS if k not in st]
+        if missing:
+            raise ValueError(f"a sampler state without {', '.join(missing)} (VkSamplerCreateInfo's members: "
+                             f"{', '.join(STATE_KEYS)})")
+        for k in ("magFilter", "minFilter", "mipmapMode", "addressModeU", "addressModeV", "addressModeW", "compareOp"):
+            if not (isinstance(st[k], str) and st[k].startswith("VK_") and isinstance(getattr(vk, st[k], None), int)):
+                raise ValueError(f"sampler {k} {st[k]!r} is not a Vulkan enum name")
+        aniso = float(st["maxAnisotropy"]) if st["anisotropyEnable"] else 1.0
+        if aniso > 1.0 and not getattr(self.device, "sampler_anisotropy", False):
+            self.notes.append(f"anisotropy {aniso:g} clamped to 1: {self.device.name} has no samplerAnisotropy")
+            aniso = 1.0
+        elif aniso > float(limits.maxSamplerAnisotropy):
+            self.notes.append(f"anisotropy {aniso:g} clamped to {limits.maxSamplerAnisotropy:g}, "
+                              f"{self.device.name}'s maxSamplerAnisotropy")
+            aniso = float(limits.maxSamplerAnisotropy)
+        st["anisotropyEnable"], st["maxAnisotropy"] = aniso > 1.0, aniso
+        bias, most = float(st["mipLodBias"]), float(limits.maxSamplerLodBias)
+        if abs(bias) > most:
+            st["mipLodBias"] = max(-most, min(most, bias))
+            self.notes.append(f"LOD bias {bias:g} clamped to {st['mipLodBias']:g}, {self.device.name}'s "
+                              "maxSamplerLodBias")
+        return st
 
     def destroy(self) -> None:
         dev = self.device.handle

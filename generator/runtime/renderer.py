@@ -29,8 +29,15 @@ light's shadow map (pcf: a `pcf_texel` the scene leaves unset is written as 1 / 
 too), the blurred moments as its `shadow_moments`. A `texture2d_shadow`
 (pcf_hardware) reads the depth pass's D32_SFLOAT image itself through a comparison sampler
 (runtime/depth_images.py: linear, compareOp LESS_OR_EQUAL), where no map is drawn a lit 1×1 depth image
-(depth 1.0); a device that cannot linearly filter D32_SFLOAT is refused for it. Other textures
-are generated: an sRGB albedo checker, a normal map of known bumps. The surface state of a permutation
+(depth 1.0); a device that cannot linearly filter D32_SFLOAT is refused for it.
+
+Material textures are the build's (runtime/material_textures.py): every texture a material binds, the scene's
+image or the generated one, is the KTX2 artifact the build's manifest lists for it (``materials.<m>.textures``),
+sha256-checked and uploaded with its whole mip chain, read through the sampler the manifest spells for Vulkan
+(``samplers[i].platforms.vulkan``), one VkSampler per distinct state; the specialized pipelines, the ubershader
+and a masked material's depth pass bind the same image and sampler. Only the renderer's own inputs are made
+here: a brick's baked table (reference/tables.py), the lit stand-ins of unused shadow slots, and a grey image
+for an ubershader texture the drawn material does not bind (its variant never samples it). The surface state of a permutation
 (spec/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
 pipelines blend source-over and are drawn after the opaque ones (not sorted by depth), the back faces of
 what a glTF file calls single-sided are culled (TOML objects keep cull mode none); the ubershader implements
@@ -81,6 +88,9 @@ class Report:
     placement: str = ""  # the placement file read, or "row" (the fallback)
     # per shadowed light: size, gpu_ms of its depth pass, how it is sampled ("depth" | "r32_copy"), its matrix
     shadow_maps: dict = field(default_factory=dict)
+    # per drawn material and texture: the artifact drawn (path, levels) and its row of the manifest's samplers
+    textures: dict = field(default_factory=dict)
+    texture_notes: list[str] = field(default_factory=list)  # what the device clamped of a sampler state
     validation: bool = False  # whether the Khronos validation layer was on
     validation_messages: list[str] = field(default_factory=list)  # what the layer said during this render
 
@@ -90,19 +100,13 @@ class Report:
 
 
 def _textures(device, lib=None):
-    """A 16×16 sRGB checker albedo, a 32×32 normal map of bumps, a lit (depth 1) stand-in shadow map and
-    moments map (E[d] = E[d²] = 1; bound where an ubershader shadow slot is unused by a draw's lights);
-    the baked table of a texture a brick declares as a table (reference/tables.py)."""
-    j, i = np.meshgrid(np.arange(16), np.arange(16))
-    albedo = np.where(((i // 4 + j // 4) % 2 == 0)[..., None], [230, 200, 120], [90, 140, 200]).astype(np.uint8)
-    v, u = np.meshgrid((np.arange(32) + 0.5) / 32, (np.arange(32) + 0.5) / 32, indexing="ij")
-    t = np.stack([0.5 * np.sin(2 * np.pi * 4 * u), 0.5 * np.cos(2 * np.pi * 3 * v), np.ones_like(u)], -1)
-    t /= np.linalg.norm(t, axis=-1, keepdims=True)
-    nmap = np.round((t + 1.0) / 2.0 * 255.0).astype(np.uint8)
+    """The renderer's own images: a lit (depth 1) stand-in shadow map and moments map (E[d] = E[d²] = 1; bound
+    where an ubershader shadow slot is unused by a draw's lights), the baked table of a texture a brick declares
+    as a table (reference/tables.py), and a linear grey 0.5 for any other name (an ubershader texture the drawn
+    material does not bind). Material textures are the build's (runtime/material_textures.py)."""
     shadow = np.ones((4, 4, 4), np.float32)
-    grey = np.full((1, 1, 4), 0.5, np.float32)  # any other texture a brick samples (a lookup table, …)
-    return _TestTextures({"albedo_map": device.image(albedo, srgb=True), "normal_map": device.image(nmap),
-                          "shadow_map": device.image(shadow), "shadow_moments": device.image(shadow)},
+    grey = np.full((1, 1, 4), 0.5, np.float32)
+    return _TestTextures({"shadow_map": device.image(shadow), "shadow_moments": device.image(shadow)},
                          lambda: device.image(grey), _table_images(device, lib))
 
 
@@ -114,8 +118,8 @@ def _table_images(device, lib) -> dict:
 
 
 class _TestTextures(dict):
-    """The generated textures by brick texture name: a baked table where a brick declares one, else a test
-    image; a name with neither gets a linear 0.5 grey."""
+    """The renderer's own textures by brick texture name: a baked table where a brick declares one, else a
+    shadow stand-in; a name with neither gets a linear 0.5 grey."""
 
     def __init__(self, known, make_grey, tables=None):
         super().__init__(known)
@@ -149,7 +153,7 @@ def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict, texel
 
 def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), language: str = "glsl",
                  device=None, progress: bool = False, uber_ids: str = "buffer", shadow_size: int = SHADOW_SIZE,
-                 placement_file=None) -> Report:
+                 placement_file=None, build=None) -> Report:
     """Render `frames` frames of `scene` into out/frame_NNNN.png; returns the report (also out/report.json).
 
     uber_ids: "buffer" (the variant read from the material entry: one ubershader pipeline) or
@@ -157,6 +161,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     variant from the one module; WGSL: naga resolves the override per pipeline).
     shadow_size: the side of every light's shadow map (depth pass), in texels.
     placement_file: the placement to use (default: the scene's SCENE.placement.toml if present, else the row).
+    build: the build whose texture artifacts the materials draw (a folder holding its manifest.json, or a
+    runtime.material_textures.BuildOutputs); needed where a drawn material binds textures.
     """
     from ..link.values import entry_bytes, light_entry, uploads
     from ..compose import compose_permutation
@@ -174,6 +180,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..compose.depth import compose_depth_units
     from ..link import link_permutation
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
+    from .material_textures import BuildOutputs, MaterialTextures
     from .shadow_pass import (VULKAN_CONVENTIONS, depth_pass, depth_plan, fit_shadow_matrix, pass_units,
                               shadowed_lights)
 
@@ -182,6 +189,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     if not (isinstance(shadow_size, int) and 1 <= shadow_size <= 8192):
         raise UserError(f"shadow map size {shadow_size!r} — use a whole number of texels from 1 to 8192")
     out = Path(out)
+    if build is not None and not isinstance(build, BuildOutputs):
+        build = BuildOutputs.read(build)
     if out.exists() and not out.is_dir():
         raise UserError(f"{out} is a file — give --out a directory")
     placed = load_placement(scene, placement_file)
@@ -260,6 +269,19 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         # light's perspective map free of acne here (a nearest sampler acnes: docs/design/runtime.md, "The renderer").
         textures, sampler = _textures(device, lib), device.sampler()
         owned += [textures, sampler]
+        # the materials' own textures: the build's artifacts with their mips and samplers
+        mtex = MaterialTextures(device, build, {m: getattr(scene.materials[m], "images", None) or {}
+                                                for m in sorted({o["material"] for o in scene.objects})})
+        owned.append(mtex)
+
+        def material_texture(t, material):
+            """(image, sampler) of material texture t: the build's artifact and its sampler where the material
+            binds one, else the renderer's own (a baked table, grey; a lit depth image if compared)."""
+            if t.compare:
+                return depth_compared(None), sampler_of(t)
+            if mtex.row(material, t.param) is not None:
+                return mtex.image(material, t.param), mtex.sampler(material, t.param)
+            return textures[t.param], sampler
         vk = device.vk
         U, S = vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
 
@@ -303,8 +325,12 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 h, res = obj["permutation"], {}
                 if h in plan.masked:  # its material's Material block and coverage texture, as its colour pass binds them
                     up = next(x for x in uploads(scene, h, composed[h]) if x["material"] == obj["material"])
-                    res = mask_resources(mask_interface(depth_units, h), buf(bytes.fromhex(up["Material"]), U),
-                                         textures, sampler)
+                    mi = mask_interface(depth_units, h)
+                    bound = {t.param: material_texture(t, obj["material"]) for t in mi.textures}
+                    res = mask_resources(mi, buf(bytes.fromhex(up["Material"]), U),
+                                         {n: im for n, (im, _) in bound.items()}, sampler)
+                    for t in mi.textures:  # each coverage texture with its own sampler
+                        res[(t.set, t.binding + 1)] = bound[t.param][1]
                 casters.append(Caster(mesh_of[i], object_bufs[i], h, res))
             for ln in shadowed:
                 desc = passes_of[ln]
@@ -368,7 +394,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             return shadow_maps[light_name] if light_name in shadow_maps else textures[t.param]
 
         def stand_in(t):
-            """A texture no light's depth pass provides: the generated one (a lit depth image if compared)."""
+            """A light texture no light's depth pass provides: the lit stand-in (a lit depth image if compared)."""
             return depth_compared(None) if t.compare else textures[t.param]
 
         compared = {}  # a texture2d_shadow's sampler and lit stand-in, made on first use
@@ -410,21 +436,28 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             if c.interface.block("Material"):
                 spec[(1, 0)] = buf(bytes.fromhex(up["Material"]), U)
             for t in c.interface.textures:
-                res = light_texture(t, obj["lights"][t.light]) if t.group == "light" else stand_in(t)
-                spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = res, sampler_of(t)
+                if t.group == "light":
+                    res, smp = light_texture(t, obj["lights"][t.light]), sampler_of(t)
+                else:
+                    mtex.check_binding(obj["material"], t)
+                    res, smp = material_texture(t, obj["material"])
+                spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = res, smp
             ub = {(0, 0): frame, (2, 0): obj_buf,
                   (1, 0): buf(np.array([materials.index(obj["material"]), 0, 0, 0], np.int32), U),
                   (1, 1): material_buffer}
             lbuf = uber.interface.block("LightBuffer")
             if lbuf is not None:  # a scene without lights has an ubershader without a light buffer
                 ub[(lbuf.set, lbuf.binding)] = light_buffers.get(obj["light_set"]) or empty_lights()
-            for t in uber.interface.textures:
-                res = stand_in(t)
+            for t in uber.interface.textures:  # the draw's material's textures and samplers, as the specialized path's
                 if t.group == "light":
                     slots = slot_lights[obj["light_set"]]
-                    res = light_texture(t, slots[t.light]) if t.light < len(slots) else res
-                ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, sampler_of(t)
+                    res, smp = light_texture(t, slots[t.light]) if t.light < len(slots) else stand_in(t), sampler_of(t)
+                else:
+                    mtex.check_binding(obj["material"], t, ubershader=True)
+                    res, smp = material_texture(t, obj["material"])
+                ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, smp
             draws.append((h, spec, ub, mesh_of[i]))
+        report.textures, report.texture_notes = mtex.report(), list(mtex.notes)
 
         # blended surfaces after the opaque ones, in scene order otherwise (no sorting by depth: docs/design/runtime.md)
         draws.sort(key=lambda d: perms[d[0]].surface.alpha == "blend")

@@ -386,6 +386,7 @@ def test_fp16_scene_renders_like_fp32(tmp_path, monkeypatch):
     from generator.library.bricks import load_library
     from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
+    from generator.assemble.render_inputs import scene_textures
 
     for t in ("glslc", "naga", "spirv-val", "spirv-opt"):
         require_tool(t)
@@ -397,7 +398,9 @@ def test_fp16_scene_renders_like_fp32(tmp_path, monkeypatch):
     monkeypatch.setenv("SHADERMATRIX_VALIDATION", "1")
 
     def image(scene, lang, name):
-        rep = render_scene(load_scene(scene, load_library()), lib, "specialized", 1, tmp_path / name, (96, 48), lang)
+        loaded = load_scene(scene, load_library())
+        rep = render_scene(loaded, lib, "specialized", 1, tmp_path / name, (96, 48), lang,
+                           build=scene_textures(loaded, tmp_path / name))
         assert rep.validation and rep.validation_messages == [], rep.validation_messages
         return np.asarray(Image.open(tmp_path / name / "frame_0000.png").convert("RGBA")).astype(np.int32)
 

@@ -287,13 +287,15 @@ def test_the_scene_renders_the_same_specialized_and_through_the_ubershader(lib, 
 
     from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
+    from generator.assemble.render_inputs import scene_textures
 
     path = tmp_path / "lod.toml"
     path.write_text(SCENE)
     scene = load_scene(path, lib)
     images = {}
     for mode in ("specialized", "ubershader"):
-        render_scene(scene, lib, mode, 1, tmp_path / mode, (96, 64), device=device)
+        render_scene(scene, lib, mode, 1, tmp_path / mode, (96, 64), device=device,
+                     build=scene_textures(scene, tmp_path / "build"))
         images[mode] = np.asarray(Image.open(tmp_path / mode / "frame_0000.png").convert("RGB")).astype(int)
     assert np.abs(images["specialized"] - images["ubershader"]).max() <= 1
     assert (images["specialized"].max(-1) > 20).mean() > 0.05  # lit, not black

@@ -334,6 +334,7 @@ def test_twisted_spheres_render_the_same_specialized_and_through_the_ubershader(
 
     from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
+    from generator.assemble.render_inputs import scene_textures
 
     images = {}
     for name, normal in (("twist", "normal_twist_map"), ("plain", "normal_map_xy")):
@@ -341,7 +342,8 @@ def test_twisted_spheres_render_the_same_specialized_and_through_the_ubershader(
         scene = load_scene(_scene(tmp_path / name, ("brushed",), **{"normal=normal_twist_map": f"normal={normal}"}),
                            lib)
         for mode in ("specialized", "ubershader") if name == "twist" else ("specialized",):
-            render_scene(scene, lib, mode, 1, tmp_path / name / mode, (64, 64), device=device)
+            render_scene(scene, lib, mode, 1, tmp_path / name / mode, (64, 64), device=device,
+                         build=scene_textures(scene, tmp_path / name / "build"))
             img = Image.open(tmp_path / name / mode / "frame_0000.png").convert("RGB")
             images[(name, mode)] = np.asarray(img).astype(int)
     twist = images[("twist", "specialized")]

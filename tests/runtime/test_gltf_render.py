@@ -17,6 +17,7 @@ def test_a_gltf_scene_renders_its_meshes_where_its_nodes_put_them(tmp_path):
     from generator.scene.load import load_scene
     from generator.runtime.placement import load_placement
     from generator.runtime.renderer import render_scene
+    from generator.assemble.render_inputs import scene_textures
 
     path = sample_doc().write_gltf(tmp_path / "s.gltf")
     scene = load_scene(path, load_library())
@@ -26,7 +27,8 @@ def test_a_gltf_scene_renders_its_meshes_where_its_nodes_put_them(tmp_path):
     assert np.allclose(leaf.model[:3, 3], [3, 0, 0])  # the node's translation
     corners = leaf.corners()
     assert np.allclose(corners.min(0), [2, 0, -1]) and np.allclose(corners.max(0), [4, 0, 1])  # the quad's box, moved
-    report = render_scene(scene, load_library(), "specialized", 1, tmp_path / "out", size=(64, 48))
+    report = render_scene(scene, load_library(), "specialized", 1, tmp_path / "out", size=(64, 48),
+                          build=scene_textures(scene, tmp_path / "out"))
     assert report.placement == str(path)
     assert _drawn(tmp_path / "out") > 200, "the quads are drawn"
     assert json.loads((tmp_path / "out" / "report.json").read_text())["placement"] == str(path)
@@ -51,6 +53,7 @@ def test_a_mirrored_single_sided_node_keeps_its_front_face(tmp_path):
     from generator.library.bricks import load_library
     from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
+    from generator.assemble.render_inputs import scene_textures
     from tests.scene.test_gltf import Doc
 
     lib, drawn = load_library(), {}
@@ -60,6 +63,7 @@ def test_a_mirrored_single_sided_node_keeps_its_front_face(tmp_path):
         g.node(name="quad", mesh=g.quad_mesh("quad_mesh", m), scale=scale)  # faces +y, the camera looks down
         scene = load_scene(g.write_gltf(tmp_path / f"{name}.gltf"), lib)
         assert scene.permutations[scene.objects[0]["permutation"]].surface.double_sided is False
-        render_scene(scene, lib, "specialized", 1, tmp_path / name, size=(64, 48))
+        render_scene(scene, lib, "specialized", 1, tmp_path / name, size=(64, 48),
+                     build=scene_textures(scene, tmp_path / name))
         drawn[name] = _drawn(tmp_path / name)
     assert drawn["plain"] > 200 and drawn["mirrored"] == drawn["plain"], drawn

@@ -177,13 +177,15 @@ def test_the_specialization_constant_ubershader_renders_the_same_image(renders, 
     from generator.library.bricks import load_library
     from generator.scene.load import load_scene
     from generator.runtime.renderer import render_scene
+    from generator.assemble.render_inputs import scene_textures
 
     lib = load_library()
     ref = _image(renders["specialized"][0] / "frame_0000.png")
     monkeypatch.setenv("SHADERMATRIX_VALIDATION", "1")  # the renderer's own device, validated
     for lang in ("glsl", "wgsl"):
-        rep = render_scene(load_scene(EXAMPLE, lib), lib, "ubershader", 1, tmp_path / lang, (96, 48), lang,
-                           uber_ids="specialization")
+        scene = load_scene(EXAMPLE, lib)
+        rep = render_scene(scene, lib, "ubershader", 1, tmp_path / lang, (96, 48), lang, uber_ids="specialization",
+                           build=scene_textures(scene, tmp_path / lang))
         assert rep.pipelines_created == 5  # one ubershader pipeline per material variant
         said = rep.validation_messages
         if lang == "wgsl":  # naga resolves the override, spirv-opt drops the constants variant's dead v_tangent

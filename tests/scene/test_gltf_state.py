@@ -238,12 +238,13 @@ def test_the_renderer_draws_the_state(tmp_path, lib):
     from generator.scene.load import load_scene
     from generator.runtime.placement import load_placement
     from generator.runtime.renderer import render_scene
+    from generator.assemble.render_inputs import scene_textures
     path = tmp_path / "state.toml"
     path.write_text(TOML)
     (tmp_path / "state.placement.toml").write_text(PLACEMENT)
     scene = load_scene(path, lib)
     W, H = 96, 64
-    render_scene(scene, lib, "specialized", 1, tmp_path / "out", size=(W, H))
+    render_scene(scene, lib, "specialized", 1, tmp_path / "out", size=(W, H), build=scene_textures(scene, tmp_path / "out"))
     from PIL import Image
     img = np.asarray(Image.open(tmp_path / "out" / "frame_0000.png").convert("RGB")).astype(int)
     placed = load_placement(scene)

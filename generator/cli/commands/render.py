@@ -18,6 +18,9 @@ def add_arguments(p) -> None:
     p.add_argument("--size", default="256x160", help="WxH (default 256x160)")
     p.add_argument("--language", choices=("glsl", "hlsl", "wgsl"), default="glsl")
     p.add_argument("--bricks", action="append", default=[], metavar="DIR", help="extra brick directory")
+    p.add_argument("--build", metavar="DIR", help="draw the materials' textures from this build's outputs (its "
+                   "manifest.json and KTX2 files; default: write the scene's texture artifacts into --out/textures "
+                   "as build does)")
 
 
 def run(args) -> int:
@@ -34,13 +37,22 @@ def run(args) -> int:
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)
     from ...runtime.device import VulkanUnavailable
+    out, build = Path(args.out), None
+    if args.build is not None:
+        build = Path(args.build)
+    elif out.is_dir() or not out.exists():  # (a file: the renderer's own error)
+        # the texture part of a build, into the render's folder: the renderer reads what an engine reads
+        from ...assemble.render_inputs import scene_textures
+        build = scene_textures(scene, out)
     try:
-        report = render_scene(scene, lib, args.mode, args.frames, Path(args.out), (int(m[1]), int(m[2])),
-                              args.language, progress=progress())
+        report = render_scene(scene, lib, args.mode, args.frames, out, (int(m[1]), int(m[2])),
+                              args.language, progress=progress(), build=build)
     except VulkanUnavailable as e:
         raise VulkanUnavailable(f"no Vulkan device to render on: {e} — install Mesa lavapipe (`make setup`)") from None
     if report.cache_problem:
         print(f"warning: {report.cache_problem}", file=sys.stderr)
+    for note in report.texture_notes:
+        print(f"note: {note}", file=sys.stderr)
     last = report.steady
     print(f"{scene.name}: {len(scene.objects)} objects, {args.mode}, {args.language}, {args.frames} frames → {args.out}; "
           f"first frame {report.time_to_first_frame_ms:.1f} ms, {report.pipelines_created} pipelines; "
