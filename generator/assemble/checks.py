@@ -18,8 +18,8 @@ shaders once, through the compile cache); a failure reads as the brick line that
 compilers' diagnostics are mapped back through #line, or the GL sources' line map). Golden sources are
 named by permutation, not by content, so a drift is a diff of one file. `languages` narrows what is
 checked as `BuildContext(languages=...)` narrows what is built: a platform is checked when one of the
-languages it is made from (MADE_FROM; vulkan: any) is given, and vulkan compiles only those
-given. (`build` is narrower: it writes a platform only when its platforms.PLATFORM_TABLE made_from is built,
+languages it is made from (its class's ``checked_from``; vulkan: any) is given, and vulkan compiles only
+those given. (`build` is narrower: it writes a platform only when its platforms.PLATFORM_TABLE made_from is built,
 so vulkan needs GLSL there.)
 """
 from __future__ import annotations
@@ -31,11 +31,10 @@ from pathlib import Path
 from ..library.bricks import Library
 from ..scene.load import Scene
 from ..backends import LANGUAGES
-from .platforms import DIALECTS, EXT, PLATFORMS
+from .platforms import DIALECTS, EXT, PLATFORM_TABLE, PLATFORMS
 
-# the languages each platform's check is made from; gl's (GLSL) is composed as its GL dialects and validated
-# as such, the others' are compiled to SPIR-V and validated
-MADE_FROM = {"vulkan": LANGUAGES, "d3d12": ("hlsl",), "gl": ("glsl",), "webgpu": ("wgsl",)}
+# every platform dialect, in the table's order (a batch composes those its checks need in this order)
+ALL_DIALECTS = tuple(d for p in PLATFORM_TABLE.values() for d in p.dialects)
 SOURCE_EXT = {**EXT, "glsl": "glsl"}  # a golden source's extension, by language or GL dialect
 
 
@@ -71,13 +70,13 @@ def checks(scene: Scene, platforms=PLATFORMS, languages=LANGUAGES) -> list[Check
     """The checks of a scene, permutation by permutation, platforms in PLATFORMS order."""
     plats = checked_platforms(platforms, languages)
     return [Check(h, p, tuple(scene.users.get(h, ())),
-                  () if p in DIALECTS else tuple(x for x in MADE_FROM[p] if x in languages))
+                  () if p in DIALECTS else tuple(x for x in PLATFORM_TABLE[p].checked_from if x in languages))
             for h in sorted(scene.permutations) for p in plats]
 
 
 def checked_platforms(platforms=PLATFORMS, languages=LANGUAGES) -> list[str]:
     """The platforms of `platforms` made from one of `languages` (vulkan from any), in PLATFORMS order."""
-    return [p for p in PLATFORMS if p in platforms and set(MADE_FROM[p]) & set(languages)]
+    return [p for p in PLATFORMS if p in platforms and set(PLATFORM_TABLE[p].checked_from) & set(languages)]
 
 
 def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> list[Outcome]:
@@ -97,7 +96,7 @@ def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> lis
     # jobs and golden files do not depend on the checks' order
     batches: dict[tuple, list] = {}
     for h, (langs, dials) in wanted.items():
-        need = (tuple(x for x in LANGUAGES if x in langs), tuple(d for d in ("gl", "essl") if d in dials))
+        need = (tuple(x for x in LANGUAGES if x in langs), tuple(d for d in ALL_DIALECTS if d in dials))
         batches.setdefault(need, []).append((h, scene.permutations[h]))
     composed, failed = {}, {}
     for (langs, dials), items in batches.items():
@@ -110,44 +109,55 @@ def run_checks(scene: Scene, lib: Library, todo: list[Check], store=None) -> lis
                                line_map=tuple(s.line_map)) for h, c in composed.items() for s in c.dialects]
     results = compile_many(list(jobs.values()), optimize=True, validate=True, store=store) if jobs else {}
     gl_errors = validate_dialects(dialect_jobs, store) if dialect_jobs else {}
-    from .write import dxil_step  # build's own DXC step (None without a dxc on PATH)
-    dxil = dxil_step() if any(c.platform == "d3d12" and c.hash in composed for c in todo) else None
+    # the build's own binary steps (d3d12's DXC; none without a dxc on PATH), for the platforms checked
+    steps = {p: step for p in dict.fromkeys(c.platform for c in todo if c.hash in composed)
+             if (step := PLATFORM_TABLE[p].binary_step()) is not None}
     return [Outcome(list(failed[c.hash])) if c.hash in failed
-            else _outcome(c, composed[c.hash], results, gl_errors, dxil, scene.permutations[c.hash].precision)
+            else _outcome(c, composed[c.hash], results, gl_errors, steps.get(c.platform),
+                          scene.permutations[c.hash].precision)
             for c in todo]
 
 
-def _outcome(c: Check, comp, results, gl_errors, dxil, precision: str) -> Outcome:
-    """One check's Outcome from the batch's results (job key -> CompileResult / GL errors)."""
+def _outcome(c: Check, comp, results, gl_errors, step, precision: str) -> Outcome:
+    """One check's Outcome from the batch's results (job key -> CompileResult / GL errors); step: its platform's
+    binary step, or None."""
     from ..toolchain.jobs import job_key
     mine = [s for s in comp.sources if s.language in c.languages]
     compiled = [results[job_key(c.hash, s.stage, s.language)] for s in mine]
     errors = [line for r in compiled if not r.ok for line in r.errors()]
     notes: list[str] = []
     sources = {f"{c.platform}/{c.hash}.{s.stage}.{SOURCE_EXT[s.language]}": s.text for s in mine}
-    if c.platform == "gl":
-        es = [e for s in comp.dialects if s.language == "essl" for e in gl_errors[job_key(c.hash, s.stage, "essl")]]
-        for s in comp.dialects:
-            if s.language == "gl":
-                errors += gl_errors[job_key(c.hash, s.stage, "gl")]
-            if s.language == "gl" or not es:
-                sources[f"gl/{c.hash}.{s.stage}.{SOURCE_EXT[s.language]}"] = s.text
-        if es:  # as `build` records it: the gl platform ships GLSL 4.50 core only for this permutation
-            notes.append(f"GLSL ES 3.10 unsupported (the build ships GLSL 4.50 core only): {es[0]}"
-                         + (f" (and {len(es) - 1} more)" if len(es) > 1 else ""))
-    elif c.platform == "d3d12" and dxil is not None and not errors:
+    p = PLATFORM_TABLE[c.platform]
+    if p.dialects:
+        errors += _dialects(c, p, [s for s in comp.dialects if s.language in p.dialects], gl_errors, sources, notes)
+    elif step is not None and not errors:
         for s in mine:
-            errors += dxil(c.hash, s, precision)[1]
+            errors += step(c.hash, s, precision)[1]
     return Outcome(errors, dict(sorted(sources.items())), notes)
 
 
-def dxc_note() -> str | None:
-    """What a d3d12 check leaves out without a dxc on PATH (None with one)."""
-    from ..toolchain import find_tool
-    if find_tool("dxc") is not None:
-        return None
-    return ("no dxc on PATH: d3d12 checks validate the HLSL with glslang's HLSL front end only, no DXIL "
-            "(docs/guide/install.md: where to get dxc)")
+def _dialects(c: Check, p, dialects, gl_errors, sources: dict, notes: list) -> list[str]:
+    """A dialect platform's check (gl): the errors of its required dialects; an optional one (GLSL ES) that
+    fails is a note and ships no source, as `build` records it ("unsupported")."""
+    from ..toolchain.jobs import job_key
+    errors = []
+    unsupported = {d: es for d in p.optional_dialects
+                   if (es := [e for s in dialects if s.language == d for e in gl_errors[job_key(c.hash, s.stage, d)]])}
+    for s in dialects:
+        if s.language not in p.optional_dialects:
+            errors += gl_errors[job_key(c.hash, s.stage, s.language)]
+        if s.language not in unsupported:
+            sources[f"{c.platform}/{c.hash}.{s.stage}.{SOURCE_EXT[s.language]}"] = s.text
+    shipped = " and ".join(p.dialect_titles[d] for d in p.dialects if d not in p.optional_dialects)
+    for d, es in unsupported.items():
+        notes.append(f"{p.dialect_titles[d]} unsupported (the build ships {shipped} only): {es[0]}"
+                     + (f" (and {len(es) - 1} more)" if len(es) > 1 else ""))
+    return errors
+
+
+def check_notes(platforms) -> list[str]:
+    """What the checks of `platforms` leave out on this machine (Platform.check_note: no dxc for d3d12's DXIL)."""
+    return [n for p in dict.fromkeys(platforms) if (n := PLATFORM_TABLE[p].check_note())]
 
 
 def run_check(scene: Scene, lib: Library, check: Check, store=None) -> Outcome:

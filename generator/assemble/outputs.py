@@ -26,11 +26,11 @@ from pathlib import Path
 
 from ..io import atomic_write
 from ..backends import LANGUAGES
-from .platforms import PLATFORM_TABLE
+from .platforms import LANGUAGE_TREE, PLATFORM_TABLE
 
 LOCK = ".shadermatrix-lock"
 # the trees a build writes (assemble/platforms.py), and the language trees of builds before platforms (emptied)
-TREES = (*(f"vulkan/{lang}" for lang in LANGUAGES), *(p.name for p in PLATFORM_TABLE.values() if p.own_files),
+TREES = (*(f"{LANGUAGE_TREE}/{lang}" for lang in LANGUAGES), *(p.name for p in PLATFORM_TABLE.values() if p.own_files),
          *LANGUAGES)
 TEMP_DIR = re.compile(r"^shadermatrix-(?:radv-)?(\d+)-")
 OWN_TMP = re.compile(r"^\..+\.[^.]+\.tmp$")  # io.atomic_write: .<name>.<random>.tmp

@@ -225,16 +225,17 @@ def pack_meta(platform: str, language: str, blob: str, generator: str, tools: di
 def _packed(entry: dict, name: str, platform: str):
     """(permutation name, stage, input key, blob kind, path, sha256) of an ok manifest entry on `platform`."""
     from .platforms import PLATFORM_TABLE
+    p = PLATFORM_TABLE[platform]
     if entry.get("status") != "ok":
         return
-    if name == "ubershader":  # built for vulkan only: its GLSL's SPIR-V
-        if platform == "vulkan":
-            for stage, item in entry.get("languages", {}).get("glsl", {}).items():
+    if name == "ubershader":  # built as SPIR-V only: in the pack of the platform that ships it (vulkan's)
+        if p.ubershader:
+            for stage, item in entry.get("languages", {}).get(p.made_from, {}).items():
                 if "spirv" in item:
                     yield name, stage, entry["input_key"], "spirv", item["spirv"], item["spirv_sha256"]
         return
     for stage, item in entry.get("platforms", {}).get(platform, {}).get("stages", {}).items():
-        kind = "dxil" if "dxil" in item else PLATFORM_TABLE[platform].blob
+        kind = p.binary if p.binary in item else p.blob  # d3d12: DXIL where dxc built it
         yield name, stage, entry["input_key"], kind, item[kind]["path"], item[kind]["sha256"]
 
 

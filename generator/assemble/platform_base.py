@@ -34,8 +34,9 @@ class Conventions:
 class Unit:
     """One permutation whose languages compiled, as its platforms' sections read it: its name (hash), the
     Composed sources and dialects, the manifest entry (``languages`` written), its precision, the dialect
-    sources' glslangValidator errors (job key -> errors), the build's atomic writer and DXC step (None: no
-    dxc). ``errors`` collects what fails the permutation (a GL core stage's, DXC's)."""
+    sources' glslangValidator errors (job key -> errors), the build's atomic writer and the platforms' binary
+    steps ({platform: Platform.binary_step()}, those it has: d3d12's DXC where a dxc is on PATH). ``errors``
+    collects what fails the permutation (a GL core stage's, DXC's)."""
 
     name: str
     composed: object
@@ -43,7 +44,7 @@ class Unit:
     precision: str
     dialect_errors: dict
     write: Callable[[str, bytes], None]
-    dxil: Callable | None = None
+    steps: dict[str, Callable] = field(default_factory=dict)
     errors: list[str] = field(default_factory=list)
     sources: dict = field(init=False)  # (language or dialect, stage) -> Source
     stages: list[str] = field(init=False)  # in pipeline order
@@ -78,11 +79,32 @@ class Platform:
     tools: tuple[str, ...] = ()     # whose exact versions its manifest and the build's key record
     ext: dict[str, str] = {}        # artifact kind -> file extension of what it writes into its own tree
     own_files: bool = True          # False: its stages name the language trees' files (they are tracked there)
+    # the languages a check of it (assemble/checks.py) compiles when asked for (vulkan: any of them); a platform
+    # with dialects is checked as its dialects, composed from its made_from
+    checked_from: tuple[str, ...] = ()
+    # dialects shipped where they validate: a failure is a note ("unsupported"), not an error (gl: GLSL ES)
+    optional_dialects: tuple[str, ...] = ()
+    dialect_titles: dict[str, str] = {}  # dialect -> how a note names it ("GLSL ES 3.10")
+    binary: str | None = None       # the artifact kind an optional tool compiles its main source to (d3d12: dxil)
+    ubershader: bool = False        # whether its pack holds the ubershader (its made_from's SPIR-V)
     conventions: Conventions
 
     def builds(self, unit: Unit) -> bool:
         """Whether this permutation's build makes the platform (a build of fewer languages makes fewer)."""
         return self.made_from in unit.langs and all((d, unit.stages[0]) in unit.sources for d in self.dialects)
+
+    def binary_step(self):
+        """The step compiling a stage's source to `binary`: callable(name, source, precision) -> (bytes | None,
+        errors); None where the platform has none or its tool is not on PATH."""
+        return None
+
+    def check_note(self) -> str | None:
+        """What a check of this platform leaves out on this machine (a tool not on PATH), or None."""
+        return None
+
+    def spell_sampler(self, state: dict) -> dict:
+        """A sampler state (scene/textures.Sampler.as_dict) in this API's words (assemble/samplers.py)."""
+        raise NotImplementedError
 
     def section(self, unit: Unit) -> dict:
         """{"stages": {stage: {kind: {"path", "sha256"}}}, and the platform's own fields after them}."""

@@ -24,12 +24,16 @@ error fails the permutation like a compile error, its source written beside as
 ``gl/<hash>.<stage>.failed.glsl`` and named in the entry's ``failed_sources`` (``"gl.<stage>"``).
 
 Each platform is one class below and one entry of PLATFORM_TABLE: what it is made from, its dialects, its
-tools, its conventions (platform_base.Conventions: depth range, NDC y, framebuffer origin, front face) and
-the method writing its section. Adding a platform is adding a class and its entry; write_platforms, the
-build's key (all_tools), packs and the output tree read the table and nothing else about a platform.
+tools, its conventions (platform_base.Conventions: depth range, NDC y, framebuffer origin, front face), what
+its check compiles, its optional binary step, and the methods writing its section, its reflection and its
+sampler states. Adding a platform is adding a class and its entry; write_platforms, the build's key
+(all_tools), the writer, checks, packs, sampler spellings and the output tree read the table and nothing
+else about a platform.
 """
 from __future__ import annotations
 
+from ..backends import LANGUAGES
+from . import samplers
 from .platform_base import Conventions, Platform, Unit, resource_rows
 
 
@@ -40,6 +44,8 @@ class Vulkan(Platform):
     name, made_from, language, blob = "vulkan", "glsl", "glsl", "spirv"
     tools = ("glslc", "glslang", "spirv-tools", "naga")  # glslang: the HLSL's SPIR-V in the vulkan tree
     own_files = False
+    checked_from = LANGUAGES  # a vulkan check compiles every language it is given to SPIR-V
+    ubershader = True
     conventions = Conventions(depth_range="0..1", ndc_y="down", framebuffer_origin="top-left", front_face="ccw")
     _TYPES = {"uniform": "uniform_buffer", "storage": "storage_buffer", "image": "sampled_image", "sampler": "sampler"}
 
@@ -61,6 +67,9 @@ class Vulkan(Platform):
                                   for v in iface.vertex_inputs],
                 "push_constants": []}
 
+    def spell_sampler(self, state: dict) -> dict:
+        return samplers.vulkan(state)
+
 
 class D3D12(Platform):
     """HLSL for Shader Model 6 (the vulkan tree's text: ``register(xN, spaceM)``), DXIL where a dxc is on PATH."""
@@ -68,6 +77,7 @@ class D3D12(Platform):
     name, made_from, language, blob = "d3d12", "hlsl", "hlsl", "hlsl"
     tools = ("glslang", "dxc")
     ext = {"hlsl": "hlsl", "dxil": "dxil"}
+    checked_from, binary = ("hlsl",), "dxil"
     conventions = Conventions(depth_range="0..1", ndc_y="up", framebuffer_origin="top-left", front_face="ccw")
     _CLASSES = {"uniform": ("CBV", "b"), "storage": ("SRV", "t"), "image": ("SRV", "t"), "sampler": ("Sampler", "s")}
     _FORMATS = {"R32G32B32_SFLOAT": "DXGI_FORMAT_R32G32B32_FLOAT", "R32G32B32A32_SFLOAT": "DXGI_FORMAT_R32G32B32A32_FLOAT",
@@ -81,14 +91,15 @@ class D3D12(Platform):
         for stage in unit.stages:
             src = unit.sources[("hlsl", stage)]
             item = {"hlsl": self.put(unit, stage, src.text.encode(), "hlsl")}
-            if unit.dxil is not None:
-                blob, errors = unit.dxil(unit.name, src, unit.precision)
+            step = unit.steps.get(self.name)
+            if step is not None:
+                blob, errors = step(unit.name, src, unit.precision)
                 unit.errors += errors
                 if blob is not None:
-                    item["dxil"] = self.put(unit, stage, blob, "dxil")
+                    item[self.binary] = self.put(unit, stage, blob, self.binary)
             stages[stage] = item
         return {"stages": stages, "profiles": {s: DX_PROFILES[(s, unit.precision)] for s in unit.stages},
-                "dxil": "built" if unit.dxil is not None else
+                "dxil": "built" if self.name in unit.steps else
                 "no dxc on PATH: HLSL only (docs/guide/install.md: where to get dxc)",
                 "cost": unit.cost("hlsl"), "cost_from": "hlsl SPIR-V (glslang)"}
 
@@ -100,6 +111,26 @@ class D3D12(Platform):
                 "input_layout": [{"semantic": self._SEMANTICS[v.name][0], "semantic_index": self._SEMANTICS[v.name][1],
                                   "format": self._FORMATS[v.format], "name": v.name} for v in iface.vertex_inputs]}
 
+    def binary_step(self):
+        """DXC, or None when no dxc is on PATH (docs/guide/install.md: where to get one)."""
+        from ..toolchain import CompileJob, find_tool
+        from ..toolchain.jobs import job_key
+        from ..toolchain.platforms import compile_dxil
+        if find_tool("dxc") is None:
+            return None
+        return lambda name, src, precision: compile_dxil(
+            CompileJob(job_key(name, src.stage, "dxil"), "hlsl", src.stage, src.text), precision)
+
+    def check_note(self) -> str | None:
+        from ..toolchain import find_tool
+        if find_tool("dxc") is not None:
+            return None
+        return ("no dxc on PATH: d3d12 checks validate the HLSL with glslang's HLSL front end only, no DXIL "
+                "(docs/guide/install.md: where to get dxc)")
+
+    def spell_sampler(self, state: dict) -> dict:
+        return samplers.d3d12(state)
+
 
 class Gl(Platform):
     """GLSL 4.50 core and, where the bricks allow, GLSL ES 3.10: the `gl` and `essl` dialects (a GlslTarget
@@ -107,6 +138,8 @@ class Gl(Platform):
 
     name, made_from, language, blob = "gl", "glsl", "gl", "glsl"
     dialects = ("gl", "essl")
+    checked_from, optional_dialects = ("glsl",), ("essl",)
+    dialect_titles = {"gl": "GLSL 4.50 core", "essl": "GLSL ES 3.10"}
     tools = ("glslang",)
     ext = {"gl": "glsl", "essl": "essl"}
     conventions = Conventions(depth_range="-1..1", ndc_y="up", framebuffer_origin="bottom-left", front_face="ccw")
@@ -146,6 +179,9 @@ class Gl(Platform):
                              for k, s, b, n, st, x in rows if k == "image"],
                 "vertex_inputs": [{"location": v.location, "name": v.name} for v in iface.vertex_inputs]}
 
+    def spell_sampler(self, state: dict) -> dict:
+        return samplers.gl(state)
+
 
 def _gl_sampler(x: dict) -> str:
     if x["compare"]:
@@ -159,6 +195,7 @@ class WebGpu(Platform):
     name, made_from, language, blob = "webgpu", "wgsl", "wgsl", "wgsl"
     tools = ("naga",)
     ext = {"wgsl": "wgsl"}
+    checked_from = ("wgsl",)
     conventions = Conventions(depth_range="0..1", ndc_y="up", framebuffer_origin="top-left", front_face="ccw")
     _FORMATS = {"R32G32B32_SFLOAT": "float32x3", "R32G32B32A32_SFLOAT": "float32x4", "R32G32_SFLOAT": "float32x2"}
     _VISIBILITY = {"vert": "VERTEX", "frag": "FRAGMENT"}
@@ -180,12 +217,17 @@ class WebGpu(Platform):
                 "vertex_inputs": [{"shaderLocation": v.location, "name": v.name, "format": self._FORMATS[v.format]}
                                   for v in iface.vertex_inputs]}
 
+    def spell_sampler(self, state: dict) -> dict:
+        return samplers.webgpu(state)
+
 
 # The one table of the platforms, in build order (the manifest's and --platform's).
 PLATFORM_TABLE: dict[str, Platform] = {p.name: p for p in (Vulkan(), D3D12(), Gl(), WebGpu())}
 PLATFORMS: tuple[str, ...] = tuple(PLATFORM_TABLE)
 DIALECTS = {p.name: p.dialects for p in PLATFORM_TABLE.values() if p.dialects}  # compose.Composed.dialects
 EXT = {kind: ext for p in PLATFORM_TABLE.values() for kind, ext in p.ext.items()}  # artifact kind -> extension
+# the tree holding every language's sources and SPIR-V (<tree>/<language>/): the platform whose stages name them
+LANGUAGE_TREE = next(p.name for p in PLATFORM_TABLE.values() if not p.own_files)
 
 
 def parse_platforms(text: str) -> list[str]:
@@ -212,12 +254,12 @@ def all_tools(platforms) -> dict:
 
 
 def write_platforms(write, name: str, composed, entry: dict, platforms, dialect_errors: dict, precision: str,
-                    dxil=None) -> list[str]:
+                    steps=None) -> list[str]:
     """Fill entry["platforms"] for one permutation whose languages compiled (entry["languages"] is written);
     returns the errors that fail it (a GL core stage's among them, its source then written beside and named in
     entry["failed_sources"]). write(rel, data): the build's atomic writer. dialect_errors: job key ->
-    glslangValidator errors. dxil(name, source, precision) -> (bytes | None, errors): the DXC step (None: no dxc)."""
-    unit = Unit(name, composed, entry, precision, dialect_errors, write, dxil)
+    glslangValidator errors. steps: {platform: its binary step} (Platform.binary_step; a platform absent: none)."""
+    unit = Unit(name, composed, entry, precision, dialect_errors, write, steps or {})
     chosen = [PLATFORM_TABLE[p] for p in platforms]
     # a build of fewer languages (BuildContext(languages=...)) writes the platforms they make
     entry["platforms"] = {p.name: p.manifest(unit) for p in chosen if p.builds(unit)}

@@ -2,7 +2,8 @@
 descriptor, glSamplerParameter or GPUDevice.createSampler.
 
 A state (scene/textures.Sampler.as_dict) is API-neutral: mag and min filter, mipmap mode, wrap per axis,
-anisotropy, LOD bias, compare op. `spell(state)` gives it per platform, with the same meaning everywhere:
+anisotropy, LOD bias, compare op. One function per API spells it (each platform class's ``spell_sampler``
+names its own; `spell(state)` gives the state for every platform), with the same meaning everywhere:
 
 - ``mipmap = "none"`` is level 0 only: Vulkan ``mipmapMode`` NEAREST with ``maxLod`` 0 (the spec's way to
   turn mipmapping off), D3D12 ``MaxLOD`` 0, GL ``GL_LINEAR``/``GL_NEAREST`` min filters (no mipmap), WebGPU
@@ -40,7 +41,7 @@ _WRAP = {"repeat": ("VK_SAMPLER_ADDRESS_MODE_REPEAT", "D3D12_TEXTURE_ADDRESS_MOD
                    "clamp-to-edge")}
 
 
-def _vulkan(s: dict) -> dict:
+def vulkan(s: dict) -> dict:
     mip = "NEAREST" if s["mipmap"] == "none" else s["mipmap"].upper()
     return {"magFilter": f"VK_FILTER_{s['mag_filter'].upper()}", "minFilter": f"VK_FILTER_{s['min_filter'].upper()}",
             "mipmapMode": f"VK_SAMPLER_MIPMAP_MODE_{mip}",
@@ -52,7 +53,7 @@ def _vulkan(s: dict) -> dict:
             "minLod": 0.0, "maxLod": 0.0 if s["mipmap"] == "none" else VK_LOD_CLAMP_NONE}
 
 
-def _d3d12(s: dict) -> dict:
+def d3d12(s: dict) -> dict:
     point = {"linear": "LINEAR", "nearest": "POINT"}
     mip = point["nearest" if s["mipmap"] == "none" else s["mipmap"]]
     cmp = "COMPARISON_" if s["compare"] else ""
@@ -76,7 +77,7 @@ def _d3d12(s: dict) -> dict:
             "MinLOD": 0.0, "MaxLOD": 0.0 if s["mipmap"] == "none" else D3D12_FLOAT32_MAX}
 
 
-def _gl(s: dict) -> dict:
+def gl(s: dict) -> dict:
     mn = s["min_filter"].upper()
     minf = f"GL_{mn}" if s["mipmap"] == "none" else f"GL_{mn}_MIPMAP_{s['mipmap'].upper()}"
     out = {"GL_TEXTURE_MAG_FILTER": f"GL_{s['mag_filter'].upper()}", "GL_TEXTURE_MIN_FILTER": minf,
@@ -90,7 +91,7 @@ def _gl(s: dict) -> dict:
     return out
 
 
-def _webgpu(s: dict) -> dict:
+def webgpu(s: dict) -> dict:
     out = {"addressModeU": _WRAP[s["wrap_u"]][3], "addressModeV": _WRAP[s["wrap_v"]][3],
            "magFilter": s["mag_filter"], "minFilter": s["min_filter"],
            "mipmapFilter": "nearest" if s["mipmap"] == "none" else s["mipmap"],
@@ -103,9 +104,8 @@ def _webgpu(s: dict) -> dict:
     return out
 
 
-SPELLINGS = {"vulkan": _vulkan, "d3d12": _d3d12, "gl": _gl, "webgpu": _webgpu}
-
-
-def spell(state: dict, platforms=tuple(SPELLINGS)) -> dict:
-    """{platform: the state in its API's words} for each of `platforms` this module knows."""
-    return {p: SPELLINGS[p](state) for p in platforms if p in SPELLINGS}
+def spell(state: dict, platforms=None) -> dict:
+    """{platform: the state in its API's words} for each of `platforms` (default: every platform), as each
+    platform class spells it (Platform.spell_sampler: one of the functions above)."""
+    from .platforms import PLATFORM_TABLE, PLATFORMS
+    return {p: PLATFORM_TABLE[p].spell_sampler(state) for p in (PLATFORMS if platforms is None else platforms)}

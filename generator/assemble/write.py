@@ -13,7 +13,7 @@ from ..io import atomic_write, sha256
 from ..toolchain import CompileJob
 from ..toolchain.jobs import job_key
 from .context import BuildContext
-from .platforms import write_platforms
+from .platforms import LANGUAGE_TREE, PLATFORM_TABLE, write_platforms
 
 
 class Writer:
@@ -22,7 +22,8 @@ class Writer:
     def __init__(self, out: Path, ctx: BuildContext, res):
         self.out, self.ctx, self.res = out, ctx, res
         self._done: set[str] = set()  # SPIR-V files this build has written or found in place
-        self._dxil = dxil_step() if "d3d12" in ctx.platforms else None
+        # the platforms' binary steps (d3d12's DXC, where a dxc is on PATH), asked for only when a platform is built
+        self._steps = {p: step for p in ctx.platforms if (step := PLATFORM_TABLE[p].binary_step()) is not None}
 
     def count(self, changed: bool) -> None:
         if changed:
@@ -40,7 +41,7 @@ class Writer:
         for src in sources:
             r = results[job_key(name, src.stage, src.language)]
             if not (r.ok and r.spirv):
-                rel = f"vulkan/{src.language}/{name}.{src.stage}.failed.{src.language}"
+                rel = f"{LANGUAGE_TREE}/{src.language}/{name}.{src.stage}.failed.{src.language}"
                 self.put(rel, src.text.encode())
                 failed[f"{src.language}.{src.stage}"] = rel
                 errs += r.errors()
@@ -54,18 +55,18 @@ class Writer:
 
     def platforms(self, h: str, composed, entry: dict, checked: dict, precision: str) -> list[str]:
         """A permutation's platform artifacts (platforms.write_platforms); checked: its dialects' errors."""
-        return write_platforms(self.put, h, composed, entry, self.ctx.platforms, checked, precision, self._dxil)
+        return write_platforms(self.put, h, composed, entry, self.ctx.platforms, checked, precision, self._steps)
 
     def _shader(self, name: str, src, r) -> dict:
         """Write one compiled source and its SPIR-V under content names; returns its manifest item."""
         data = src.text.encode()
         src_sha, spv_sha = sha256(data), sha256(r.spirv)
-        if "vulkan" not in self.ctx.platforms:  # the SPIR-V checks ran (and their costs are recorded); nothing to ship
+        if LANGUAGE_TREE not in self.ctx.platforms:  # the SPIR-V checks ran (their costs are recorded): nothing to ship
             return {"source_sha256": src_sha, "spirv_sha256": spv_sha, "cost": self.cost(spv_sha, r.spirv)}
-        rel_src = f"vulkan/{src.language}/{name}.{src.stage}.{src_sha[:12]}.{src.language}"
+        rel_src = f"{LANGUAGE_TREE}/{src.language}/{name}.{src.stage}.{src_sha[:12]}.{src.language}"
         # SPIR-V is named by its content alone: identical modules (the vertex shaders of most permutations) are
         # one file, and every manifest item that has them names it (aliased); sources keep their own header
-        rel_spv = f"vulkan/{src.language}/{spv_sha[:16]}.{src.stage}.spv"
+        rel_spv = f"{LANGUAGE_TREE}/{src.language}/{spv_sha[:16]}.{src.stage}.spv"
         self.put(rel_src, data)
         if rel_spv in self._done:
             self.res.aliased += 1
@@ -89,14 +90,3 @@ def validate_dialects(pairs, store, gate=None) -> dict[str, list[str]]:
     jobs = [CompileJob(job_key(h, s.stage, s.language), s.language, s.stage, s.text, line_map=tuple(s.line_map))
             for h, c in pairs for s in c.dialects]
     return validate(jobs, store, gate=gate) if jobs else {}
-
-
-def dxil_step():
-    """The DXC step of the d3d12 platform, or None when no dxc is on PATH (docs/guide/install.md: where to get one)."""
-    from ..toolchain import find_tool
-    from ..toolchain.platforms import compile_dxil
-    if find_tool("dxc") is None:
-        return None
-    return lambda name, src, precision: compile_dxil(
-        CompileJob(job_key(name, src.stage, "dxil"), "hlsl", src.stage, src.text), precision)
-

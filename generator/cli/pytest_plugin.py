@@ -48,9 +48,9 @@ class PermutationItem(pytest.Item):
         self.add_marker("shadermatrix")
 
     def runtest(self):
-        from ..assemble.checks import dxc_note, golden_diff
+        from ..assemble.checks import check_notes, golden_diff
         res = self.parent.outcome(self)
-        notes = [*res.notes, *([dxc_note()] if self.check.platform == "d3d12" else [])]
+        notes = [*res.notes, *check_notes([self.check.platform])]
         for note in filter(None, notes):
             self.user_properties.append(("shadermatrix-note", note))
             self.add_report_section("call", "shadermatrix", note)

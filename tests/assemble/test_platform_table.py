@@ -123,3 +123,62 @@ def test_gl_ships_the_core_text_and_marks_es_unsupported_where_es_failed(compose
     assert {stage: sorted(item) for stage, item in gl["stages"].items()} == {"vert": ["glsl"], "frag": ["glsl"]}
     assert not list((tmp_path / "gl").glob("*.essl"))
     assert list(gl) == ["stages", "versions", "essl", "reflection", "tools"]
+
+
+BUILD_CODE = ("generator/assemble/checks.py", "generator/assemble/write.py", "generator/assemble/samplers.py",
+              "generator/assemble/pack.py", "generator/assemble/outputs.py", "generator/cli/commands/check.py",
+              "generator/cli/pytest_plugin.py")
+
+
+def test_the_build_code_names_no_platform_but_through_the_table():
+    """Adding a platform is adding its class: the build's code outside platforms.py reads the classes'
+    declarations (checked_from, dialects, binary_step, spell_sampler, ubershader, LANGUAGE_TREE), and no code
+    there compares with a platform's or a dialect's name (docstrings and help texts may name them)."""
+    import ast
+
+    from generator.assemble.platforms import PLATFORM_TABLE
+    names = {*PLATFORM_TABLE, *(d for p in PLATFORM_TABLE.values() for d in p.dialects)}
+    found = []
+    for rel in BUILD_CODE:
+        tree = ast.parse((REPO / rel).read_text(encoding="utf-8"))
+        docs = {id(n.body[0].value) for n in ast.walk(tree)
+                if isinstance(n, (ast.Module, ast.FunctionDef, ast.ClassDef)) and n.body
+                and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+        helps = {id(k.value) for n in ast.walk(tree) if isinstance(n, ast.Call) for k in n.keywords if k.arg == "help"}
+        for n in ast.walk(tree):
+            if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs | helps:
+                if n.value in names or any(n.value.startswith(f"{x}/") for x in names):
+                    found.append(f"{rel}:{n.lineno}: {n.value!r}")
+            if isinstance(n, ast.JoinedStr) and n.values and isinstance(n.values[0], ast.Constant) \
+                    and any(str(n.values[0].value).startswith(f"{x}/") for x in names):
+                found.append(f"{rel}:{n.lineno}: f{n.values[0].value!r}…")
+    assert found == []
+
+
+def test_a_dialect_platform_checks_its_optional_dialect_as_a_note_and_spells_samplers_by_its_class(composed):
+    """The generic check of a platform with dialects (assemble/checks.py): a required dialect's errors fail
+    it, an optional one's are a note naming it by its class's title and its source is not listed; a sampler
+    state is spelled by the class's spell_sampler, for every platform the table holds."""
+    from generator.assemble import platforms as P
+    from generator.assemble.checks import Check, _dialects
+    from generator.assemble.samplers import spell
+    from generator.toolchain.jobs import job_key
+    h, c = composed
+    gl = P.PLATFORM_TABLE["gl"]
+    check = Check(h, "gl", ())
+    ok = {job_key(h, s.stage, s.language): [] for s in c.dialects}
+    sources, notes = {}, []
+    assert _dialects(check, gl, c.dialects, ok, sources, notes) == [] and notes == []
+    assert sorted(sources) == sorted(f"gl/{h}.{s.stage}.{P.EXT[s.language]}" for s in c.dialects)
+    es = {**ok, job_key(h, "frag", "essl"): ["x.py:1:1: no ES"], job_key(h, "vert", "gl"): ["y.py:2:1: no core"]}
+    sources, notes = {}, []
+    assert _dialects(check, gl, c.dialects, es, sources, notes) == ["y.py:2:1: no core"]
+    assert notes == ["GLSL ES 3.10 unsupported (the build ships GLSL 4.50 core only): x.py:1:1: no ES"]
+    assert sorted(sources) == sorted(f"gl/{h}.{s.stage}.glsl" for s in c.dialects if s.language == "gl")
+    state = {"mag_filter": "linear", "min_filter": "nearest", "mipmap": "none", "wrap_u": "repeat",
+             "wrap_v": "clamp", "anisotropy": 1, "lod_bias": 0.0, "compare": None}
+    spelled = spell(state)
+    assert list(spelled) == list(P.PLATFORM_TABLE)
+    assert spelled == {n: p.spell_sampler(state) for n, p in P.PLATFORM_TABLE.items()}
+    assert spelled["vulkan"]["addressModeV"] == "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE"
+    assert spelled["gl"]["GL_TEXTURE_MIN_FILTER"] == "GL_NEAREST" and spelled["webgpu"]["lodMaxClamp"] == 0.0

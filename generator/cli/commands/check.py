@@ -35,8 +35,8 @@ def add_arguments(p) -> None:
 
 def selection(platform: str | None, languages: str | None, flag: str = "--") -> tuple[list[str], list[str]]:
     """(platforms checked, languages) of the options' text; UsageError naming the option (flag: its prefix)."""
-    from ...assemble.checks import MADE_FROM, checked_platforms
-    from ...assemble.platforms import PLATFORMS, parse_platforms
+    from ...assemble.checks import checked_platforms
+    from ...assemble.platforms import PLATFORM_TABLE, PLATFORMS, parse_platforms
     from ...backends import LANGUAGES, parse_languages
     opt_p, opt_l = ("--platform", "--languages") if flag == "--" else (f"{flag}platforms", f"{flag}languages")
     try:
@@ -48,14 +48,14 @@ def selection(platform: str | None, languages: str | None, flag: str = "--") -> 
     except ValueError as e:
         raise UsageError(f"{opt_l}: {e}") from None
     if not checked_platforms(plats, langs):
-        made = ", ".join(f"{p}: {'/'.join(MADE_FROM[p])}" for p in PLATFORMS)
+        made = ", ".join(f"{p}: {'/'.join(PLATFORM_TABLE[p].checked_from)}" for p in PLATFORMS)
         raise UsageError(f"{opt_p} {','.join(plats)} with {opt_l} {','.join(langs)} checks nothing — a platform is "
                          f"checked when it is made from one of the languages ({made})")
     return checked_platforms(plats, langs), langs
 
 
 def run(args) -> int:
-    from ...assemble.checks import checks, default_store, dxc_note, golden_diff, run_checks, stale_golden
+    from ...assemble.checks import check_notes, checks, default_store, golden_diff, run_checks, stale_golden
     from ...io import atomic_write
     from ...library.bricks import load_library
     from ...scene.load import load_scene
@@ -98,8 +98,7 @@ def run(args) -> int:
                 print(f"DRIFT {rel}: a golden source no permutation of the scene emits "
                       "(--update-golden removes it)", file=sys.stderr)
         stale = [] if args.update_golden else stale
-    note = dxc_note() if any(c.platform == "d3d12" for c in todo) else None
-    if note:
+    for note in check_notes(c.platform for c in todo):
         print(f"note: {note}", file=sys.stderr)
     print(f"{len(todo) - failed - drifted} of {len(todo)} checks pass ({len(scene.permutations)} permutations × "
           f"{len(plats)} platform{'s' if len(plats) != 1 else ''}: {', '.join(plats)}); {failed} failed, "
