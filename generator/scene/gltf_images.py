@@ -1,6 +1,6 @@
 """glTF images and samplers → the texture bindings of the mapped materials (scene/textures.py).
 
-Each texture a mapped material binds (scene/gltf.py: base_color_map, orm_map, albedo_map, normal_map,
+Each texture a mapped material binds (scene/gltf_materials.py: base_color_map, orm_map, albedo_map, normal_map,
 emissive_map) is read from the file: its texture's image — by URI (a percent-encoded path relative to the
 glTF file's folder, or a base64 data URI) or by buffer view (with its mimeType) — PNG, JPEG, or an
 uncompressed KTX2 (io/images.py), each image once, whichever materials bind it; and its sampler. A texture

@@ -13,7 +13,7 @@ A texture the material does not sample (occlusionTexture; emissiveTexture under 
 transform: it changes nothing drawn.
 texCoord: the extension's overrides the textureInfo's (as the extension says: an exporter may keep the
 pre-transform set there and a fallback set in the textureInfo); the set used must be 0, since the meshes
-carry one UV set, TEXCOORD_0 (scene/gltf.py reads no TEXCOORD_1): another is an error at the texCoord that
+carry one UV set, TEXCOORD_0 (scene/gltf_meshes.py reads no TEXCOORD_1): another is an error at the texCoord that
 chose it.
 """
 from __future__ import annotations
