@@ -14,6 +14,7 @@ out, and values above 1 are clipped as a UNORM target would.
 """
 BRICK = {
     "kind": "output",
+    "encodes": "sqrt",  # display-encoded: a UNORM attachment stores it (an _SRGB one would encode it twice)
     "cite": "Hoffman & Baker 2006, Gamma Conversion: sqrt(linear)",
 }
 

@@ -16,6 +16,7 @@ pow's base non-negative (pow of a negative base is undefined in GLSL and HLSL).
 """
 BRICK = {
     "kind": "output",
+    "encodes": "srgb",  # display-encoded: a UNORM attachment stores it (an _SRGB one would encode it twice)
     "cite": "IEC 61966-2-1:1999 sRGB encoding (piecewise)",
 }
 

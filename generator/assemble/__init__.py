@@ -29,7 +29,7 @@ from . import state
 from .context import BuildContext
 from .keys import build_key, scene_keys
 from .loop import compile_permutations
-from .manifest import FORMAT_VERSION, check as check_manifest, material_states, render_state
+from .manifest import FORMAT_VERSION, check as check_manifest, conventions, material_states, output_state, render_state
 from .outputs import clean_leftovers, collect_garbage, locked, shown, write_depfile
 from .platforms import PLATFORMS
 from .reflection import scene_tables
@@ -182,6 +182,7 @@ class _Build:
             "tools": self.tools,
             "languages": list(self.ctx.languages),
             "platforms": list(self.ctx.platforms),
+            "conventions": conventions(self.ctx.platforms),
             "permutations": entries,
             "ubershader": uber,
             **material_states(scene, scene_tables(scene, compiled.composed, self.previous)),
@@ -193,8 +194,12 @@ class _Build:
 
     def _head(self, h: str) -> dict:
         perm = self.scene.permutations[h]
-        return {"id": perm.canonical(), "hash": h, "input_key": self.keys.permutations[h],
+        head = {"id": perm.canonical(), "hash": h, "input_key": self.keys.permutations[h],
                 "objects": self.scene.users.get(h, []), "languages": {}, "render_state": render_state(perm.surface)}
+        out = self.ctx.library.get("output", perm.output)  # None: an unknown brick, which fails the permutation
+        if out is not None:
+            head["output"] = output_state(out)
+        return head
 
     def _written(self, pairs, part) -> None:
         """A compiled chunk: written and analysed while the next chunks compile."""

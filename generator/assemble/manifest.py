@@ -1,4 +1,5 @@
-"""manifest.json's format: its version, its JSON Schema (package data), and the render state it states.
+"""manifest.json's format: its version, its JSON Schema (package data), and the pipeline state and platform
+conventions it states (runtime/pipeline_state.py is their one statement, shared with the renderer).
 
 The schema (manifest.schema.json beside this module, JSON Schema draft 2020-12) is the one description of
 every field: docs/reference/manifest.md is generated from it, and an engine's loader can validate against
@@ -19,35 +20,16 @@ import os
 from importlib import resources
 
 from ..lang.errors import UserError
-from ..spec.surface import Surface
+from ..runtime.pipeline_state import object_block, output_state, render_state  # noqa: F401 (the build's)
 
 FORMAT_VERSION = 1
 SCHEMA_FILE = "manifest.schema.json"
 CHECK_ENV = "SHADERMATRIX_CHECK_MANIFEST"
 
-# Source-over for a shader whose colour is not premultiplied (link/glue.py surface_output returns the output
-# brick's colour as is, its alpha the coverage); the attachment's alpha accumulates coverage, a + d(1 - a).
-_SOURCE_OVER = {"color": {"src": "src_alpha", "dst": "one_minus_src_alpha", "op": "add"},
-                "alpha": {"src": "one", "dst": "one_minus_src_alpha", "op": "add"},
-                "premultiplied": False}
-
 
 class ManifestSchemaError(UserError):
     """The manifest a build was about to write does not match its schema (a generator bug, or a hand-edited
     manifest whose entries the build kept)."""
-
-
-def render_state(surface: Surface, cutoff: float | None = None) -> dict:
-    """The pipeline state of a surface (spec/surface.py): alpha mode, blending, culling, depth. `cutoff`: a
-    material's alpha_cutoff, stated with alpha mode mask (a permutation has none: its materials share it)."""
-    state: dict = {"alpha_mode": surface.alpha}
-    if surface.alpha == "mask" and cutoff is not None:
-        state["alpha_cutoff"] = cutoff
-    blend = surface.alpha == "blend"
-    state["blend"] = dict(_SOURCE_OVER) if blend else None
-    state["cull"] = "none" if surface.double_sided else "back"
-    state["depth"] = {"test": True, "write": not blend, "compare": "less"}
-    return state
 
 
 def material_states(scene, tables: dict) -> dict:
@@ -56,6 +38,14 @@ def material_states(scene, tables: dict) -> dict:
                                                               entry["params"].get("alpha_cutoff"))}
                  for name, entry in tables["materials"].items()}
     return {**tables, "materials": materials}
+
+
+def conventions(platforms) -> dict:
+    """The manifest's ``conventions``: what the Object block holds (runtime/pipeline_state.py), and per platform
+    written its clip space, front face, cull modes, attachment formats and the Object block's binding, in its
+    API's words (each platform class's declarations: assemble/platform_base.py conventions_section)."""
+    from .platforms import PLATFORM_TABLE
+    return {"object_block": object_block(), "platforms": {p: PLATFORM_TABLE[p].conventions_section() for p in platforms}}
 
 
 @functools.lru_cache(maxsize=1)

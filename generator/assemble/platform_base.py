@@ -88,6 +88,14 @@ class Platform:
     binary: str | None = None       # the artifact kind an optional tool compiles its main source to (d3d12: dxil)
     ubershader: bool = False        # whether its pack holds the ubershader (its made_from's SPIR-V)
     conventions: Conventions
+    # the conventions in the API's words (the manifest's conventions.platforms.<name>): the pipeline state that
+    # makes a counter-clockwise triangle a front face, each cull mode of a render state, the attachment formats
+    # by their API-neutral names (runtime/pipeline_state.py COLOR_FORMATS, DEPTH_FORMAT), and where a state
+    # the API needs besides them (gl: the clip control that makes depth 0..1, the sRGB write switch) is named
+    front_face_state: dict = {}
+    cull_states: dict = {}
+    formats: dict[str, str] = {}
+    extra_state: dict[str, str] = {}
 
     def builds(self, unit: Unit) -> bool:
         """Whether this permutation's build makes the platform (a build of fewer languages makes fewer)."""
@@ -101,6 +109,26 @@ class Platform:
     def check_note(self) -> str | None:
         """What a check of this platform leaves out on this machine (a tool not on PATH), or None."""
         return None
+
+    def block_binding(self, set_: int, binding: int) -> dict:
+        """Where a uniform block at Vulkan's (set, binding) binds on this platform, in its reflection's words; a
+        value that differs by permutation (gl numbers its blocks per program) is None there."""
+        raise NotImplementedError
+
+    def conventions_section(self) -> dict:
+        """The manifest's conventions.platforms.<name>: clip space, front face and cull modes, attachment
+        formats and where the Object block binds (runtime/pipeline_state.py states what it holds)."""
+        from ..runtime.pipeline_state import COLOR_FORMATS, DEPTH_CLEAR, DEPTH_FORMAT, OBJECT_SET_BINDING
+        c = self.conventions
+        d = {"clip": {"depth_range": c.depth_range, "ndc_y": c.ndc_y, "framebuffer_origin": c.framebuffer_origin},
+             "front_face": {"winding": c.front_face, "state": dict(self.front_face_state)},
+             "cull": {mode: dict(state) for mode, state in self.cull_states.items()},
+             "attachments": {"color": {k: self.formats[f] for k, f in COLOR_FORMATS.items()},
+                             "depth": self.formats[DEPTH_FORMAT], "depth_clear": DEPTH_CLEAR},
+             "object_block": self.block_binding(*OBJECT_SET_BINDING)}
+        if self.extra_state:
+            d["state"] = dict(self.extra_state)
+        return d
 
     def spell_sampler(self, state: dict) -> dict:
         """A sampler state (scene/textures.Sampler.as_dict) in this API's words (assemble/samplers.py)."""

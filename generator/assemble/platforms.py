@@ -47,6 +47,10 @@ class Vulkan(Platform):
     checked_from = LANGUAGES  # a vulkan check compiles every language it is given to SPIR-V
     ubershader = True
     conventions = Conventions(depth_range="0..1", ndc_y="down", framebuffer_origin="top-left", front_face="ccw")
+    front_face_state = {"frontFace": "VK_FRONT_FACE_COUNTER_CLOCKWISE"}
+    cull_states = {"back": {"cullMode": "VK_CULL_MODE_BACK_BIT"}, "none": {"cullMode": "VK_CULL_MODE_NONE"}}
+    formats = {"R8G8B8A8_SRGB": "VK_FORMAT_R8G8B8A8_SRGB", "R8G8B8A8_UNORM": "VK_FORMAT_R8G8B8A8_UNORM",
+               "D32_SFLOAT": "VK_FORMAT_D32_SFLOAT"}
     _TYPES = {"uniform": "uniform_buffer", "storage": "storage_buffer", "image": "sampled_image", "sampler": "sampler"}
 
     def section(self, unit: Unit) -> dict:
@@ -67,6 +71,9 @@ class Vulkan(Platform):
                                   for v in iface.vertex_inputs],
                 "push_constants": []}
 
+    def block_binding(self, set_: int, binding: int) -> dict:
+        return {"set": set_, "binding": binding}
+
     def spell_sampler(self, state: dict) -> dict:
         return samplers.vulkan(state)
 
@@ -79,6 +86,10 @@ class D3D12(Platform):
     ext = {"hlsl": "hlsl", "dxil": "dxil"}
     checked_from, binary = ("hlsl",), "dxil"
     conventions = Conventions(depth_range="0..1", ndc_y="up", framebuffer_origin="top-left", front_face="ccw")
+    front_face_state = {"FrontCounterClockwise": True}  # D3D12_RASTERIZER_DESC; its default is clockwise
+    cull_states = {"back": {"CullMode": "D3D12_CULL_MODE_BACK"}, "none": {"CullMode": "D3D12_CULL_MODE_NONE"}}
+    formats = {"R8G8B8A8_SRGB": "DXGI_FORMAT_R8G8B8A8_UNORM_SRGB", "R8G8B8A8_UNORM": "DXGI_FORMAT_R8G8B8A8_UNORM",
+               "D32_SFLOAT": "DXGI_FORMAT_D32_FLOAT"}
     _CLASSES = {"uniform": ("CBV", "b"), "storage": ("SRV", "t"), "image": ("SRV", "t"), "sampler": ("Sampler", "s")}
     _FORMATS = {"R32G32B32_SFLOAT": "DXGI_FORMAT_R32G32B32_FLOAT", "R32G32B32A32_SFLOAT": "DXGI_FORMAT_R32G32B32A32_FLOAT",
                 "R32G32_SFLOAT": "DXGI_FORMAT_R32G32_FLOAT"}
@@ -110,6 +121,9 @@ class D3D12(Platform):
                                "visibility": st, **x} for k, s, b, n, st, x in resource_rows(iface)],
                 "input_layout": [{"semantic": self._SEMANTICS[v.name][0], "semantic_index": self._SEMANTICS[v.name][1],
                                   "format": self._FORMATS[v.format], "name": v.name} for v in iface.vertex_inputs]}
+
+    def block_binding(self, set_: int, binding: int) -> dict:
+        return {"register": f"b{binding}", "space": set_}
 
     def binary_step(self):
         """DXC, or None when no dxc is on PATH (docs/guide/install.md: where to get one)."""
@@ -143,6 +157,14 @@ class Gl(Platform):
     tools = ("glslang",)
     ext = {"gl": "glsl", "essl": "essl"}
     conventions = Conventions(depth_range="-1..1", ndc_y="up", framebuffer_origin="bottom-left", front_face="ccw")
+    front_face_state = {"glFrontFace": "GL_CCW"}  # OpenGL's default
+    cull_states = {"back": {"glEnable": "GL_CULL_FACE", "glCullFace": "GL_BACK"}, "none": {"glDisable": "GL_CULL_FACE"}}
+    formats = {"R8G8B8A8_SRGB": "GL_SRGB8_ALPHA8", "R8G8B8A8_UNORM": "GL_RGBA8", "D32_SFLOAT": "GL_DEPTH_COMPONENT32F"}
+    extra_state = {"depth_range_0_1": "glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) (OpenGL 4.5 or ARB_clip_control; "
+                                      "ES: EXT_clip_control) maps clip z / w in 0..1 to depth as the other platforms "
+                                      "do; without it the projection must put z / w in -1..1",
+                   "srgb_write": "glEnable(GL_FRAMEBUFFER_SRGB) on desktop OpenGL, or a GL_SRGB8_ALPHA8 attachment "
+                                 "stores what is written unencoded (OpenGL ES encodes always)"}
 
     def section(self, unit: Unit) -> dict:
         name = unit.name
@@ -179,6 +201,9 @@ class Gl(Platform):
                              for k, s, b, n, st, x in rows if k == "image"],
                 "vertex_inputs": [{"location": v.location, "name": v.name} for v in iface.vertex_inputs]}
 
+    def block_binding(self, set_: int, binding: int) -> dict:
+        return {"binding": None}  # gl_bindings numbers a program's blocks in order: see each reflection
+
     def spell_sampler(self, state: dict) -> dict:
         return samplers.gl(state)
 
@@ -197,6 +222,9 @@ class WebGpu(Platform):
     ext = {"wgsl": "wgsl"}
     checked_from = ("wgsl",)
     conventions = Conventions(depth_range="0..1", ndc_y="up", framebuffer_origin="top-left", front_face="ccw")
+    front_face_state = {"frontFace": "ccw"}  # GPUPrimitiveState; the default
+    cull_states = {"back": {"cullMode": "back"}, "none": {"cullMode": "none"}}
+    formats = {"R8G8B8A8_SRGB": "rgba8unorm-srgb", "R8G8B8A8_UNORM": "rgba8unorm", "D32_SFLOAT": "depth32float"}
     _FORMATS = {"R32G32B32_SFLOAT": "float32x3", "R32G32B32A32_SFLOAT": "float32x4", "R32G32_SFLOAT": "float32x2"}
     _VISIBILITY = {"vert": "VERTEX", "frag": "FRAGMENT"}
 
@@ -216,6 +244,9 @@ class WebGpu(Platform):
                                  **resource(k, x)} for k, s, b, n, st, x in resource_rows(iface)],
                 "vertex_inputs": [{"shaderLocation": v.location, "name": v.name, "format": self._FORMATS[v.format]}
                                   for v in iface.vertex_inputs]}
+
+    def block_binding(self, set_: int, binding: int) -> dict:
+        return {"group": set_, "binding": binding}
 
     def spell_sampler(self, state: dict) -> dict:
         return samplers.webgpu(state)

@@ -30,7 +30,7 @@ BUILTIN_BRICKS = _INSTALLED_BRICKS if _INSTALLED_BRICKS.is_dir() else REPO / "br
 
 
 PARAM_TYPES = ("float", "vec2", "vec3", "vec4", "mat4")
-META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc", "fp16", "tolerance"}
+META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc", "fp16", "tolerance", "encodes"}
 
 
 @dataclass
@@ -62,6 +62,9 @@ class Brick:
     # the float32 hemisphere max relative error the brick's approximation (a baked table, a fit) is chosen
     # for: `accuracy` passes it up to max(tolerance, --fail-above); 0: exact up to rounding
     tolerance: float = 0.0
+    # an output brick's: what its colour is, "linear" radiance or display-encoded ("srgb", "sqrt"), which decides
+    # the colour attachment that stores it (runtime/pipeline_state.py); "linear" unless the brick says otherwise
+    encodes: str = "linear"
 
     @property
     def fp16_unsafe(self) -> str:
@@ -275,8 +278,13 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
     if kind == "packing" and "normal" not in slots:
         raise _meta_error(shown, loc, "a packing brick needs a 'normal' slot (the shading normal it provides)",
                           '"slots": {"normal": {"kind": "normal", "default": "vertex"}}')
+    if "encodes" in meta and kind != "output":
+        line, col = positions.get(("encodes",), (loc.line, loc.col))
+        raise SourceError(shown, line, col, f"'encodes' is declared by a {kind} brick",
+                          "only an output brick says what its colour encodes: remove it")
     brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip(),
-                  str(meta.get("fp16", "")).strip(), float(meta.get("tolerance", 0.0)))
+                  str(meta.get("fp16", "")).strip(), float(meta.get("tolerance", 0.0)),
+                  meta.get("encodes", "linear"))
     _check_entries(brick, loc)
     return brick
 

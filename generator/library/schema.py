@@ -32,6 +32,8 @@ BRICK_SCHEMA = {
         "fp16": {"type": "string", "maxLength": 1000},  # "unsafe: why" makes an fp16 build warn
         "needs": {"type": "array", "items": IDENT},
         "tolerance": {"type": "number", "minimum": 0.0, "maximum": 100.0},  # a 3-factor fit: ~36 (homomorphic_factorization)
+        # an output brick's colour: linear radiance, or encoded for display (exactly sRGB, or sqrt's approximation)
+        "encodes": {"enum": ["linear", "srgb", "sqrt"]},
         "params": {"type": "object", "propertyNames": IDENT, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type", "default"],
             "properties": {"type": {"type": "string"}, "default": VALUE, "doc": {"type": "string"},

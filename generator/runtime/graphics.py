@@ -10,9 +10,10 @@
   vertex buffer binding per vertex input (the Interface's ``vertex_inputs``: location, name, Vulkan
   format), descriptor sets described by ``set_layouts`` ({set: {binding: kind}}, kinds of
   :mod:`.compute`: UNIFORM, STORAGE, SAMPLED_IMAGE, SAMPLER), as :func:`layouts_from_interface`
-  reads them off an Interface. Triangle lists, cull mode none (back with ``cull_back``: a single-sided
-  material, spec/surface.py), front faces counter-clockwise, depth test LESS with writes, viewport and
-  scissor = the target, no blending (source-over with ``blend``: glTF's BLEND, src·a + dst·(1 − a)).
+  reads them off an Interface. Triangle lists, front faces counter-clockwise, viewport and scissor = the
+  target; cull, blend and depth write from a ``render_state`` (the manifest's: runtime/pipeline_state.py
+  render_state), or without one cull mode none (back with ``cull_back``), depth test LESS with writes and no
+  blending (source-over with ``blend``: src·a + dst·(1 − a)).
 - :class:`GpuMesh`: a :class:`~.meshes.Mesh` uploaded, one vertex buffer per attribute, and its
   uint32 index buffer.
 - :class:`DepthTarget`: a D32_SFLOAT image drawn by a depth-only render pass (vertex-only pipelines), then
@@ -104,6 +105,18 @@ def save_png(array, path) -> Path:
 
 # ------------------------------------------------------------------ pipeline
 
+def _from_render_state(state: dict) -> tuple[bool, bool, bool]:
+    """(cull back, blend source-over, write depth) of a manifest render_state; ValueError for a state this
+    pipeline cannot draw (another blend equation or depth test than the manifest's format 1 states)."""
+    from .pipeline_state import SOURCE_OVER
+    depth = state["depth"]
+    if state["blend"] not in (None, SOURCE_OVER) or not depth["test"] or depth["compare"] != "less" \
+            or state["cull"] not in ("back", "none"):
+        raise ValueError(f"this renderer draws source-over or no blending, cull back or none, depth test less; not "
+                         f"{state}")
+    return state["cull"] == "back", state["blend"] is not None, bool(depth["write"])
+
+
 class GraphicsPipeline:
     """A vertex + fragment pipeline for `target`'s render pass, or a vertex-only one (``frag_spirv=None``) for a
     :class:`DepthTarget` (depth-only: no colour attachment, so no blend state and no fragment stage).
@@ -119,9 +132,11 @@ class GraphicsPipeline:
                  frag_spirv: bytes | None,
                  vertex_inputs, set_layouts: dict[int, dict[int, str]], specialization: dict[int, int] | None = None,
                  vert_entry: str = "main", frag_entry: str = "main", cache=None, flags: int = 0,
-                 cull_back: bool = False, blend: bool = False):
+                 cull_back: bool = False, blend: bool = False, render_state: dict | None = None):
         vk = self.vk = device.vk
-        self.cull_back, self.blend = cull_back, blend  # render state of the surface (spec/surface.py)
+        self.cull_back, self.blend, self.depth_write = cull_back, blend, True
+        if render_state is not None:  # the surface's pipeline state as the manifest states it
+            self.cull_back, self.blend, self.depth_write = _from_render_state(render_state)
         self.flags = flags  # VkPipelineCreateFlags (e.g. capture statistics: runtime/gpu_stats.py)
         self.cache = cache  # a runtime.pipeline_cache.PipelineCacheFile, or None
         self.device, self.target = device, target
@@ -207,7 +222,8 @@ class GraphicsPipeline:
                                       depthFailOp=vk.VK_STENCIL_OP_KEEP, compareOp=vk.VK_COMPARE_OP_ALWAYS,
                                       compareMask=0, writeMask=0, reference=0)
         depth = vk.VkPipelineDepthStencilStateCreateInfo(
-            depthTestEnable=vk.VK_TRUE, depthWriteEnable=vk.VK_TRUE, depthCompareOp=vk.VK_COMPARE_OP_LESS,
+            depthTestEnable=vk.VK_TRUE, depthWriteEnable=vk.VK_TRUE if self.depth_write else vk.VK_FALSE,
+            depthCompareOp=vk.VK_COMPARE_OP_LESS,
             depthBoundsTestEnable=vk.VK_FALSE, stencilTestEnable=vk.VK_FALSE, front=stencil, back=stencil,
             minDepthBounds=0.0, maxDepthBounds=1.0)
         mask = (vk.VK_COLOR_COMPONENT_R_BIT | vk.VK_COLOR_COMPONENT_G_BIT | vk.VK_COLOR_COMPONENT_B_BIT

@@ -39,9 +39,10 @@ and a masked material's depth pass bind the same image and sampler. Only the ren
 here: a brick's baked table (reference/tables.py), the lit stand-ins of unused shadow slots, and a grey image
 for an ubershader texture the drawn material does not bind (its variant never samples it). The surface state of a permutation
 (spec/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
-pipelines blend source-over and are drawn after the opaque ones (not sorted by depth), the back faces of
-what a glTF file calls single-sided are culled (TOML objects keep cull mode none); the ubershader implements
-none of it (it stands in for the BRDF, packing and output only). Pipelines are created through
+pipelines blend source-over without writing depth and are drawn after the opaque ones (not sorted by depth),
+single-sided surfaces cull their back faces, all as the manifest's render_state says (the given build's entry,
+else runtime/pipeline_state.py, the function the build writes it with); the ubershader implements none of it
+(it stands in for the BRDF, packing and output only). Pipelines are created through
 a persisted pipeline cache (runtime/pipeline_cache.py), and when the render opens its own device,
 Mesa's shader disk cache lives in out/shader_cache and the driver's hit and miss counts go into the
 report (runtime/shader_cache.py).
@@ -162,7 +163,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     shadow_size: the side of every light's shadow map (depth pass), in texels.
     placement_file: the placement to use (default: the scene's SCENE.placement.toml if present, else the row).
     build: the build whose texture artifacts the materials draw (a folder holding its manifest.json, or a
-    runtime.material_textures.BuildOutputs); needed where a drawn material binds textures.
+    runtime.material_textures.BuildOutputs); needed where a drawn material binds textures. The render state of
+    a permutation its manifest lists is read from there too.
     """
     from ..link.values import entry_bytes, light_entry, uploads
     from ..compose import compose_permutation
@@ -181,6 +183,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..link import link_permutation
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
     from .material_textures import BuildOutputs, MaterialTextures
+    from .pipeline_state import render_state
     from .shadow_pass import (VULKAN_CONVENTIONS, depth_pass, depth_plan, fit_shadow_matrix, pass_units,
                               shadowed_lights)
 
@@ -300,10 +303,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     frag = spv[(f"{tag}{variant}", "frag")]
                 else:
                     spec = {SPEC_VARIANT: variant}
-            sf = perms[tag].surface if tag in perms else None  # the ubershader: no surface state (docs/design/runtime.md)
             p = gx.GraphicsPipeline(device, target, spv[(tag, "vert")], frag, iface.vertex_inputs,
                                     gx.layouts_from_interface(iface), cache=cache, specialization=spec,
-                                    cull_back=tag in single_sided, blend=sf is not None and sf.alpha == "blend")
+                                    render_state=states.get(tag))  # the ubershader: none (docs/design/runtime.md)
             owned.append(p)  # released whatever happens next (list.append is atomic: the worker may call this)
             report.pipeline_create_ms.append((time.perf_counter() - t0) * 1e3)
             report.pipelines_created += 1
@@ -311,9 +313,13 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             return p
 
         object_bufs = [buf(gx.object_bytes(o.model), U) for o in placed.objects]
-        # Back faces are culled for what a glTF file says is single-sided (its objects carry double_sided
-        # False); a TOML scene's objects keep cull mode none, as they were always drawn (spec/surface.py).
-        single_sided = {o["permutation"] for o in scene.objects if o.get("double_sided") is False}
+        # Each permutation's pipeline state is the manifest's render_state: the build's entry where a build is
+        # given that lists it, else the same function's value (runtime/pipeline_state.py, what the build writes):
+        # back faces culled for a single-sided surface (TOML or glTF), blending and no depth write for blend.
+        entries = (build.manifest.get("permutations") or []) if build is not None else []
+        listed = {e.get("hash"): e["render_state"] for e in entries
+                  if isinstance(e, dict) and isinstance(e.get("render_state"), dict)}
+        states = {h: listed.get(h) or render_state(p.surface) for h, p in perms.items()}
 
         # Depth passes: every object drawn from each shadowed light by the generated depth units, as its
         # depth_pass description says (runtime/depth_passes.py).

@@ -320,7 +320,9 @@ class RenderPassOnly:
 
 class OffscreenTarget(_Target):
     """A W×H R8G8B8A8_UNORM colour image and D32_SFLOAT depth, their render pass and framebuffer, a readback
-    buffer and two timestamp queries. Draw frames with :meth:`draw`, read the last one with :meth:`read`."""
+    buffer and two timestamp queries. Draw frames with :meth:`draw`, read the last one with :meth:`read`.
+    `color_format` R8G8B8A8_SRGB makes the colour attachment encode what is written (the manifest's attachment
+    for a linear output); the renderer's default stores the shader's values as they are."""
 
     ATTACHMENTS = ("depth", "color")
 
@@ -332,12 +334,14 @@ class OffscreenTarget(_Target):
     def _after_pass(self, cmd) -> None:
         pass
 
-    def __init__(self, device: Device, width: int, height: int):
+    def __init__(self, device: Device, width: int, height: int, color_format: str = COLOR_FORMAT):
         vk = self.vk = device.vk
         self.device, self.width, self.height = device, int(width), int(height)
         if self.width < 1 or self.height < 1:
             raise ValueError(f"a target needs W, H ≥ 1, got {width}x{height}")
-        self.color_format, self.depth_format = _format(vk, COLOR_FORMAT), _format(vk, DEPTH_FORMAT)
+        if color_format not in ("R8G8B8A8_UNORM", "R8G8B8A8_SRGB"):  # read() reads 4 bytes a pixel
+            raise ValueError(f"an offscreen target's colour is R8G8B8A8_UNORM or R8G8B8A8_SRGB, not {color_format!r}")
+        self.color_format, self.depth_format = _format(vk, color_format), _format(vk, DEPTH_FORMAT)
         self.color = self.depth = self.render_pass = self.framebuffer = self.readback = self.queries = None
         self.gpu_ms: float | None = None
         self._drawn = False

@@ -14,8 +14,8 @@ defaults writes nothing more and keeps its canonical string and hash (goldens, c
 - `double_sided`: false (default) | true. The fragment main reverses N, T and B on back faces
   (gl_FrontFacing / SV_IsFrontFace / @builtin(front_facing)) before shading: glTF 3.9.5, "the back-face must
   have its normals reversed before the lighting equation is evaluated". The pipeline's cull mode (none vs
-  back) is render state, not shader code: the renderer culls the back faces of a glTF object whose material
-  is single-sided (the object's `double_sided`, runtime/renderer.py); TOML objects keep cull mode none.
+  back) is render state, not shader code: runtime/pipeline_state.py render_state states it for the manifest
+  and the renderer (back for a single-sided surface, TOML or glTF).
 - `vertex_color`: false (default) | true. COLOR_0 (RGBA; a mesh without one reads white) is a vertex input
   and interpolant; rho_d is multiplied by its RGB before the BRDF (glTF: base colour · COLOR_0; exact for
   rho_d = base (1 − metallic); f0 = mix(0.04, base, metallic) of a metal is not tinted) and its A scales
