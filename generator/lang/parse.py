@@ -261,7 +261,7 @@ def _module_constant(path, node, name, value) -> ir.Const:
 
 # Struct and block names of the templates and the glue (backends/*/templates, link/glue.py LightData<i>, link/uber.py,
 # link/__init__.py): a brick's struct is emitted under its own name beside them, so it may be none of them.
-TEMPLATE_STRUCTS = frozenset({"Draw", "Frame", "Info", "LightEntry", "Lights", "Material", "MaterialBuffer",
+TEMPLATE_STRUCTS = frozenset({"Blur", "Draw", "Frame", "Info", "LightEntry", "Lights", "Material", "MaterialBuffer",
                               "MaterialEntry", "Object", "PSIn", "Params", "Result", "Samples", "VSIn", "VSOut"})
 _TEMPLATE_STRUCT_FAMILIES = re.compile(r"(LightData|LightBuffer)[0-9]*")
 _STRUCT_NAME = re.compile(r"[A-Z][A-Za-z0-9]*")
