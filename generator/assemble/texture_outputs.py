@@ -15,6 +15,11 @@ again, and the bindings that use it).
 Shadow maps are the renderer's (or engine's) images, not artifacts: each platform reflection's sampler
 descriptor of a light texture gets ``sampler_state``, the row of ``samplers`` its brick reads with —
 bilinear, level 0, clamped; a ``texture2d_shadow`` (pcf_hardware) a comparison sampler, less-or-equal.
+
+Baked tables (assemble/tables.py) are read as their bricks' texel-centre arithmetic assumes: bilinear, level
+0, clamped to the edge. Each row of the manifest's ``tables`` gets ``sampler`` (that state with ``index``, its
+row of ``samplers``, as a material binding has it), and each reflection's sampler descriptor of a table
+``sampler_state``, the same index.
 """
 from __future__ import annotations
 
@@ -31,7 +36,10 @@ from .textures import TEXTURES_DIR, texture_artifact
 # the states the shadow bricks are read with (what runtime/renderer.py binds: bilinear, clamp to edge, level 0)
 SHADOW_SAMPLER = Sampler(mipmap="none", wrap_u="clamp", wrap_v="clamp")
 SHADOW_COMPARE_SAMPLER = Sampler(mipmap="none", wrap_u="clamp", wrap_v="clamp", compare="less_or_equal")
+# the state a baked table is read with: what its brick's texel-centre arithmetic assumes
+TABLE_SAMPLER = Sampler(mipmap="none", wrap_u="clamp", wrap_v="clamp")
 _LIGHT_NAME = re.compile(r"^(?:_smp_)?l\d+_(.+)$")  # a light texture's resource (l0_shadow_map) and sampler
+_TEXTURE_NAME = re.compile(r"^(?:_smp_)?t_(.+)$")  # a material texture's resource (t_on_sin_sin) and sampler
 _OWN_TMP = re.compile(r"^\..+\.[^.]+\.tmp$")  # io.atomic_write's temporaries, left by an interrupted build
 
 
@@ -113,6 +121,7 @@ def write_textures(out: Path, scene: Scene, manifest: dict, count=None, previous
     if files:
         manifest["textures"] = sorted(files.values(), key=lambda r: r["path"])
     _light_samplers(manifest, samplers)
+    _table_samplers(manifest, samplers)
     manifest.pop("samplers", None)
     if samplers.rows:
         manifest["samplers"] = samplers.rows
@@ -149,6 +158,27 @@ def _light_samplers(manifest: dict, samplers: _Samplers) -> None:
                     op = t.get("compare_op") or SHADOW_COMPARE_SAMPLER.compare
                     d["sampler_state"] = samplers(replace(SHADOW_COMPARE_SAMPLER, compare=op) if compared
                                                   else SHADOW_SAMPLER)
+
+
+def _table_samplers(manifest: dict, samplers: _Samplers) -> None:
+    """Each row of ``tables`` gets ``sampler``, each reflection's sampler descriptor of a table ``sampler_state``
+    (module docstring)."""
+    tables = [t for t in manifest.get("tables", []) if isinstance(t, dict)]
+    if not tables:
+        return
+    index = samplers(TABLE_SAMPLER)
+    for t in tables:
+        t["sampler"] = {**TABLE_SAMPLER.as_dict(), "index": index}
+    names = {t.get("texture") for t in tables}
+    for e in [*manifest.get("permutations", []), manifest.get("ubershader") or {}]:
+        bound = {t["name"] for t in _stage_textures(e) if "light" not in t} & names
+        if not bound:
+            continue
+        for refl in ((p or {}).get("reflection") for p in (e.get("platforms") or {}).values()):
+            for d in _sampler_descriptors(refl):
+                named = _TEXTURE_NAME.match(str(d.get("name", "")))  # WebGPU's entries name no parameter
+                if (d.get("parameter") or (named and named[1])) in bound:
+                    d["sampler_state"] = index
 
 
 def _sampler_descriptors(refl) -> list:

@@ -8,7 +8,9 @@ found through the fields an engine reads (assemble/texture_outputs.py writes the
   ``sha256``, ``format``, ``width``, ``height``, ``levels``, and ``sampler.index``, its row in ``samplers``;
   where the build reflected the permutation, the ``set``/``binding`` of the image (and under ``ubershader``
   the ubershader's), which the renderer checks against the bindings of the shaders it draws with;
-- ``samplers[index].platforms.vulkan``: the sampler state in VkSamplerCreateInfo's words.
+- ``samplers[index].platforms.vulkan``: the sampler state in VkSamplerCreateInfo's words;
+- ``tables[i].sampler.index``: the row of ``samplers`` a baked table is read with (the renderer bakes the
+  table's texels itself, the same bytes as the build's file: reference/tables.py).
 
 Each file is read once, its sha256 checked against the manifest's, decoded with all its levels
 (io/ktx2.decode_levels), checked against the row (format, size, levels) and uploaded as one
@@ -163,14 +165,32 @@ class MaterialTextures:
 
     def sampler(self, material: str, name: str):
         """The Sampler of texture `name` of `material`: its manifest state, one Sampler per distinct state."""
+        index = self.build.rows(material)[name]["sampler"]["index"]
+        return self._sampler(index, self.build.sampler_state(index), f"{material}/{name}")
+
+    def table_sampler(self, name: str):
+        """The Sampler of baked table `name`: the state its row of the build's ``tables`` names, or None where no
+        build was given or it lists no such table (the renderer's default sampler then: the same state)."""
+        if self.build is None:
+            return None
+        for i, row in enumerate(self.build.manifest.get("tables") or []):
+            if isinstance(row, dict) and row.get("texture") == name:
+                index = (row.get("sampler") or {}).get("index")
+                state = self.build.sampler_state(index)
+                if state is None:
+                    raise UserError(f"{self._where()}: tables[{i}] ({name}): sampler index {index!r} names no row of "
+                                    f"samplers spelled for vulkan — {REBUILD}")
+                return self._sampler(index, state, f"table {name}")
+        return None
+
+    def _sampler(self, index: int, state: dict, what: str):
+        """One Sampler per distinct state (what the device cannot do clamped, said in notes)."""
         from .images import Sampler
 
-        index = self.build.rows(material)[name]["sampler"]["index"]
-        state = self.build.sampler_state(index)
         key = tuple(sorted(state.items()))
         if key not in self._samplers:
             s = self._samplers[key] = Sampler(self.device, state)
-            self.notes += [f"samplers[{index}] ({material}/{name}): {n}" for n in s.notes]
+            self.notes += [f"samplers[{index}] ({what}): {n}" for n in s.notes]
         return self._samplers[key]
 
     def report(self) -> dict:

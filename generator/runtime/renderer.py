@@ -36,7 +36,8 @@ image or the generated one, is the KTX2 artifact the build's manifest lists for 
 sha256-checked and uploaded with its whole mip chain, read through the sampler the manifest spells for Vulkan
 (``samplers[i].platforms.vulkan``), one VkSampler per distinct state; the specialized pipelines, the ubershader
 and a masked material's depth pass bind the same image and sampler. Only the renderer's own inputs are made
-here: a brick's baked table (reference/tables.py), the lit stand-ins of unused shadow slots, and a grey image
+here: a brick's baked table (reference/tables.py; read through the sampler its row of the build's ``tables``
+names), the lit stand-ins of unused shadow slots, and a grey image
 for an ubershader texture the drawn material does not bind (its variant never samples it). The surface state of a permutation
 (spec/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
 pipelines blend source-over without writing depth and are drawn after the opaque ones (not sorted by depth),
@@ -284,7 +285,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 return depth_compared(None), sampler_of(t)
             if mtex.row(material, t.param) is not None:
                 return mtex.image(material, t.param), mtex.sampler(material, t.param)
-            return textures[t.param], sampler
+            return textures[t.param], mtex.table_sampler(t.param) or sampler  # a table: the state its row names
         vk = device.vk
         U, S = vk.VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk.VK_BUFFER_USAGE_STORAGE_BUFFER_BIT
 

@@ -121,6 +121,20 @@ def test_a_build_writes_the_tables_its_shaders_sample_as_ktx2_listed_in_the_mani
     assert np.array_equal(texels, tables.baked("oren_nayar_sin_sin", (64, 64), "unorm8"))
     assert row["error"]["max_rel"] < 0.05 and "Oren & Nayar" in row["reference"]
     assert set(row["used_by"]) == {m["permutations"][0]["hash"], "ubershader"}
+    # read as the brick's texel-centre arithmetic assumes: bilinear, level 0, clamped; its row of samplers,
+    # which every platform reflection's sampler of the table names too
+    index = row["sampler"]["index"]
+    assert {k: v for k, v in row["sampler"].items() if k != "index"} == {
+        "mag_filter": "linear", "min_filter": "linear", "mipmap": "none", "wrap_u": "clamp", "wrap_v": "clamp",
+        "anisotropy": 1, "lod_bias": 0.0, "compare": None}
+    vk = m["samplers"][index]["platforms"]["vulkan"]
+    assert vk["maxLod"] == 0.0 and vk["addressModeU"] == "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE"
+    for platform, p in m["permutations"][0]["platforms"].items():
+        refl = p["reflection"]
+        rows = [*refl.get("descriptors", []), *refl.get("resources", []), *refl.get("samplers", []),
+                *refl.get("bind_groups", [])]
+        assert [d.get("sampler_state") for d in rows if "on_sin_sin" in d["name"] and (
+            "sampler" in d or d.get("type") in ("sampler", "Sampler", "sampler2D"))] == [index], platform
     # a rebuild (another object, so not up to date) keeps the row whose input key and file are intact, and
     # bakes again a table whose file was damaged
     (tmp_path / "out" / row["path"]).write_bytes(b"damaged")

@@ -208,6 +208,39 @@ def test_the_textured_scene_draws_its_images_and_samplers(device, lib, tmp_path)
     assert len(lit) > 50 and (lit[:, 0] > lit[:, 2] + 20).mean() > 0.5, "the wall (leftmost) shows its red brick"
 
 
+def test_a_baked_table_is_read_through_the_sampler_its_row_names(device, lib, tmp_path):
+    """A factored BRDF's table (oren_nayar_factored: on_sin_sin) is drawn through the sampler of its row of the
+    build's ``tables``: the row as written draws what the renderer's default sampler draws (the same state),
+    one whose sampler row says nearest draws another image."""
+    from PIL import Image
+
+    from generator.assemble.render_inputs import scene_textures
+    from generator.runtime.material_textures import BuildOutputs
+    from generator.runtime.renderer import render_scene
+    from generator.scene.load import load_scene
+
+    path = tmp_path / "t.toml"
+    path.write_text('[scene]\nname = "t"\n[materials.m]\nbrdf = "oren_nayar_factored"\n[lights.sun]\n'
+                    'type = "directional"\n[light_sets]\nall = ["sun"]\n[[objects]]\nname = "o"\n'
+                    'material = "m"\nlights = "all"\n')
+    scene = load_scene(path, lib)
+    build = scene_textures(scene, tmp_path / "b", lib)
+    (row,) = [t for t in build.manifest["tables"] if t["texture"] == "on_sin_sin"]
+    state = build.manifest["samplers"][row["sampler"]["index"]]
+    assert (state["mipmap"], state["wrap_u"], state["mag_filter"]) == ("none", "clamp", "linear")
+
+    def frame(name, b):
+        render_scene(scene, lib, "specialized", 1, tmp_path / name, (W, H), device=device, build=b)
+        return np.asarray(Image.open(tmp_path / name / "frame_0000.png").convert("RGB")).astype(int)
+
+    plain = frame("none", None)
+    assert (frame("row", build) == plain).all(), "the table's row is the renderer's default state"
+    nearest = copy.deepcopy(build.manifest)
+    vk = nearest["samplers"][row["sampler"]["index"]]["platforms"]["vulkan"]
+    vk.update(magFilter="VK_FILTER_NEAREST", minFilter="VK_FILTER_NEAREST")
+    assert (frame("nearest", BuildOutputs(nearest, build.root)) != plain).any(), "the row's state is the one drawn"
+
+
 def test_what_the_device_cannot_do_is_clamped_and_said(device):
     from generator.assemble.samplers import spell
     from generator.runtime.images import Sampler

@@ -43,7 +43,7 @@ def run(args) -> int:
     elif out.is_dir() or not out.exists():  # (a file: the renderer's own error)
         # the texture part of a build, into the render's folder: the renderer reads what an engine reads
         from ...assemble.render_inputs import scene_textures
-        build = scene_textures(scene, out)
+        build = scene_textures(scene, out, lib)
     try:
         report = render_scene(scene, lib, args.mode, args.frames, out, (int(m[1]), int(m[2])),
                               args.language, progress=progress(), build=build)
