@@ -14,7 +14,8 @@ again, and the bindings that use it).
 
 Shadow maps are the renderer's (or engine's) images, not artifacts: each platform reflection's sampler
 descriptor of a light texture gets ``sampler_state``, the row of ``samplers`` its brick reads with —
-bilinear, level 0, clamped; a ``texture2d_shadow`` (pcf_hardware) a comparison sampler, less-or-equal.
+bilinear, level 0, clamped; a ``texture2d_shadow`` (pcf_hardware) a comparison sampler, less-or-equal. Each
+light's ``depth_pass.binds`` row names the same row by ``sampler_state``: the state is described once, here.
 
 Baked tables (assemble/tables.py) are read as their bricks' texel-centre arithmetic assumes: bilinear, level
 0, clamped to the edge. Each row of the manifest's ``tables`` gets ``sampler`` (that state with ``index``, its
@@ -154,10 +155,22 @@ def _light_samplers(manifest: dict, samplers: _Samplers) -> None:
                 named = _LIGHT_NAME.match(str(d.get("name", "")))  # WebGPU's entries name no parameter
                 t = lights.get(d.get("parameter") or (named and named[1]))
                 if t is not None:
-                    compared = t.get("compare") or t.get("sampler") == "comparison" or t.get("compare_op")
-                    op = t.get("compare_op") or SHADOW_COMPARE_SAMPLER.compare
-                    d["sampler_state"] = samplers(replace(SHADOW_COMPARE_SAMPLER, compare=op) if compared
-                                                  else SHADOW_SAMPLER)
+                    d["sampler_state"] = samplers(_light_state(t))
+    # the depth passes' binds name the same rows: one description of each light sampler, the samplers table's
+    by_hash = {e.get("hash"): e for e in manifest.get("permutations", [])}
+    for light in (manifest.get("lights") or {}).values():
+        for b in ((light or {}).get("depth_pass") or {}).get("binds", []):
+            t = next((t for t in _stage_textures(by_hash.get(b.get("permutation"), {}))
+                      if t.get("light") == b.get("light_index") and t.get("name") == b.get("texture")), None)
+            if t is not None:
+                b["sampler_state"] = samplers(_light_state(t))
+
+
+def _light_state(t: dict) -> Sampler:
+    """The state light texture `t` (an interface row) is read with: a comparison sampler where it compares."""
+    if t.get("compare") or t.get("sampler") == "comparison" or t.get("compare_op"):
+        return replace(SHADOW_COMPARE_SAMPLER, compare=t.get("compare_op") or SHADOW_COMPARE_SAMPLER.compare)
+    return SHADOW_SAMPLER
 
 
 def _table_samplers(manifest: dict, samplers: _Samplers) -> None:

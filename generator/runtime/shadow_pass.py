@@ -148,13 +148,6 @@ def platform_premultiply(depth_range: str, ndc_y: str, framebuffer_origin: str) 
     return m.tolist()
 
 
-def _sampler(compare: bool) -> dict:
-    base = {"filter": "linear", "mipmap": "nearest", "lod": [0.0, 0.0], "address": "clamp_to_edge"}
-    if compare:
-        return {**base, "compare_op": "less_or_equal", "border": "opaque_white"}
-    return base
-
-
 def depth_pass(light, textures: dict[str, bool], values: dict, units: dict, binds: list[dict],
                size: int = SHADOW_SIZE, platforms: dict | None = None) -> dict:
     """The depth pass of one shadowed light (scene Light `light`, the textures its filter samples, its parameter
@@ -191,7 +184,8 @@ def depth_pass(light, textures: dict[str, bool], values: dict, units: dict, bind
 
 def bindings(light_name: str, textures: dict[str, bool], objects, interfaces: dict) -> list[dict]:
     """Where a shadowed light's result binds: per permutation that reads it (an object's light set holds the light
-    at index i), the texture of light i its filter samples, with its set, binding, sampler binding and sampler.
+    at index i), the texture of light i its filter samples, with its set, binding and sampler binding (the build
+    adds ``sampler_state``, the row of the manifest's samplers it is read with: assemble/texture_outputs.py).
     interfaces: {permutation hash: its textures as the manifest's Interface lists them (Texture.as_dict)}."""
     rows, seen = [], set()
     for o in objects:
@@ -201,9 +195,7 @@ def bindings(light_name: str, textures: dict[str, bool], objects, interfaces: di
         i = o["lights"].index(light_name)
         for t in interfaces.get(o["permutation"], []):
             if t.get("light") == i and t["name"] in textures:
-                compare = textures[t["name"]]
                 reads = "moments" if t["name"] == MOMENTS else "depth"
                 rows.append({"permutation": o["permutation"], "light_index": i, "texture": t["name"], "set": t["set"],
-                             "binding": t["binding"], "sampler_binding": t["sampler_binding"], "image": reads,
-                             "sampler": _sampler(compare)})
+                             "binding": t["binding"], "sampler_binding": t["sampler_binding"], "image": reads})
     return sorted(rows, key=lambda r: (r["permutation"], r["texture"]))

@@ -114,6 +114,12 @@ def test_the_binds_are_where_each_permutation_reads_the_light_s_map(built):
                      if t.get("light") == index and t["name"] == texture)
             assert (b["set"], b["binding"], b["sampler_binding"]) == (t["set"], t["binding"], t["sampler_binding"])
             assert b["texture"] == texture and b["image"] == image and b["light_index"] == index
+            # its sampler is the samplers row the permutation's reflection names at sampler_binding (one description)
+            (d,) = [d for d in perms[b["permutation"]]["platforms"]["vulkan"]["reflection"]["descriptors"]
+                    if (d["set"], d["binding"]) == (b["set"], b["sampler_binding"])]
+            assert d["type"] == "sampler" and b["sampler_state"] == d["sampler_state"], (ln, b)
+            state = m["samplers"][b["sampler_state"]]
+            assert (state["mipmap"], state["wrap_u"], state["compare"]) == ("none", "clamp", None)
 
 
 def test_the_matrix_convention_maps_the_brick_s_texel_on_every_platform(built):

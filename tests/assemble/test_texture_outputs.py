@@ -205,6 +205,10 @@ def test_shadow_maps_get_their_sampler_in_every_platform_reflection(tmp_path):
     cmp = states["vulkan"]["shadow_depth"]["platforms"]
     assert cmp["vulkan"]["compareEnable"] is True and cmp["d3d12"]["Filter"] == "D3D12_FILTER_COMPARISON_MIN_MAG_LINEAR_MIP_POINT"
     assert cmp["gl"]["GL_TEXTURE_COMPARE_FUNC"] == "GL_LEQUAL" and cmp["webgpu"]["compare"] == "less-equal"
+    # each depth pass's binds name the same rows (the sampler is described once, in samplers)
+    binds = {b["texture"]: m["samplers"][b["sampler_state"]] for light in m["lights"].values()
+             for b in light["depth_pass"]["binds"]}
+    assert binds == states["vulkan"]
 
 
 @pytest.mark.parametrize("mn, mag, mip, name", [
