@@ -233,8 +233,8 @@ def _with_standin_slots(b: Brick, lib: Library, normal: str | None = None) -> st
     if not b.slots:
         return b.id
     fillers = [f"{slot}={normal if normal and v['kind'] == 'normal' else standin(lib, v['kind']).id}"
-               for slot, v in b.slots.items()]
-    return f"{b.id}({','.join(fillers)})"
+               for slot, v in b.slots.items() if not v.get("optional")]  # an optional slot stays empty: no cost
+    return f"{b.id}({','.join(fillers)})" if fillers else b.id
 
 
 def _reads_tangent(spec: str, lib: Library) -> bool:
@@ -312,6 +312,18 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -
                 perm_plan("brick", b.id, kind, replace(base, packing=f"{standin(lib, 'packing').id}(normal={b.id})"))
             elif kind == "output":
                 perm_plan("brick", b.id, kind, replace(base, output=b.id))
+            elif kind == "uv":  # in the first packing with a uv slot: that packing with minus without it
+                host = next((p for p in lib.of_kind("packing") if not is_standin(p)
+                             and any(v["kind"] == "uv" for v in p.slots.values())), None)
+                brdf = _consumer(lib, host, pair) if host is not None else None
+                if brdf is None:
+                    plans.append(_Plan("brick", b.id, kind, batch.fail(b.id, "no packing has a uv slot"),
+                                       batch.perm(base)))
+                    continue
+                plain = _with_standin_slots(host, lib)
+                with_uv = f"{plain[:-1]},uv={b.id})" if plain.endswith(")") else f"{plain}(uv={b.id})"
+                perm_plan("brick", b.id, kind, replace(base, brdf=brdf, packing=with_uv),
+                          baseline=replace(base, brdf=brdf, packing=plain))
 
     models, variant_packing = course_models()
     for m in models:
