@@ -18,7 +18,7 @@ ALT_TESTS := tests/lang/test_fuzz.py tests/lang/test_fuzz_regressions.py tests/i
 
 test: setup
 	$(VENV)/bin/ruff check .
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q --durations=15
 	@if [ -x .venv-alt/bin/python ]; then \
 	  echo "make test: $(ALT_TESTS) on $$(.venv-alt/bin/python -V)"; \
 	  .venv-alt/bin/python -m pytest -q -p no:cacheprovider $(ALT_TESTS); \
