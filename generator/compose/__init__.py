@@ -150,15 +150,21 @@ def _emit(lib: Library, target, prog, globals_: bool = True):
     return target.emit(prog.structs, prog.functions, prog.globals if globals_ else (), records=composing(lib).records)
 
 
-def _render(lib: Library, template: str, target, ctx: dict, emitted, name: str) -> Source:
-    """Render one template with the library's Templates; `name` is the generated file's name for #line resets."""
-    text = composing(lib).templates.render(template, target=target, functions=emitted.text, **ctx)
+def placed(text: str, target, emitted, name: str) -> tuple[str, int]:
+    """A rendered template's text with its #line resets written for file `name`, and the line at which the
+    emitted functions start in it (their line map is shifted by that much)."""
     lines = text.split("\n")
     for i, line in enumerate(lines):
         if line.strip() == LINE_RESET:
             lines[i] = target.line_reset(i + 2, name)
     text = "\n".join(lines)
-    offset = text[: text.index(emitted.text)].count("\n") if emitted.text else 0
+    return text, (text[: text.index(emitted.text)].count("\n") if emitted.text else 0)
+
+
+def _render(lib: Library, template: str, target, ctx: dict, emitted, name: str) -> Source:
+    """Render one template with the library's Templates; `name` is the generated file's name for #line resets."""
+    text, offset = placed(composing(lib).templates.render(template, target=target, functions=emitted.text, **ctx),
+                          target, emitted, name)
     stage = template.split("/")[1].split(".")[0]
     stage = {"vertex": "vert", "fragment": "frag", "ubershader": "frag", "eval": "comp", "shade": "comp"}[stage]
     return Source(target.name, stage, text, emitted.shifted(offset))

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from ..backends import language
 from ..backends.base import Emitted
 from ..link.depth import (BLUR, DEPTH, blur_interface, depth_interface, mask_program, mask_unit)
-from . import LINE_RESET, Composed, Source, _provenance, _templates_used, jinja_env
+from . import Composed, Source, _provenance, _templates_used, composing, placed
 
 VERTEX, FRAGMENT = "depth_vertex", "depth_fragment"  # the templates' kinds (Language.template)
 
@@ -49,7 +49,7 @@ def unit_names(plan: DepthPlan) -> list[str]:
 def compose_depth_units(plan: DepthPlan, lib, languages, dialects=()) -> dict[str, Composed]:
     """{unit name: Composed} of every unit `plan` needs (unit_names), in `languages` and `dialects`."""
     out = {}
-    env = jinja_env()  # one environment for this call's units (compose.jinja_env: the templates' settings)
+    env = composing(lib).templates  # the library's templates, as every unit of it renders from
     for name in unit_names(plan):
         if name == DEPTH:
             out[name] = _compose(env, name, "depth pass: casters' position; moments", depth_interface(plan.moments),
@@ -103,11 +103,5 @@ def _compose(env, name: str, key: str, iface, languages, dialects, flags: dict, 
 
 def _render(env, template: str, target, ctx: dict, emitted: Emitted, name: str, stage: str) -> Source:
     """Render one depth template (as compose._render does a material's: #line resets, the line map shifted)."""
-    text = env.get_template(template).render(target=target, functions=emitted.text, **ctx)
-    lines = text.split("\n")
-    for i, line in enumerate(lines):
-        if line.strip() == LINE_RESET:
-            lines[i] = target.line_reset(i + 2, name)
-    text = "\n".join(lines)
-    offset = text[: text.index(emitted.text)].count("\n") if emitted.text else 0
+    text, offset = placed(env.render(template, target=target, functions=emitted.text, **ctx), target, emitted, name)
     return Source(target.name, stage, text, emitted.shifted(offset))

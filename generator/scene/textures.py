@@ -32,8 +32,7 @@ from pathlib import Path, PurePosixPath, PureWindowsPath
 import numpy as np
 
 from ..io import sha256
-from ..io.images import DecodedImage, decode_image, generated_image, located, MAX_IMAGE_BYTES
-from ..lang.errors import SourceError, read_bytes
+from ..io.images import DecodedImage, generated_image, located, read_image
 from ..spec.surface import EMISSIVE_MAP
 
 FILTERS = ("linear", "nearest")
@@ -137,12 +136,7 @@ def white(name: str, decl: dict, sampler: Sampler = DEFAULT_SAMPLER) -> TextureB
 
 def read_file(path: Path, shown: str, fail) -> DecodedImage:
     """The image in file `path`, named `shown` in errors raised through `fail`."""
-    try:
-        data = read_bytes(path, "image file", MAX_IMAGE_BYTES)
-    except SourceError as e:
-        hint = e.hint if e.hint != "check the path" else "check the path (a relative one starts at the scene's folder)"
-        raise fail(f"image '{shown}': {e.message}", hint) from None
-    return decode_image(data, fail, shown)
+    return read_image(path, fail, shown)
 
 
 def _suggest(name: str, names) -> str:
