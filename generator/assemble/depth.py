@@ -46,6 +46,11 @@ def write_depth_passes(build) -> None:
             resolved.pop(h, None)
     shadowed = {ln: t for ln, t in shadowed_lights(_Objects(scene, resolved), resolved.values()).items()
                 if ln in manifest.get("lights", {})}
+    # a light entry carried over from the last build (its objects' permutations failed) keeps no depth pass
+    # of that build: the units it named are written only for the lights shadowed now
+    for ln, light in list(manifest.get("lights", {}).items()):
+        if ln not in shadowed and "depth_pass" in light:
+            manifest["lights"][ln] = {k: v for k, v in light.items() if k != "depth_pass"}
     if not shadowed:
         return
     plan = depth_plan(shadowed, linked)

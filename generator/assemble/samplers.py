@@ -5,9 +5,11 @@ A state (scene/textures.Sampler.as_dict) is API-neutral: mag and min filter, mip
 anisotropy, LOD bias, compare op. One function per API spells it (each platform class's ``spell_sampler``
 names its own; `spell(state)` gives the state for every platform), with the same meaning everywhere:
 
-- ``mipmap = "none"`` is level 0 only: Vulkan ``mipmapMode`` NEAREST with ``maxLod`` 0 (the spec's way to
-  turn mipmapping off), D3D12 ``MaxLOD`` 0, GL ``GL_LINEAR``/``GL_NEAREST`` min filters (no mipmap), WebGPU
-  ``lodMaxClamp`` 0. Otherwise every level is read (Vulkan ``VK_LOD_CLAMP_NONE``, D3D12 ``D3D12_FLOAT32_MAX``,
+- ``mipmap = "none"`` is level 0 only: Vulkan ``mipmapMode`` NEAREST with ``maxLod`` 0.25 (the Vulkan
+  specification's note on emulating GL's non-mipmapped min filters: with maxLod 0 the clamped LOD is never
+  above 0, so the mag filter would be used under minification too, and a min filter that differs from the
+  mag filter would be ignored), D3D12 ``MaxLOD`` 0.25 and WebGPU ``lodMaxClamp`` 0.25 alike, GL
+  ``GL_LINEAR``/``GL_NEAREST`` min filters (no mipmap). Otherwise every level is read (Vulkan ``VK_LOD_CLAMP_NONE``, D3D12 ``D3D12_FLOAT32_MAX``,
   WebGPU's default 32).
 - ``anisotropy > 1``: Vulkan ``anisotropyEnable``, D3D12's ANISOTROPIC filter, GL
   ``GL_TEXTURE_MAX_ANISOTROPY`` (GL 4.6, or EXT_texture_filter_anisotropic), WebGPU ``maxAnisotropy``.
@@ -40,6 +42,10 @@ _WRAP = {"repeat": ("VK_SAMPLER_ADDRESS_MODE_REPEAT", "D3D12_TEXTURE_ADDRESS_MOD
          "clamp": ("VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE", "D3D12_TEXTURE_ADDRESS_MODE_CLAMP", "GL_CLAMP_TO_EDGE",
                    "clamp-to-edge")}
 
+# the largest LOD of a sampler that reads level 0 only: above 0, so that minification (LOD > 0) still selects
+# the min filter, and below 0.5, so that nearest mipmap selection stays at level 0
+LEVEL_0_ONLY = 0.25
+
 
 def vulkan(s: dict) -> dict:
     mip = "NEAREST" if s["mipmap"] == "none" else s["mipmap"].upper()
@@ -50,7 +56,7 @@ def vulkan(s: dict) -> dict:
             "anisotropyEnable": s["anisotropy"] > 1, "maxAnisotropy": float(s["anisotropy"]),
             "compareEnable": s["compare"] is not None,
             "compareOp": COMPARE_OPS[s["compare"]][0] if s["compare"] else "VK_COMPARE_OP_NEVER",
-            "minLod": 0.0, "maxLod": 0.0 if s["mipmap"] == "none" else VK_LOD_CLAMP_NONE}
+            "minLod": 0.0, "maxLod": LEVEL_0_ONLY if s["mipmap"] == "none" else VK_LOD_CLAMP_NONE}
 
 
 def d3d12(s: dict) -> dict:
@@ -74,7 +80,7 @@ def d3d12(s: dict) -> dict:
     return {"Filter": name, "AddressU": _WRAP[s["wrap_u"]][1], "AddressV": _WRAP[s["wrap_v"]][1],
             "AddressW": _WRAP[s["wrap_u"]][1], "MipLODBias": s["lod_bias"], "MaxAnisotropy": s["anisotropy"],
             "ComparisonFunc": COMPARE_OPS[s["compare"]][1] if s["compare"] else "D3D12_COMPARISON_FUNC_NEVER",
-            "MinLOD": 0.0, "MaxLOD": 0.0 if s["mipmap"] == "none" else D3D12_FLOAT32_MAX}
+            "MinLOD": 0.0, "MaxLOD": LEVEL_0_ONLY if s["mipmap"] == "none" else D3D12_FLOAT32_MAX}
 
 
 def gl(s: dict) -> dict:
@@ -95,7 +101,7 @@ def webgpu(s: dict) -> dict:
     out = {"addressModeU": _WRAP[s["wrap_u"]][3], "addressModeV": _WRAP[s["wrap_v"]][3],
            "magFilter": s["mag_filter"], "minFilter": s["min_filter"],
            "mipmapFilter": "nearest" if s["mipmap"] == "none" else s["mipmap"],
-           "lodMinClamp": 0.0, "lodMaxClamp": 0.0 if s["mipmap"] == "none" else 32.0,
+           "lodMinClamp": 0.0, "lodMaxClamp": LEVEL_0_ONLY if s["mipmap"] == "none" else 32.0,
            "maxAnisotropy": s["anisotropy"]}
     if s["compare"]:
         out["compare"] = COMPARE_OPS[s["compare"]][3]

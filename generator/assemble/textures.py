@@ -176,8 +176,9 @@ def _filter_for(texels: np.ndarray, holds: str, colour_space: str, keep_length: 
         raise ValueError(f"a colour space is one of {', '.join(COLOUR_SPACES)}, not {colour_space!r}")
     if colour_space == "srgb" and holds != "color":
         raise ValueError(f"{holds} texels are linear: only a colour texture is sRGB-encoded")
-    if keep_length and holds not in ("normal", "normal_xy"):
-        raise ValueError("keep_length is for normal maps (the Toksvig packings read the filtered length)")
+    if keep_length and holds != "normal":  # normal_xy rebuilds z as a unit vector: a kept length would be lost
+        raise ValueError("keep_length is for normal maps stored with z (the Toksvig packings read the filtered "
+                         "length)")
     if not isinstance(texels, np.ndarray) or texels.ndim != 3 or texels.shape[2] != 4 or 0 in texels.shape:
         raise ValueError(f"texels are an (H, W, 4) array, not {getattr(texels, 'shape', type(texels).__name__)}")
     if texels.dtype not in (np.uint8, np.float16, np.float32):

@@ -95,7 +95,14 @@ def read_uri(uri: str, base: Path, fail: Fail) -> DecodedImage:
     if len(scheme) > 1:  # a one-letter "scheme" is a Windows drive letter
         raise fail(f"image '{uri}': a {scheme}: URI is not a file beside the glTF",
                    "download the image and refer to it by a relative path")
-    return read_image(Path(base) / urllib.parse.unquote(uri), fail, shown=uri)
+    rel = urllib.parse.unquote(uri)
+    path = Path(base) / rel
+    # a glTF names files beside it: an absolute path or one that leads out of its folder is refused (untrusted
+    # input must not make the build read, and ship, any file of the machine it runs on)
+    if Path(rel).is_absolute() or len(scheme) == 1 or not path.resolve().is_relative_to(Path(base).resolve()):
+        raise fail(f"image '{uri}': the path leads out of the glTF's folder",
+                   "copy the image beside the glTF (or below its folder) and refer to it by a relative path")
+    return read_image(path, fail, shown=uri)
 
 
 def decode_data_uri(uri: str, fail: Fail, shown: str | None = None) -> DecodedImage:

@@ -1,7 +1,7 @@
 """The pipeline state a permutation is drawn with, stated once for the build and the renderer.
 
 The build writes these into the manifest (``render_state`` and ``output`` per permutation, ``conventions``
-scene-wide: assemble/conventions.py), and the renderer draws by the very same values (runtime/renderer.py,
+scene-wide: assemble/manifest.py conventions), and the renderer draws by the very same values (runtime/renderer.py,
 runtime/graphics.py ``GraphicsPipeline(render_state=...)``), as the depth passes share runtime/shadow_pass.py:
 
 - :func:`render_state`: alpha mode (and a material's cutoff), blending, culling and depth from the surface
@@ -26,7 +26,7 @@ SOURCE_OVER = {"color": {"src": "src_alpha", "dst": "one_minus_src_alpha", "op":
                "premultiplied": False}
 ENCODINGS = ("linear", "srgb", "sqrt")  # an output brick's `encodes` (library/schema.py)
 # the colour attachment that stores an output without a second (or a missing) encoding, API-neutral (Vulkan's
-# names without VK_FORMAT_); each platform spells it (assemble/platforms.py attachment_formats)
+# names without VK_FORMAT_); each platform spells it (assemble/platform_base.py Platform.formats)
 COLOR_FORMATS = {"srgb": "R8G8B8A8_SRGB", "unorm": "R8G8B8A8_UNORM"}
 DEPTH_FORMAT = "D32_SFLOAT"
 DEPTH_CLEAR = 1.0  # the far plane; the depth test is LESS

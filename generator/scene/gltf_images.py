@@ -122,7 +122,7 @@ class _Images:
         if BASISU in ext:
             eptr = f"{ptr}/extensions/{BASISU}"
             basis = rd.ref(rd.get(ext, BASISU, f"{ptr}/extensions", "obj"), "source", eptr, "images", None)
-            if src is not None:
+            if src is not None and basis is not None:
                 self.notes.append(f"texture {ti}: its {BASISU} image ({pointer('images', basis)}) is not read "
                                   f"(Basis Universal needs a transcoder); its source {pointer('images', src)} is")
             else:

@@ -181,4 +181,4 @@ def test_a_dialect_platform_checks_its_optional_dialect_as_a_note_and_spells_sam
     assert list(spelled) == list(P.PLATFORM_TABLE)
     assert spelled == {n: p.spell_sampler(state) for n, p in P.PLATFORM_TABLE.items()}
     assert spelled["vulkan"]["addressModeV"] == "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE"
-    assert spelled["gl"]["GL_TEXTURE_MIN_FILTER"] == "GL_NEAREST" and spelled["webgpu"]["lodMaxClamp"] == 0.0
+    assert spelled["gl"]["GL_TEXTURE_MIN_FILTER"] == "GL_NEAREST" and spelled["webgpu"]["lodMaxClamp"] == 0.25

@@ -75,7 +75,7 @@ def test_every_binding_is_listed_with_its_artifact_binding_and_sampler(built):
     assert (n["format"], n["levels"], n["holds"], n["colour_space"]) == ("R8G8B8A8_UNORM", 3, "normal", "linear")
     row = m["samplers"][a["sampler"]["index"]]
     assert row["platforms"]["vulkan"]["addressModeU"] == "VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT"
-    assert row["platforms"]["vulkan"]["maxLod"] == 0.0 and row["platforms"]["webgpu"]["lodMaxClamp"] == 0.0
+    assert row["platforms"]["vulkan"]["maxLod"] == 0.25 and row["platforms"]["webgpu"]["lodMaxClamp"] == 0.25
     assert set(row["platforms"]) == {"vulkan", "webgpu"}  # the platforms built
 
 
@@ -226,7 +226,7 @@ def test_every_filter_combination_has_its_d3d12_and_gl_names(mn, mag, mip, name)
     assert s["d3d12"]["Filter"] == name
     gl_min = f"GL_{mn.upper()}" + ("" if mip == "none" else f"_MIPMAP_{mip.upper()}")
     assert s["gl"]["GL_TEXTURE_MIN_FILTER"] == gl_min and s["gl"]["GL_TEXTURE_MAG_FILTER"] == f"GL_{mag.upper()}"
-    assert (s["d3d12"]["MaxLOD"] == 0.0) == (mip == "none") == (s["vulkan"]["maxLod"] == 0.0)
+    assert (s["d3d12"]["MaxLOD"] == 0.25) == (mip == "none") == (s["vulkan"]["maxLod"] == 0.25)
 
 
 def test_default_images_are_real_pngs():

@@ -128,7 +128,7 @@ def test_a_build_writes_the_tables_its_shaders_sample_as_ktx2_listed_in_the_mani
         "mag_filter": "linear", "min_filter": "linear", "mipmap": "none", "wrap_u": "clamp", "wrap_v": "clamp",
         "anisotropy": 1, "lod_bias": 0.0, "compare": None}
     vk = m["samplers"][index]["platforms"]["vulkan"]
-    assert vk["maxLod"] == 0.0 and vk["addressModeU"] == "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE"
+    assert vk["maxLod"] == 0.25 and vk["addressModeU"] == "VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE"
     for platform, p in m["permutations"][0]["platforms"].items():
         refl = p["reflection"]
         rows = [*refl.get("descriptors", []), *refl.get("resources", []), *refl.get("samplers", []),

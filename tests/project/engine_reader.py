@@ -124,7 +124,7 @@ def check_sampler(m: dict, scene: dict, mname: str, tname: str, t: dict, errors:
     if vk is not None:
         spelled = {"magFilter": VK_FILTER[want["mag_filter"]], "minFilter": VK_FILTER[want["min_filter"]],
                    "addressModeU": VK_ADDRESS[want["wrap_u"]], "addressModeV": VK_ADDRESS[want["wrap_v"]],
-                   "maxLod": 0.0 if want["mipmap"] == "none" else 1000.0,
+                   "maxLod": 0.25 if want["mipmap"] == "none" else 1000.0,
                    "anisotropyEnable": want["anisotropy"] > 1}
         if {k: vk[k] for k in spelled} != spelled:
             errors.append(f"material {mname} texture {tname}: Vulkan sampler {vk}, the page's spelling {spelled}")

@@ -142,6 +142,11 @@ def _mutate(case: str, g: Doc, tmp_path) -> str:
     if case == "no-source":
         del g.d["textures"][1]["source"]
         return "/textures/1"
+    if case in ("path-out-of-folder", "absolute-path"):  # a real image, outside the glTF's folder
+        outside = tmp_path.parent / f"{tmp_path.name}-outside.png"
+        outside.write_bytes((tmp_path / "floor tiles.png").read_bytes())
+        g.d["images"][0]["uri"] = f"../{outside.name}" if case == "path-out-of-folder" else str(outside)
+        return "/images/0"
     raise AssertionError(case)
 
 
@@ -153,6 +158,8 @@ ERRORS = {
     "no-uri-no-view": "an image has neither a uri nor a bufferView",
     "bad-wrap": "1234 is not a glTF wrapS",
     "no-source": "the texture has no source image",
+    "path-out-of-folder": "the path leads out of the glTF's folder",
+    "absolute-path": "the path leads out of the glTF's folder",
 }
 
 
