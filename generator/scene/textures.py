@@ -41,6 +41,7 @@ WRAPS = ("repeat", "mirrored", "clamp")
 HOLDS = ("color", "data", "normal", "normal_xy")
 MAX_ANISOTROPY = 16  # the largest maxSamplerAnisotropy of Vulkan, D3D12 and WebGPU implementations
 MAX_LOD_BIAS = 16.0  # D3D12's range is [-16, 15.99]; Vulkan clamps to maxSamplerLodBias (at least 2)
+MAX_LOD_BIAS_UP = 15.99  # the top of D3D12's range (D3D12_MIP_LOD_BIAS_MAX)
 SAMPLER_KEYS = ("filter", "mag_filter", "min_filter", "mipmap", "wrap", "wrap_u", "wrap_v", "anisotropy", "lod_bias")
 # the declaration of emissive = "texture"'s texture, which no brick declares (the glue samples it: link/glue.py)
 EMISSIVE_DECLARATION = {"srgb": True, "holds": "color", "doc": "sRGB RGB: emitted radiance, scaled by emissive"}
@@ -207,9 +208,9 @@ def toml_sampler(loc, header: str, tname: str, s: dict) -> Sampler:
         raise loc.error(at("anisotropy"), f"sampler '{tname}': anisotropy {aniso!r} is not an integer from 1 to "
                         f"{MAX_ANISOTROPY}", "write e.g. anisotropy = 8 (1: no anisotropic filtering)")
     bias = float(s.get("lod_bias", 0.0))
-    if not -MAX_LOD_BIAS <= bias <= MAX_LOD_BIAS:
+    if not -MAX_LOD_BIAS <= bias <= MAX_LOD_BIAS_UP:
         raise loc.error(at("lod_bias"), f"sampler '{tname}': lod_bias {bias} is outside [-{MAX_LOD_BIAS:g}, "
-                        f"{MAX_LOD_BIAS:g}]", "write a bias in levels, e.g. lod_bias = -0.5")
+                        f"{MAX_LOD_BIAS_UP:g}]", "write a bias in levels, e.g. lod_bias = -0.5")
     sampler = Sampler(mag, mn, s.get("mipmap", DEFAULT_SAMPLER.mipmap), s.get("wrap_u", wrap), s.get("wrap_v", wrap),
                       aniso, bias)
     problem = sampler.problem()

@@ -183,7 +183,7 @@ CASES = {
     "anisotropy-nearest": (WOOD.replace('mipmap = "none", ', "anisotropy = 4, "), "anisotropy = ",
                            "anisotropy 4 needs linear filters and linear mipmaps", 'filter = "linear"'),
     "lod-bias": (WOOD.replace('mipmap = "none", ', "lod_bias = 20.0, "), "lod_bias = ",
-                 "lod_bias 20.0 is outside [-16, 16]", "lod_bias = -0.5"),
+                 "lod_bias 20.0 is outside [-16, 15.99]", "lod_bias = -0.5"),
     "absolute-path": (WOOD.replace('"tex/wood.png"', '"/srv/wood.png"'), "albedo_map = \"",
                       "texture 'albedo_map': '/srv/wood.png' is an absolute path", "relative to the scene's folder"),
     "path-not-string": (WOOD.replace('"tex/wood.png"', "3"), "albedo_map = 3",
