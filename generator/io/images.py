@@ -313,7 +313,7 @@ def _icc_description(icc: bytes) -> str | None:
 
 def generated_image(name: str) -> DecodedImage:
     """The image the renderer draws for packing texture `name` where the scene names none: a 16 × 16 sRGB
-    checker for ``albedo_map``, a 32 × 32 normal map of bumps for ``normal_map``, else a 1 × 1 linear grey 0.5."""
+    checker for ``albedo_map``, a 32 × 32 normal map of bumps for ``normal_map``, else a 1 × 1 linear grey 0.5 (half float)."""
     if name == "albedo_map":
         j, i = np.meshgrid(np.arange(16), np.arange(16))
         rgb = np.where(((i // 4 + j // 4) % 2 == 0)[..., None], [230, 200, 120], [90, 140, 200])
@@ -325,6 +325,6 @@ def generated_image(name: str) -> DecodedImage:
         rgb = np.round((t + 1.0) / 2.0 * 255.0)
         texels, srgb = np.concatenate([rgb, np.full((32, 32, 1), 255.0)], axis=-1).astype(np.uint8), False
     else:
-        texels, srgb = np.full((1, 1, 4), 0.5, np.float32), False
+        texels, srgb = np.full((1, 1, 4), 0.5, np.float16), False  # half: exact, and filterable on WebGPU (float32 needs float32-filterable)
     return DecodedImage(np.ascontiguousarray(texels), "generated", "generated", 4, texels.dtype.itemsize * 8, srgb,
                         "generated")

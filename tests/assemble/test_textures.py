@@ -207,7 +207,7 @@ def test_generated_artifacts_are_marked():
     offset, length, _ = f["levels"][0]
     assert normal.data[offset:offset + length] == generated_image("normal_map").texels.tobytes()
     grey = generated_artifact("f0_map", "color").descriptor
-    assert (grey["format"], grey["colour_space"], grey["width"]) == ("R32G32B32A32_SFLOAT", "linear", 1)
+    assert (grey["format"], grey["colour_space"], grey["width"]) == ("R16G16B16A16_SFLOAT", "linear", 1)
 
 
 def test_colour_note_when_the_file_disagrees_with_the_packing():

@@ -171,7 +171,7 @@ def test_generated_images():
     assert normal.texels.shape == (32, 32, 4) and normal.declared_srgb is False
     t = normal.texels[..., :3] / 255.0 * 2.0 - 1.0
     assert np.abs(np.sqrt((t * t).sum(-1)) - 1.0).max() < 0.01  # unit normals, to 8-bit rounding
-    assert grey.texels.dtype == np.float32 and grey.texels.tolist() == [[[0.5] * 4]]
+    assert grey.texels.dtype == np.float16 and grey.texels.tolist() == [[[0.5] * 4]]
     assert {i.source for i in (albedo, normal, grey)} == {"generated"}
 
 
