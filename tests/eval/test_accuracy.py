@@ -155,7 +155,22 @@ def test_float16_is_reported_not_required():
 @pytest.mark.lavapipe
 @pytest.mark.toolchain  # compiles eval kernels
 def test_gpu_languages_no_nan_or_inf_and_agree_with_the_reference(device, eval_session):
-    rep = accuracy.run(SPECS, list(accuracy.GPU_TARGETS), ["float32"], LIB, hemisphere_k=6, session=eval_session)
+    """Every spec in one GPU language, the languages taken in turn (the whole product: the slow test below)."""
+    targets = list(accuracy.GPU_TARGETS)
+    for i, target in enumerate(targets):
+        _check_gpu(accuracy.run(SPECS[i::len(targets)], [target], ["float32"], LIB, hemisphere_k=6,
+                                session=eval_session))
+
+
+@pytest.mark.slow
+@pytest.mark.lavapipe
+@pytest.mark.toolchain
+def test_every_spec_in_every_gpu_language_agrees_with_the_reference(device, eval_session):
+    _check_gpu(accuracy.run(SPECS, list(accuracy.GPU_TARGETS), ["float32"], LIB, hemisphere_k=6,
+                            session=eval_session))
+
+
+def _check_gpu(rep: dict) -> None:
     for r in rep["results"]:
         assert r["nan"] == 0 and r["inf"] == 0, (r["spec"], r["target"], r["set"])
         if r["set"] == "hemisphere":  # defaults: kappa <= 64 (n = 64) -> 64 ulp (1 + 64/16)
