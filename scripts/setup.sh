@@ -20,6 +20,13 @@ APT_PKGS=(
   "glslc=$GLSLC_V"                         # shaderc: batches many GLSL/HLSL compiles in one process
   "glslang-tools=$GLSLANG_V"               # glslangValidator (HLSL front end, version reporting)
   "spirv-tools=$SPIRV_TOOLS_V"             # spirv-val, spirv-opt, spirv-as, spirv-dis
+  # The C side (include/shadermatrix/pack.h, examples/engine-c): Vulkan's headers, cJSON, and clang for
+  # AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer (gcc builds the engine itself)
+  "libvulkan-dev=1.3.239.0-1"
+  "libcjson-dev=1.7.15-1+deb12u4"
+  "libcjson1=1.7.15-1+deb12u4"
+  "clang-14=1:14.0.6-12"
+  "libclang-rt-14-dev=1:14.0.6-12"
 )
 # Mesa from bookworm-backports, pinned: its shader disk cache reports hits and misses
 # (MESA_SHADER_CACHE_SHOW_STATS; Mesa 22.3 cannot), which is how a render shows that it was served
@@ -66,6 +73,11 @@ if ((${#missing[@]} + ${#missing_bpo[@]})); then
     exit 1
   fi
 fi
+# gcc and libc's headers build the C engine and pack.h's tests (and naga's build scripts below)
+command -v cc >/dev/null 2>&1 && [[ -e /usr/include/stdio.h ]] || {
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq && apt-get install -y -qq --no-install-recommends gcc libc6-dev >/dev/null
+}
 
 # naga (WGSL front end + validator), pinned, from crates.io into .tools/bin, which the end of this
 # script links into .venv/bin. A naga of the pinned version already on PATH is used as is.
