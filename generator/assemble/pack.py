@@ -3,7 +3,8 @@
 A pack holds what its platform loads (assemble/platforms.py PLATFORM_TABLE ``blob``): ``vulkan`` the optimized SPIR-V of
 the GLSL, ``d3d12`` DXIL where dxc built it and the HLSL text otherwise, ``gl`` the GLSL 4.50 core text,
 ``webgpu`` the WGSL text; the metadata's ``blob`` says which (``spirv``, ``dxil``, ``hlsl``, ``glsl``,
-``wgsl``). ``DIR/packs/<platform>.<key16>.smpack``, ``key16`` the first 16 hex digits of the pack key.
+``wgsl``). The depth passes' units (the manifest's ``depth_shaders``) are packed beside the permutations,
+each under its entry's 12-hex ``hash``: an engine loads every shader it draws with from the pack. ``DIR/packs/<platform>.<key16>.smpack``, ``key16`` the first 16 hex digits of the pack key.
 The file is named by its key, like every artifact of the tree: a rebuild writes a new file beside the
 old one, the manifest (``packs``: platform, language, path, sha256, key, entries, size) is replaced, and
 only then is the old pack removed. The ubershader is in the vulkan pack (the other platforms do not build it).
@@ -23,7 +24,8 @@ Format, version 1 (all integers little-endian, fixed widths; offsets from the st
                               "target_env": "vulkan1.1", "tools": {tool: exact version}}
     zero padding to a multiple of 8
     index, N entries of 104 bytes, sorted by (permutation, stage), no two alike
-      0  16  permutation      ASCII, NUL-padded: the manifest's 12-hex ``hash``, or ``ubershader``
+      0  16  permutation      ASCII, NUL-padded: the manifest's 12-hex ``hash`` (a permutation's or a depth
+                              unit's, ``depth_shaders.<unit>.hash``), or ``ubershader``
      16   8  stage            ASCII, NUL-padded: ``vert``, ``frag``
      24  32  input key        raw sha256: the manifest entry's ``input_key``
      56  32  blob sha256      raw sha256 of the blob
@@ -240,13 +242,14 @@ def _packed(entry: dict, name: str, platform: str):
 
 
 def write_packs(out: Path, manifest: dict, count=None) -> list[dict]:
-    """Write one pack per platform of `manifest` (its ok permutations; the ubershader in vulkan's) into
+    """Write one pack per platform of `manifest` (its ok permutations and depth units; the ubershader in vulkan's) into
     out/packs; returns the manifest's ``packs`` list. count(changed): the build's file counter."""
     from .platforms import PLATFORM_TABLE
     out = Path(out)
     listed = []
     for platform in manifest.get("platforms", []):
         rows = [r for e in manifest["permutations"] for r in _packed(e, e["hash"], platform)]
+        rows += [r for e in (manifest.get("depth_shaders") or {}).values() for r in _packed(e, e["hash"], platform)]
         rows += list(_packed(manifest.get("ubershader") or {}, "ubershader", platform))
         entries, kinds = [], set()
         for name, stage, input_key, kind, rel, sha in rows:

@@ -38,11 +38,11 @@ def minimal_read(data: bytes) -> dict:
 
 
 def expected_entries(out: Path, manifest: dict, platform: str) -> dict:
-    """{(permutation, stage): bytes} the pack of `platform` must hold: every ok entry's artifact (and the
-    ubershader's GLSL SPIR-V in vulkan's)."""
+    """{(permutation, stage): bytes} the pack of `platform` must hold: every ok entry's artifact, the depth
+    units' under their hash (and the ubershader's GLSL SPIR-V in vulkan's)."""
     from generator.assemble.platforms import PLATFORM_TABLE
     want = {}
-    for e in manifest["permutations"]:
+    for e in [*manifest["permutations"], *(manifest.get("depth_shaders") or {}).values()]:
         if e.get("status") == "ok":
             for stage, item in e["platforms"][platform]["stages"].items():
                 kind = "dxil" if "dxil" in item else PLATFORM_TABLE[platform].blob  # no dxc: d3d12 packs HLSL
@@ -88,8 +88,10 @@ def test_build_pack_on_the_command_line_writes_one_pack_per_platform_listed_in_t
         assert p["path"] == f"packs/{p['platform']}.{p['key'][:16]}.smpack"
         assert hashlib.sha256(data).hexdigest() == p["sha256"] and len(data) == p["size"]
         uber = 1 if p["platform"] == "vulkan" else 0  # the ubershader is built for vulkan only
+        depth = sum(len(u["platforms"][p["platform"]]["stages"]) for u in manifest["depth_shaders"].values())
+        assert depth >= 1  # the example's sun is shadowed: its depth pass's units are packed too
         assert p["entries"] == len(expected_entries(out, manifest, p["platform"])) == \
-            2 * (len(manifest["permutations"]) + uber)
+            2 * (len(manifest["permutations"]) + uber) + depth
     assert sorted(x.name for x in (out / "packs").iterdir()) == sorted(Path(p["path"]).name for p in packs)
 
 
@@ -97,7 +99,8 @@ def test_build_pack_on_the_command_line_writes_one_pack_per_platform_listed_in_t
 def test_the_package_reader_and_an_independent_reader_agree_with_the_manifests_spirv(packed):
     from generator.assemble.pack import lookup, read_pack
     out, manifest = packed
-    keys = {p["hash"]: p["input_key"] for p in manifest["permutations"]} | {"ubershader": manifest["ubershader"]["input_key"]}
+    keys = {p["hash"]: p["input_key"] for p in [*manifest["permutations"], *manifest["depth_shaders"].values()]} | \
+        {"ubershader": manifest["ubershader"]["input_key"]}
     for p in manifest["packs"]:
         want = expected_entries(out, manifest, p["platform"])
         data = (out / p["path"]).read_bytes()
