@@ -24,9 +24,10 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import reference_manifest  # noqa: E402  (this script's sibling: the manifest's schema as a page)
+import reference_frame  # noqa: E402  (likewise: the frame export's schema)
 
 COMMAND = "make reference"
-PAGES = ("README.md", "cli.md", "bricks.md", "language.md", "manifest.md", "manifest.schema.json")
+PAGES = ("README.md", "cli.md", "bricks.md", "language.md", "manifest.md", "manifest.schema.json", "frame.md")
 WIDTH = 100  # the usage lines' width: fixed, so the page does not depend on the terminal
 
 
@@ -300,7 +301,9 @@ def render_index() -> str:
                 ["[language.md](language.md)", "the brick language: types, intrinsics, constants, kind contracts, "
                                                "shading and surface inputs, BRICK metadata"],
                 ["[manifest.md](manifest.md)", "every field of a build's manifest.json, from its JSON Schema "
-                                               "[manifest.schema.json](manifest.schema.json)"]])
+                                               "[manifest.schema.json](manifest.schema.json)"],
+                ["[frame.md](frame.md)", "every field of `render --export`'s frame.json (meshes, matrices, camera), "
+                                         "from its JSON Schema"]])
             + f"\nRegenerate them with `{COMMAND}` after changing the code they describe.\n")
 
 
@@ -308,7 +311,8 @@ def render_all() -> dict[str, str]:
     return {"README.md": render_index(), "cli.md": render_cli(), "bricks.md": render_bricks(),
             "language.md": render_language(),
             "manifest.md": reference_manifest.render(header("manifest.json", reference_manifest.SCHEMA_PATH)),
-            "manifest.schema.json": reference_manifest.schema_text()}
+            "manifest.schema.json": reference_manifest.schema_text(),
+            "frame.md": reference_frame.render(header("Frame export", reference_frame.SCHEMA_PATH))}
 
 
 def main(argv=None) -> int:
@@ -320,7 +324,7 @@ def main(argv=None) -> int:
     from generator.io import atomic_write
     pages = render_all()
     if not args.no_build:
-        problems = reference_manifest.check_example_build()
+        problems = reference_manifest.check_example_build() + reference_frame.check_example_export()
         if problems:
             print("\n".join(problems), file=sys.stderr)
             return 1

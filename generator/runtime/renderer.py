@@ -155,7 +155,7 @@ def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict, texel
 
 def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), language: str = "glsl",
                  device=None, progress: bool = False, uber_ids: str = "buffer", shadow_size: int = SHADOW_SIZE,
-                 placement_file=None, build=None) -> Report:
+                 placement_file=None, build=None, export=None) -> Report:
     """Render `frames` frames of `scene` into out/frame_NNNN.png; returns the report (also out/report.json).
 
     uber_ids: "buffer" (the variant read from the material entry: one ubershader pipeline) or
@@ -166,6 +166,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     build: the build whose texture artifacts the materials draw (a folder holding its manifest.json, or a
     runtime.material_textures.BuildOutputs); needed where a drawn material binds textures. The render state of
     a permutation its manifest lists is read from there too.
+    export: a folder to write the frame export into (runtime/frame_export.py: meshes, object matrices, camera,
+    the shadowed lights' matrices, as this render used them).
     """
     from ..link.values import entry_bytes, light_entry, uploads
     from ..compose import compose_permutation
@@ -184,7 +186,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..link import link_permutation
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
     from .material_textures import BuildOutputs, MaterialTextures
-    from .pipeline_state import render_state
+    from .pipeline_state import COLOR_FORMATS, render_state
     from .shadow_pass import (VULKAN_CONVENTIONS, depth_pass, depth_plan, fit_shadow_matrix, pass_units,
                               shadowed_lights)
 
@@ -197,6 +199,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         build = BuildOutputs.read(build)
     if out.exists() and not out.is_dir():
         raise UserError(f"{out} is a file — give --out a directory")
+    if export is not None and Path(export).exists() and not Path(export).is_dir():
+        raise UserError(f"{export} is a file — give --export a directory")
     placed = load_placement(scene, placement_file)
     out.mkdir(parents=True, exist_ok=True)
     W, H = size
@@ -256,16 +260,19 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     try:
         cache = PipelineCacheFile(device, out / f"pipeline_cache.{language}.bin")
         report.cache_problem = cache.problem
-        target = gx.OffscreenTarget(device, W, H)
+        attachment = color_attachment(scene, lib, perms)
+        target = gx.OffscreenTarget(device, W, H, color_format=COLOR_FORMATS[attachment])
+        clear = clear_color(attachment)
         owned += [target, cache]
         # by name (sphere, plane, box) or by object (a glTF primitive's mesh, maybe instanced), and whether the
         # model matrix mirrors it (then uploaded with its winding reversed: front faces stay counter-clockwise
         # for the back-face culling of single-sided materials and for gl_FrontFacing)
-        meshes = {}
+        meshes, cpu_meshes = {}, {}
         key_of = [(o.mesh if isinstance(o.mesh, str) else id(o.mesh), o.mirrored) for o in placed.objects]
         for o, key in zip(placed.objects, key_of):
             if key not in meshes:
-                meshes[key] = gx.GpuMesh(device, make_mesh(o.mesh, o.mirrored))
+                cpu_meshes[key] = make_mesh(o.mesh, o.mirrored)
+                meshes[key] = gx.GpuMesh(device, cpu_meshes[key])
                 owned.append(meshes[key])
         mesh_of = [meshes[k] for k in key_of]
         # One bilinear sampler for every texture, shadow maps included: the one tap of the shadow brick then
@@ -467,7 +474,18 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         report.textures, report.texture_notes = mtex.report(), list(mtex.notes)
 
         # blended surfaces after the opaque ones, in scene order otherwise (no sorting by depth: docs/design/runtime.md)
-        draws.sort(key=lambda d: perms[d[0]].surface.alpha == "blend")
+        blended_last = sorted(range(len(draws)), key=lambda i: perms[draws[i][0]].surface.alpha == "blend")
+        draws = [draws[i] for i in blended_last]
+        if export is not None:
+            from .frame_export import FrameExport, write_export
+            write_export(export, FrameExport(
+                scene.name, (W, H), attachment, clear, eye, gx.column_major(vp),
+                meshes=[(_mesh_name(k, placed.objects[key_of.index(k)]), m) for k, m in cpu_meshes.items()],
+                objects=[{"name": o.name, "mesh": list(cpu_meshes).index(k), "model": gx.column_major(o.model),
+                          "mirrored": o.mirrored} for o, k in zip(placed.objects, key_of)],
+                draw_order=blended_last,
+                lights={ln: {"shadow_matrix": matrices[ln], "pcf_texel": texels.get(ln), "size": passes_of[ln]["size"],
+                             "eye": points.mean(0)} for ln in shadowed}))
         specialized: dict[str, object] = {}
         order = list(dict.fromkeys(h for h, _, _, _ in draws))  # first use
         start = time.perf_counter()
@@ -504,7 +522,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 else:
                     items.append(gx.DrawItem(uber_pipes[uber_of[h]], mesh, ub))
                     nu += 1
-            gpu = target.draw(items, clear=(0.06, 0.07, 0.09, 1.0))
+            gpu = target.draw(items, clear=clear)
             image = target.read()
             if index == 0:  # drawn and read back; writing the PNG is not part of it
                 report.time_to_first_frame_ms = (time.perf_counter() - start) * 1e3
@@ -538,6 +556,34 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     import json
     atomic_write(out / "report.json", (json.dumps(report.as_dict(), indent=2) + "\n").encode())
     return report
+
+
+# The background, display-encoded: on an sRGB attachment the render clears with its linear values, which the
+# attachment encodes back, so every output's frame has the same background bytes.
+CLEAR = (0.06, 0.07, 0.09, 1.0)
+
+
+def color_attachment(scene, lib, perms) -> str:
+    """The colour attachment (pipeline_state.COLOR_FORMATS key) the scene's output brick asks for, as the build writes
+    it into each permutation's ``output``: every permutation of a scene ends in the scene's output brick."""
+    from .pipeline_state import output_state
+
+    kinds = {output_state(lib.get("output", p.output))["attachment"] for p in perms.values()}
+    return kinds.pop() if len(kinds) == 1 else "unorm"
+
+
+def clear_color(attachment: str) -> tuple:
+    """CLEAR as the floats given to the clear of an `attachment` target."""
+    if attachment != "srgb":
+        return CLEAR
+    decode = lambda c: c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4  # noqa: E731 (IEC 61966-2-1)
+    return (*(decode(c) for c in CLEAR[:3]), CLEAR[3])
+
+
+def _mesh_name(key, placed) -> str:
+    """A mesh's name in the frame export: the placement's mesh name, or the glTF primitive's, '_mirrored' when so."""
+    base = key[0] if isinstance(key[0], str) else (getattr(placed.mesh, "name", None) or placed.name)
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in str(base)) + ("_mirrored" if key[1] else "")
 
 
 def _light_specs(lib, light) -> dict:

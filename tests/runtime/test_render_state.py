@@ -13,7 +13,6 @@ build writes: runtime/pipeline_state.py).
 """
 from __future__ import annotations
 
-import functools
 
 import numpy as np
 import pytest
@@ -48,7 +47,7 @@ def _scene(tmp_path, name: str, materials: str, objects: dict[str, tuple[str, st
 
 def _render(scene, out, color_format: str | None = None) -> np.ndarray:
     """The frame the renderer draws of `scene` (specialized pipelines), RGB int; color_format: its colour
-    attachment instead of the renderer's R8G8B8A8_UNORM."""
+    attachment instead of the one the scene's output asks for (the manifest's output.attachment)."""
     from PIL import Image
 
     from generator.assemble.render_inputs import scene_textures
@@ -58,7 +57,7 @@ def _render(scene, out, color_format: str | None = None) -> np.ndarray:
     target = gx.OffscreenTarget
     try:
         if color_format is not None:
-            gx.OffscreenTarget = functools.partial(target, color_format=color_format)
+            gx.OffscreenTarget = lambda device, w, h, **_: target(device, w, h, color_format=color_format)
         render_scene(scene, load_library(), "specialized", 1, out, size=SIZE, build=scene_textures(scene, out))
     finally:
         gx.OffscreenTarget = target

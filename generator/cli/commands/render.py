@@ -21,6 +21,9 @@ def add_arguments(p) -> None:
     p.add_argument("--build", metavar="DIR", help="draw the materials' textures from this build's outputs (its "
                    "manifest.json and KTX2 files; default: write the scene's texture artifacts into --out/textures "
                    "as build does)")
+    p.add_argument("--export", metavar="DIR", help="also write the frame export into DIR: frame.json and the meshes "
+                   "(what an engine takes from its own scene: meshes, object matrices, camera, the shadowed lights' "
+                   "matrices, as this render used them; docs/reference/frame.md)")
 
 
 def run(args) -> int:
@@ -46,7 +49,7 @@ def run(args) -> int:
         build = scene_textures(scene, out, lib)
     try:
         report = render_scene(scene, lib, args.mode, args.frames, out, (int(m[1]), int(m[2])),
-                              args.language, progress=progress(), build=build)
+                              args.language, progress=progress(), build=build, export=args.export)
     except VulkanUnavailable as e:
         raise VulkanUnavailable(f"no Vulkan device to render on: {e} — install Mesa lavapipe (`make setup`)") from None
     if report.cache_problem:
