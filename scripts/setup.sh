@@ -27,6 +27,10 @@ APT_PKGS=(
   "libcjson1=1.7.15-1+deb12u4"
   "clang-14=1:14.0.6-12"
   "libclang-rt-14-dev=1:14.0.6-12"
+  # the build systems an engine drives `shadermatrix build` from, run for real by the build-integration tests
+  "cmake=3.25.1-1"
+  "ninja-build=1.11.1-2~deb12u1"
+  "make=4.3-4.1"
 )
 # Mesa from bookworm-backports, pinned: its shader disk cache reports hits and misses
 # (MESA_SHADER_CACHE_SHOW_STATS; Mesa 22.3 cannot), which is how a render shows that it was served
