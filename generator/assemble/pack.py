@@ -43,7 +43,8 @@ versions again: a tool upgrade gives a new key, a new file name, and no entry of
 for the new inputs. Only entries whose status is ``ok`` are packed (a stale entry's SPIR-V is that of
 older inputs; a failed one has none). No times, sorted entries: two builds give the same bytes.
 
-``read_pack(path)`` checks everything (magic, version, sizes, offsets and lengths in bounds, blobs
+``read_pack(path)`` checks everything (magic, version, sizes, the metadata in exactly its canonical form,
+offsets and lengths in bounds, blobs
 contiguous with nothing after the last, every blob's sha256, the key) and raises ``PackError`` (a
 ``UserError``) naming the file and what is wrong; ``lookup(pack, permutation, stage)`` returns a blob.
 """
@@ -133,6 +134,34 @@ def _text(raw: bytes, what: str, fail) -> str:
         fail(f"index entry has a non-ASCII {what} field")
 
 
+# The metadata is read only in the form encode_pack writes it, json.dumps(sort_keys, separators), so that a
+# reader can hash the key from its bytes as they are: include/shadermatrix/pack.h, which cannot re-encode
+# JSON, accepts exactly these bytes (no floats: their canonical text is Python's repr; integers in 64 bits).
+META_DEPTH = 32
+
+
+def _meta_int(text: str) -> int:
+    value = int(text)
+    if not -2**63 <= value < 2**63:
+        raise ValueError("an integer past 64 bits")
+    return value
+
+
+def _meta_float(text: str):
+    raise ValueError(f"a non-integer number {text[:20]}")
+
+
+def _depth(value) -> int:
+    """How deep `value` nests (an object or array is 1 more than its deepest member); stops past META_DEPTH."""
+    deepest, todo = 0, [(value, 1)]
+    while todo and deepest <= META_DEPTH:
+        v, d = todo.pop()
+        if isinstance(v, (dict, list)):
+            deepest = max(deepest, d)
+            todo += [(x, d + 1) for x in (v.values() if isinstance(v, dict) else v)]
+    return deepest
+
+
 def read_pack(path) -> dict:
     """A pack, checked whole: {"path", "version", "key", "meta", "language", "tools", "generator",
     "entries": {(permutation, stage): PackEntry}}. Raises PackError naming the file and the defect."""
@@ -162,12 +191,16 @@ def read_pack(path) -> dict:
     if blobs_at > len(data):
         fail(f"truncated: the header announces {count} entries and {meta_len} bytes of metadata, ending at byte "
              f"{blobs_at}, but the file has {len(data)} bytes")
+    raw_meta = data[HEADER.size:HEADER.size + meta_len]
     try:
-        meta = json.loads(data[HEADER.size:HEADER.size + meta_len].decode("utf-8"))
-    except (UnicodeDecodeError, ValueError):
-        fail("the metadata is not JSON")
+        meta = json.loads(raw_meta.decode("utf-8"), parse_int=_meta_int, parse_float=_meta_float,
+                          parse_constant=_meta_float)
+    except (UnicodeDecodeError, ValueError, RecursionError):
+        fail("the metadata is not JSON (or holds a non-integer number, or an integer past 64 bits)")
     if not isinstance(meta, dict) or meta.get("format") != "smpack":
         fail("the metadata is not a shader pack's")
+    if _canonical(meta) != raw_meta or _depth(meta) > META_DEPTH:
+        fail(f"the metadata is not canonical JSON (sorted keys, no spaces, ASCII, nested at most {META_DEPTH} deep)")
     if any(data[HEADER.size + meta_len:index_at]):
         fail("non-zero padding after the metadata")
     entries: dict = {}
