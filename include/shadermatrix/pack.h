@@ -6,15 +6,13 @@
    everywhere else include it without the define. It compiles as C99, C11 and C++17 and allocates nothing,
    except smpack_open_file's one buffer holding the file.
 
-   smpack_open_memory / smpack_open_file check the whole pack before anything is read from it, exactly as
-   the generator's own reader (generator/assemble/pack.py, read_pack) does and in the same order: magic,
-   version, reserved field, sizes, canonical metadata and its padding, then per index entry its name
-   fields, the index order, its offset and length inside the blobs, its blob's sha256, a blob shared at one
-   offset with one length; then the blobs contiguous with nothing after the last, and the pack key. A pack
-   either opens with every entry trustworthy or is refused with a status and a message naming the defect
-   and its byte or entry. No input makes it read outside the given bytes; integers are read byte by byte
-   (little-endian), so the bytes need no alignment. The format: docs/guide/build.md#shader-packs; this
-   reader: docs/reference/pack-h.md. */
+   Opening checks the whole pack, as the generator's reader does (generator/assemble/pack.py read_pack) and
+   in its order: magic, version, reserved field, sizes, the metadata (canonical JSON) and its padding; per
+   index entry its names, the index order, its offset and length in the blobs, its blob's sha256, one
+   length per offset; then blobs contiguous with nothing after the last, and the pack key. A pack opens with
+   every entry trustworthy, or is refused with a status and a message naming the defect and its byte or
+   entry. No input makes it read outside the given bytes; integers are read byte by byte (little-endian),
+   so the bytes need no alignment. Format: docs/guide/build.md#shader-packs; reader: docs/reference/pack-h.md. */
 #ifndef SHADERMATRIX_PACK_H
 #define SHADERMATRIX_PACK_H
 
@@ -70,9 +68,9 @@ typedef struct smpack {
     char error[256];             /* the last open's message, "" after a success */
 } smpack;
 
-/* Opens the `size` bytes at `data` as a pack, checking all of it; nothing is copied, so `data` must outlive
-   the pack. SMPACK_OK, or the defect's status with its message in smpack_error(pack); on failure the pack
-   holds no entries. SMPACK_ERR_ARGUMENT when pack or data is NULL. */
+/* Opens the `size` bytes at `data` as a pack, checking all of it. Nothing is copied: `data` must outlive the
+   pack. SMPACK_OK, or the defect's status with its message in smpack_error(pack) and no entries in the pack;
+   SMPACK_ERR_ARGUMENT when pack or data is NULL. */
 smpack_status smpack_open_memory(smpack *pack, const void *data, size_t size);
 
 /* Reads the file at `path` into one malloc'd buffer owned by the pack, then opens it as smpack_open_memory
@@ -80,8 +78,8 @@ smpack_status smpack_open_memory(smpack *pack, const void *data, size_t size);
    freed on failure, or by smpack_close. */
 smpack_status smpack_open_file(smpack *pack, const char *path);
 
-/* Frees what smpack_open_file read and empties the pack (count 0). Safe on a pack whose open failed, on a
-   closed pack, and on NULL. Close a pack before opening it again. */
+/* Frees what smpack_open_file read, and empties the pack. Safe on a refused or closed pack and on NULL. Close
+   a pack before opening it again. */
 void smpack_close(smpack *pack);
 
 /* The last open's message: what is wrong and at which byte or entry ("" after a success). Never NULL. */
@@ -144,14 +142,11 @@ static const uint32_t smpack_i_k[64] = {
 
 static uint32_t smpack_i_rotr(uint32_t x, unsigned n) { return (x >> n) | (x << (32u - n)); }
 
-static uint32_t smpack_i_be32(const unsigned char *p) {
-    return ((uint32_t)p[0] << 24) | ((uint32_t)p[1] << 16) | ((uint32_t)p[2] << 8) | (uint32_t)p[3];
-}
-
 static void smpack_i_sha_block(uint32_t h[8], const unsigned char *p) {
     uint32_t w[64], a = h[0], b = h[1], c = h[2], d = h[3], e = h[4], f = h[5], g = h[6], k = h[7];
     unsigned t;
-    for (t = 0; t < 16; t++) w[t] = smpack_i_be32(p + 4 * t);
+    for (t = 0; t < 16; t++)
+        w[t] = ((uint32_t)p[4 * t] << 24) | ((uint32_t)p[4 * t + 1] << 16) | ((uint32_t)p[4 * t + 2] << 8) | p[4 * t + 3];
     for (t = 16; t < 64; t++) {
         uint32_t s0 = smpack_i_rotr(w[t - 15], 7) ^ smpack_i_rotr(w[t - 15], 18) ^ (w[t - 15] >> 3);
         uint32_t s1 = smpack_i_rotr(w[t - 2], 17) ^ smpack_i_rotr(w[t - 2], 19) ^ (w[t - 2] >> 10);
@@ -170,8 +165,7 @@ static void smpack_i_sha_init(smpack_i_sha *s) {
     static const uint32_t h0[8] = {0x6a09e667u, 0xbb67ae85u, 0x3c6ef372u, 0xa54ff53au,
                                    0x510e527fu, 0x9b05688cu, 0x1f83d9abu, 0x5be0cd19u};
     memcpy(s->h, h0, sizeof h0);
-    s->fill = 0;
-    s->total = 0;
+    s->fill = 0, s->total = 0;
 }
 
 static void smpack_i_sha_update(smpack_i_sha *s, const void *data, size_t n) {
@@ -194,12 +188,8 @@ static void smpack_i_sha_final(smpack_i_sha *s, unsigned char out[32]) {
     uint64_t bits = s->total * 8u;
     unsigned i;
     s->block[s->fill++] = 0x80;
-    if (s->fill > 56) {
-        memset(s->block + s->fill, 0, 64 - s->fill);
-        smpack_i_sha_block(s->h, s->block);
-        s->fill = 0;
-    }
-    memset(s->block + s->fill, 0, 56 - s->fill);
+    memset(s->block + s->fill, 0, 64 - s->fill);
+    if (s->fill > 56) smpack_i_sha_block(s->h, s->block), memset(s->block, 0, 56);
     for (i = 0; i < 8; i++) s->block[56 + i] = (unsigned char)(bits >> (56 - 8 * i));
     smpack_i_sha_block(s->h, s->block);
     for (i = 0; i < 32; i++) out[i] = (unsigned char)(s->h[i / 4] >> (24 - 8 * (i % 4)));
@@ -217,9 +207,10 @@ void smpack_sha256(const void *data, size_t size, unsigned char out[32]) {
 static uint32_t smpack_i_u32(const unsigned char *p) {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
+static uint64_t smpack_i_u64(const unsigned char *p) { return smpack_i_u32(p) | ((uint64_t)smpack_i_u32(p + 4) << 32); }
 
-static uint64_t smpack_i_u64(const unsigned char *p) {
-    return (uint64_t)smpack_i_u32(p) | ((uint64_t)smpack_i_u32(p + 4) << 32);
+static const unsigned char *smpack_i_entry(const smpack *pack, uint32_t i) {
+    return pack->data + pack->index_at + (size_t)i * SMPACK_ENTRY_SIZE;
 }
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -227,14 +218,12 @@ __attribute__((format(printf, 3, 4)))
 #endif
 static smpack_status smpack_i_fail(smpack *pack, smpack_status status, const char *fmt, ...) {
     va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(pack->error, sizeof pack->error, fmt, ap);
-    va_end(ap);
+    va_start(ap, fmt), vsnprintf(pack->error, sizeof pack->error, fmt, ap), va_end(ap);
     return status;
 }
 
-/* The length of a NUL-padded name field, or 0 when it is malformed: empty, a NUL before its last non-NUL
-   byte, or a byte past ASCII (read_pack's _text refuses the same). */
+/* The length of a NUL-padded name field; 0 when it is malformed: empty, a NUL before its last non-NUL byte,
+   or a byte past ASCII (read_pack refuses the same). */
 static size_t smpack_i_name(const unsigned char *field, size_t width) {
     size_t n = width, k;
     while (n && field[n - 1] == 0) n--;
@@ -243,73 +232,67 @@ static size_t smpack_i_name(const unsigned char *field, size_t width) {
     return n;
 }
 
-/* Compares NUL-padded field `a` (width w) with field or C string `b` of at most w characters. */
-static int smpack_i_cmp_name(const unsigned char *a, const unsigned char *b, size_t w) {
+/* Orders entry e against NUL-padded permutation and stage, as Python orders (str, str) tuples of ASCII. */
+static int smpack_i_cmp_entry(const unsigned char *e, const unsigned char *perm, const unsigned char *stage) {
     size_t k;
-    for (k = 0; k < w; k++) {
-        if (a[k] != b[k]) return a[k] < b[k] ? -1 : 1;
-        if (a[k] == 0) return 0;
+    for (k = 0; k < 24; k++) {
+        unsigned a = e[k], b = k < 16 ? perm[k] : stage[k - 16];
+        if (a != b) return a < b ? -1 : 1;
+        if (a == 0 && k < 16) k = 15; /* the permutations are equal: on to the stage */
+        else if (a == 0) return 0;
     }
     return 0;
 }
 
-static int smpack_i_cmp_entry(const unsigned char *e, const unsigned char *perm, const unsigned char *stage) {
-    int c = smpack_i_cmp_name(e, perm, 16);
-    return c ? c : smpack_i_cmp_name(e + 16, stage, 8);
-}
-
-static void smpack_i_copy_name(char *dst, const unsigned char *field, size_t width) {
+/* A name into dst (width + 1 bytes); for a message (printable), bytes outside printable ASCII as '?'. */
+static void smpack_i_copy_name(char *dst, const unsigned char *field, size_t width, int printable) {
     size_t k;
-    for (k = 0; k < width && field[k]; k++) dst[k] = (char)field[k];
+    for (k = 0; k < width && field[k]; k++)
+        dst[k] = (char)(printable && (field[k] < 0x20 || field[k] > 0x7e) ? '?' : field[k]);
     dst[k] = 0;
 }
 
-/* ---- the metadata: accepted only when its bytes are exactly what the generator writes, json.dumps(meta,
-   sort_keys=True, separators=(",", ":")), so that the key can be hashed from the bytes as they are. */
+/* ---- the metadata: accepted only as exactly the bytes the generator writes, json.dumps(meta, sort_keys=True,
+   separators=(",", ":")), so that the key can be hashed from them as they are */
 
 typedef struct smpack_i_json { const unsigned char *m; size_t n, i; const char *why; } smpack_i_json;
 
 static int smpack_i_hex4(const unsigned char *p, uint32_t *v) {
     int k;
-    *v = 0;
-    for (k = 0; k < 4; k++) {
+    for (*v = 0, k = 0; k < 4; k++) {
         unsigned c = p[k];
         if (c >= '0' && c <= '9') *v = (*v << 4) | (c - '0');
         else if (c >= 'a' && c <= 'f') *v = (*v << 4) | (c - 'a' + 10);
-        else return 0; /* upper case too: the generator writes lower-case escapes */
+        else return 0; /* upper case too: Python writes lower-case escapes */
     }
     return 1;
 }
 
-/* A string in canonical form at j->i (its opening quote): printable ASCII as itself, `"` `\` and the five
-   short escapes as \" \\ \b \f \n \r \t, every other character below 0x20 or from 0x7f as \u with four
+static int smpack_i_bad(smpack_i_json *j, const char *why) { j->why = why; return 0; }
+
+/* A canonical string at j->i (its opening quote): printable ASCII as itself but `"` and `\`, those and the
+   five short escapes as \" \\ \b \f \n \r \t, any other character below 0x20 or from 0x7f as \u with four
    lower-case hex digits. Leaves j->i after the closing quote. */
 static int smpack_i_string(smpack_i_json *j) {
-    j->i++;
-    for (;;) {
+    for (j->i++;;) {
         unsigned c;
-        if (j->i >= j->n) { j->why = "a string runs past the end"; return 0; }
+        uint32_t v;
+        if (j->i >= j->n) return smpack_i_bad(j, "a string runs past the end");
         c = j->m[j->i];
         if (c == '"') { j->i++; return 1; }
-        if (c < 0x20 || c > 0x7e) { j->why = "a byte that is not printable ASCII"; return 0; }
+        if (c < 0x20 || c > 0x7e) return smpack_i_bad(j, "a byte that is not printable ASCII");
         if (c != '\\') { j->i++; continue; }
-        if (j->i + 1 >= j->n) { j->why = "a string runs past the end"; return 0; }
-        c = j->m[j->i + 1];
-        if (c == 'u') {
-            uint32_t v;
-            if (j->n - j->i < 6 || !smpack_i_hex4(j->m + j->i + 2, &v)) { j->why = "a malformed \\u escape"; return 0; }
-            if ((v >= 0x20 && v < 0x7f) || v == 8 || v == 9 || v == 10 || v == 12 || v == 13) {
-                j->why = "a \\u escape the generator writes otherwise"; return 0;
-            }
-            j->i += 6;
-        } else if (c == '"' || c == '\\' || c == 'b' || c == 'f' || c == 'n' || c == 'r' || c == 't') {
-            j->i += 2;
-        } else { j->why = "an escape the generator does not write"; return 0; }
+        c = j->i + 1 < j->n ? j->m[j->i + 1] : 0;
+        if (c == '"' || c == '\\' || c == 'b' || c == 'f' || c == 'n' || c == 'r' || c == 't') { j->i += 2; continue; }
+        if (c != 'u') return smpack_i_bad(j, "an escape Python does not write");
+        if (j->n - j->i < 6 || !smpack_i_hex4(j->m + j->i + 2, &v)) return smpack_i_bad(j, "a malformed \\u escape");
+        if ((v >= 0x20 && v < 0x7f) || v == 8 || v == 9 || v == 10 || v == 12 || v == 13)
+            return smpack_i_bad(j, "a \\u escape Python writes otherwise");
+        j->i += 6;
     }
 }
 
-/* The next code point of a canonical string's body at *i (a surrogate pair is one code point, as Python
-   reads it): keys are sorted by code point. */
+/* The next code point of a canonical string's body at *i, a surrogate pair as one (as Python reads it). */
 static uint32_t smpack_i_codepoint(const unsigned char *m, size_t end, size_t *i) {
     uint32_t v, lo;
     unsigned c = m[*i];
@@ -329,6 +312,7 @@ static uint32_t smpack_i_codepoint(const unsigned char *m, size_t end, size_t *i
     return v;
 }
 
+/* Keys are sorted by code point (Python's str order), not by their escaped bytes. */
 static int smpack_i_key_cmp(const unsigned char *m, size_t a, size_t a_end, size_t b, size_t b_end) {
     while (a < a_end && b < b_end) {
         uint32_t x = smpack_i_codepoint(m, a_end, &a), y = smpack_i_codepoint(m, b_end, &b);
@@ -337,145 +321,144 @@ static int smpack_i_key_cmp(const unsigned char *m, size_t a, size_t a_end, size
     return (a < a_end) - (b < b_end);
 }
 
-/* An integer as Python writes one (no sign on 0, no leading zero) that fits 64 bits; no fractions or
-   exponents: a float's canonical text cannot be checked without reproducing Python's repr. */
+/* An integer as Python writes one (no "-0", no leading zero) within 64 bits. No fraction or exponent: a
+   float's canonical text is Python's repr, which this reader does not reproduce (read_pack refuses too). */
 static int smpack_i_integer(smpack_i_json *j) {
-    size_t at = j->i, digits;
-    int negative = j->m[at] == '-';
-    if (negative) at++;
-    digits = at;
+    size_t at = j->i + (j->m[j->i] == '-'), first = at, digits;
     while (at < j->n && j->m[at] >= '0' && j->m[at] <= '9') at++;
-    digits = at - digits;
-    if (!digits || (j->m[at - digits] == '0' && (digits > 1 || negative))) { j->why = "a malformed number"; return 0; }
-    if (at < j->n && (j->m[at] == '.' || j->m[at] == 'e' || j->m[at] == 'E')) { j->why = "a non-integer number"; return 0; }
-    if (digits > 19 || (digits == 19 && memcmp(j->m + at - 19, negative ? "9223372036854775808"
-                                                                         : "9223372036854775807", 19) > 0)) {
-        j->why = "an integer past 64 bits"; return 0;
-    }
+    digits = at - first;
+    if (!digits || (j->m[first] == '0' && (digits > 1 || first > j->i))) return smpack_i_bad(j, "a malformed number");
+    if (at < j->n && (j->m[at] == '.' || j->m[at] == 'e' || j->m[at] == 'E'))
+        return smpack_i_bad(j, "a non-integer number");
+    if (digits > 19 || (digits == 19 && memcmp(j->m + first, first > j->i ? "9223372036854775808"
+                                                                           : "9223372036854775807", 19) > 0))
+        return smpack_i_bad(j, "an integer past 64 bits");
     j->i = at;
     return 1;
 }
 
+/* One value at j->i; sets *is_smpack when it is the string "smpack". */
+static int smpack_i_scalar(smpack_i_json *j, int *is_smpack) {
+    const unsigned char *p = j->m + j->i;
+    size_t left = j->n - j->i;
+    *is_smpack = 0;
+    if (*p == '"') {
+        if (!smpack_i_string(j)) return 0;
+        *is_smpack = j->m + j->i - p == 8 && memcmp(p, "\"smpack\"", 8) == 0;
+        return 1;
+    }
+    if (*p == '-' || (*p >= '0' && *p <= '9')) return smpack_i_integer(j);
+    if (left >= 4 && (memcmp(p, "true", 4) == 0 || memcmp(p, "null", 4) == 0)) { j->i += 4; return 1; }
+    if (left >= 5 && memcmp(p, "false", 5) == 0) { j->i += 5; return 1; }
+    return smpack_i_bad(j, "a byte that starts no JSON value Python writes");
+}
+
 static smpack_status smpack_i_meta(smpack *pack, const unsigned char *m, size_t n) {
-    /* an explicit stack, not recursion: nesting depth is bounded by SMPACK_META_DEPTH whatever the input */
-    unsigned char kind[SMPACK_META_DEPTH];
+    /* an explicit stack, not recursion: the depth is bounded whatever the input */
+    unsigned char close[SMPACK_META_DEPTH];
     size_t key_at[SMPACK_META_DEPTH], key_end[SMPACK_META_DEPTH];
-    int depth = 0, want_key = 0, format_next = 0, format_ok = 0;
+    int depth = 0, want_key = 0, is_format = 0, format_ok = 0, is_smpack;
     smpack_i_json j;
-    j.m = m; j.n = n; j.i = 0; j.why = NULL;
+    j.m = m, j.n = n, j.i = 0, j.why = NULL;
     if (n == 0 || m[0] != '{')
         return smpack_i_fail(pack, SMPACK_ERR_META, "the metadata is not a JSON object (byte %d)", SMPACK_HEADER_SIZE);
     for (;;) {
-        int is_format = format_next;
-        format_next = 0;
-        if (want_key) { /* a key, then ':', then a value */
-            size_t at = j.i + 1;
-            if (j.i >= n || m[j.i] != '"') { j.why = "an object key that is not a string"; break; }
+        if (want_key) { /* a key sorting after the one before, ':', then its value */
+            size_t at = j.i + 1, *prev = &key_end[depth - 1];
+            if (j.i >= n || m[j.i] != '"') { smpack_i_bad(&j, "an object key that is not a string"); break; }
             if (!smpack_i_string(&j)) break;
-            if (key_end[depth - 1] && smpack_i_key_cmp(m, key_at[depth - 1], key_end[depth - 1], at, j.i - 1) >= 0) {
-                j.i = at - 1; j.why = "keys not sorted, or a repeated key"; break;
+            if (*prev && smpack_i_key_cmp(m, key_at[depth - 1], *prev, at, j.i - 1) >= 0) {
+                j.i = at - 1, smpack_i_bad(&j, "keys not sorted, or a repeated key"); break;
             }
-            key_at[depth - 1] = at; key_end[depth - 1] = j.i - 1;
-            format_next = depth == 1 && j.i - 1 - at == 6 && memcmp(m + at, "format", 6) == 0;
-            if (j.i >= n || m[j.i] != ':') { j.why = "no ':' right after a key"; break; }
-            j.i++;
+            key_at[depth - 1] = at, *prev = j.i - 1;
+            is_format = depth == 1 && j.i - 1 - at == 6 && memcmp(m + at, "format", 6) == 0;
+            if (j.i >= n || m[j.i++] != ':') { smpack_i_bad(&j, "no ':' right after a key"); break; }
             want_key = 0;
             continue;
         }
-        if (j.i >= n) { j.why = "it ends early"; break; }
+        if (j.i >= n) { smpack_i_bad(&j, "it ends early"); break; }
         if (m[j.i] == '{' || m[j.i] == '[') { /* a container: empty, or its first key or value next */
-            if (depth == SMPACK_META_DEPTH) { j.why = "nesting deeper than SMPACK_META_DEPTH (32)"; break; }
-            kind[depth] = m[j.i]; key_at[depth] = key_end[depth] = 0; depth++;
-            j.i++;
-            if (j.i < n && m[j.i] == (kind[depth - 1] == '{' ? '}' : ']')) { j.i++; depth--; }
-            else { want_key = kind[depth - 1] == '{'; continue; }
-        } else if (m[j.i] == '"') {
-            size_t at = j.i;
-            if (!smpack_i_string(&j)) break;
-            format_ok |= is_format && j.i - at == 8 && memcmp(m + at, "\"smpack\"", 8) == 0;
-        } else if (m[j.i] == '-' || (m[j.i] >= '0' && m[j.i] <= '9')) {
-            if (!smpack_i_integer(&j)) break;
-        } else if (n - j.i >= 4 && (memcmp(m + j.i, "true", 4) == 0 || memcmp(m + j.i, "null", 4) == 0)) {
-            j.i += 4;
-        } else if (n - j.i >= 5 && memcmp(m + j.i, "false", 5) == 0) {
-            j.i += 5;
-        } else { j.why = "a byte that starts no JSON value the generator writes"; break; }
-        /* after a value: the end, ',' and the next key or value, or the close of its container(s) */
-        while (depth && j.i < n && m[j.i] == (kind[depth - 1] == '{' ? '}' : ']')) { j.i++; depth--; }
-        if (!depth) {
-            if (j.i != n) { j.why = "bytes after the object"; break; }
-            if (!format_ok)
-                return smpack_i_fail(pack, SMPACK_ERR_META, "the metadata is not a shader pack's (no \"format\":\"smpack\")");
-            return SMPACK_OK;
+            if (depth == SMPACK_META_DEPTH) { smpack_i_bad(&j, "nested deeper than SMPACK_META_DEPTH (32)"); break; }
+            close[depth] = m[j.i] == '{' ? '}' : ']', key_end[depth] = 0, is_format = 0;
+            want_key = m[j.i++] == '{';
+            if (j.i >= n || m[j.i] != close[depth++]) continue;
+            j.i++, depth--, want_key = 0;
+        } else if (!smpack_i_scalar(&j, &is_smpack)) {
+            break;
+        } else {
+            format_ok |= is_format && is_smpack, is_format = 0;
         }
-        if (j.i >= n || m[j.i] != ',') { j.why = "no ',' or close after a value"; break; }
-        j.i++;
-        want_key = kind[depth - 1] == '{';
+        /* after a value: the close of its container(s), the end, or ',' and the next key or value */
+        while (depth && j.i < n && m[j.i] == close[depth - 1]) j.i++, depth--;
+        if (!depth && j.i != n) { smpack_i_bad(&j, "bytes after the object"); break; }
+        if (!depth && !format_ok)
+            return smpack_i_fail(pack, SMPACK_ERR_META, "the metadata is not a shader pack's (no \"format\":\"smpack\")");
+        if (!depth) return SMPACK_OK;
+        if (j.i >= n || m[j.i++] != ',') { smpack_i_bad(&j, "no ',' or close after a value"); break; }
+        want_key = close[depth - 1] == '}';
     }
     return smpack_i_fail(pack, SMPACK_ERR_META, "the metadata is not canonical JSON at byte %llu: %s",
                          (unsigned long long)(SMPACK_HEADER_SIZE + j.i), j.why);
 }
 
-/* ---- the pack key: sha256 of ["smpack",1,<meta>,[["perm","stage","<input key hex>","<sha hex>"],...]] */
+/* ---- the key: sha256 of ["smpack",1,<meta as in the file>,[["perm","stage","<input key hex>","<sha hex>"],...]] */
 
-static void smpack_i_sha_json_name(smpack_i_sha *s, const unsigned char *field, size_t n) {
-    /* a name is ASCII without NUL: escaped as json.dumps escapes it */
-    size_t k;
-    for (k = 0; k < n; k++) {
+static void smpack_i_sha_name(smpack_i_sha *s, const unsigned char *field, size_t width) {
+    size_t k, n = smpack_i_name(field, width);
+    smpack_i_sha_update(s, "\"", 1);
+    for (k = 0; k < n; k++) { /* ASCII without NUL, escaped as json.dumps escapes it */
+        static const char hex[] = "0123456789abcdef";
         unsigned c = field[k];
-        char e[8];
-        size_t len = 2;
-        e[0] = '\\';
-        if (c == '"' || c == '\\') e[1] = (char)c;
-        else if (c == 8) e[1] = 'b';
-        else if (c == 12) e[1] = 'f';
-        else if (c == 10) e[1] = 'n';
-        else if (c == 13) e[1] = 'r';
-        else if (c == 9) e[1] = 't';
-        else if (c < 0x20 || c == 0x7f) { snprintf(e, sizeof e, "\\u%04x", c); len = 6; }
-        else { e[0] = (char)c; len = 1; }
-        smpack_i_sha_update(s, e, len);
+        char e[6] = {'\\', 'u', '0', '0', 0, 0};
+        const char *short_escape = c == '"' ? "\"" : c == '\\' ? "\\" : c == 8 ? "b" : c == 12 ? "f" : c == 10 ? "n"
+                                 : c == 13 ? "r" : c == 9 ? "t" : NULL;
+        if (short_escape) { e[1] = *short_escape; smpack_i_sha_update(s, e, 2); }
+        else if (c < 0x20 || c == 0x7f) { e[4] = hex[c >> 4]; e[5] = hex[c & 15]; smpack_i_sha_update(s, e, 6); }
+        else { e[0] = (char)c; smpack_i_sha_update(s, e, 1); }
     }
+    smpack_i_sha_update(s, "\",", 2);
 }
 
-static void smpack_i_sha_hex(smpack_i_sha *s, const unsigned char *raw) {
+static void smpack_i_sha_hex(smpack_i_sha *s, const unsigned char *raw, char after) {
     static const char digits[] = "0123456789abcdef";
-    char hex[64];
+    char hex[67];
     int k;
-    for (k = 0; k < 32; k++) { hex[2 * k] = digits[raw[k] >> 4]; hex[2 * k + 1] = digits[raw[k] & 15]; }
-    smpack_i_sha_update(s, hex, 64);
+    for (hex[0] = hex[65] = '"', hex[66] = after, k = 0; k < 32; k++)
+        hex[1 + 2 * k] = digits[raw[k] >> 4], hex[2 + 2 * k] = digits[raw[k] & 15];
+    smpack_i_sha_update(s, hex, 67);
 }
 
-static int smpack_i_key_matches(const smpack *pack) {
+/* The key the pack's metadata and index give (whatever its header says). */
+static void smpack_i_key(const smpack *pack, unsigned char out[32]) {
     smpack_i_sha s;
-    unsigned char got[32];
     uint32_t i;
     smpack_i_sha_init(&s);
     smpack_i_sha_update(&s, "[\"smpack\",1,", 12);
     smpack_i_sha_update(&s, pack->data + SMPACK_HEADER_SIZE, pack->meta_length);
     smpack_i_sha_update(&s, ",[", 2);
     for (i = 0; i < pack->count; i++) {
-        const unsigned char *e = pack->data + pack->index_at + (size_t)i * SMPACK_ENTRY_SIZE;
-        smpack_i_sha_update(&s, i ? ",[\"" : "[\"", i ? 3u : 2u);
-        smpack_i_sha_json_name(&s, e, smpack_i_name(e, 16));
-        smpack_i_sha_update(&s, "\",\"", 3);
-        smpack_i_sha_json_name(&s, e + 16, smpack_i_name(e + 16, 8));
-        smpack_i_sha_update(&s, "\",\"", 3);
-        smpack_i_sha_hex(&s, e + 24);
-        smpack_i_sha_update(&s, "\",\"", 3);
-        smpack_i_sha_hex(&s, e + 56);
-        smpack_i_sha_update(&s, "\"]", 2);
+        const unsigned char *e = smpack_i_entry(pack, i);
+        smpack_i_sha_update(&s, i ? ",[" : "[", i ? 2u : 1u);
+        smpack_i_sha_name(&s, e, 16);
+        smpack_i_sha_name(&s, e + 16, 8);
+        smpack_i_sha_hex(&s, e + 24, ',');
+        smpack_i_sha_hex(&s, e + 56, ']');
     }
     smpack_i_sha_update(&s, "]]", 2);
-    smpack_i_sha_final(&s, got);
-    return memcmp(got, pack->key, 32) == 0;
+    smpack_i_sha_final(&s, out);
 }
 
 /* ---- the index and the blobs, entry by entry in read_pack's order */
 
-static smpack_status smpack_i_blobs_contiguous(smpack *pack) {
-    /* read_pack's walk over the distinct offsets in ascending order, each the next's start; used only when
-       the blobs are not laid out in order of first use (the way the generator writes them) */
+static smpack_status smpack_i_trailing(smpack *pack, uint64_t end) {
+    if (end == (uint64_t)pack->size) return SMPACK_OK;
+    return smpack_i_fail(pack, SMPACK_ERR_OVERLAP, "%llu bytes of trailing garbage after the last blob (byte %llu)",
+                         (unsigned long long)((uint64_t)pack->size - end), (unsigned long long)end);
+}
+
+/* read_pack's walk over the distinct offsets in ascending order, each blob's end the next one's start; only
+   for blobs not laid out in order of first use (as the generator lays them out): O(blobs x entries). */
+static smpack_status smpack_i_contiguous(smpack *pack) {
     uint64_t cur = pack->blobs_at, prev = 0;
     int first = 1;
     for (;;) {
@@ -483,122 +466,110 @@ static smpack_status smpack_i_blobs_contiguous(smpack *pack) {
         int found = 0;
         uint32_t i;
         for (i = 0; i < pack->count; i++) {
-            const unsigned char *e = pack->data + pack->index_at + (size_t)i * SMPACK_ENTRY_SIZE;
-            uint64_t o = smpack_i_u64(e + 88);
-            if ((first || o > prev) && (!found || o < best)) { best = o; best_len = smpack_i_u64(e + 96); found = 1; }
+            uint64_t o = smpack_i_u64(smpack_i_entry(pack, i) + 88);
+            if ((first || o > prev) && (!found || o < best)) {
+                best = o; best_len = smpack_i_u64(smpack_i_entry(pack, i) + 96); found = 1;
+            }
         }
-        if (!found) break;
+        if (!found) return smpack_i_trailing(pack, cur);
         if (best != cur)
             return smpack_i_fail(pack, SMPACK_ERR_OVERLAP, "the blobs are not contiguous: a gap or an overlap at byte %llu",
                                  (unsigned long long)(best < cur ? best : cur));
-        cur = best + best_len;
-        prev = best;
-        first = 0;
+        cur = best + best_len, prev = best, first = 0;
     }
-    if (cur != (uint64_t)pack->size)
-        return smpack_i_fail(pack, SMPACK_ERR_OVERLAP, "%llu bytes of trailing garbage after the last blob (byte %llu)",
-                             (unsigned long long)((uint64_t)pack->size - cur), (unsigned long long)cur);
-    return SMPACK_OK;
 }
 
 static smpack_status smpack_i_entries(smpack *pack) {
-    const unsigned char *d = pack->data;
     uint64_t size = (uint64_t)pack->size, end = (uint64_t)pack->blobs_at;
-    int in_order = 1, zero_at_end = 0; /* the blobs so far cover blobs_at..end in order of first use */
+    int in_order = 1, zero_at_end = 0; /* so far the distinct blobs cover blobs_at..end, in order of first use */
     uint32_t i;
     for (i = 0; i < pack->count; i++) {
-        const unsigned char *e = d + pack->index_at + (size_t)i * SMPACK_ENTRY_SIZE;
+        const unsigned char *e = smpack_i_entry(pack, i), *same = NULL;
         uint64_t offset = smpack_i_u64(e + 88), length = smpack_i_u64(e + 96);
-        const unsigned char *same = NULL;
+        unsigned long long at = (unsigned long long)(e - pack->data);
         char perm[17], stage[9];
         unsigned char got[32];
-        if (!smpack_i_name(e, 16))
-            return smpack_i_fail(pack, SMPACK_ERR_INDEX, "index entry %llu (byte %llu) has a malformed permutation field",
-                                 (unsigned long long)i, (unsigned long long)(pack->index_at + (size_t)i * SMPACK_ENTRY_SIZE));
-        if (!smpack_i_name(e + 16, 8))
-            return smpack_i_fail(pack, SMPACK_ERR_INDEX, "index entry %llu (byte %llu) has a malformed stage field",
-                                 (unsigned long long)i, (unsigned long long)(pack->index_at + (size_t)i * SMPACK_ENTRY_SIZE + 16));
-        smpack_i_copy_name(perm, e, 16);
-        smpack_i_copy_name(stage, e + 16, 8);
+        if (!smpack_i_name(e, 16) || !smpack_i_name(e + 16, 8))
+            return smpack_i_fail(pack, SMPACK_ERR_INDEX, "index entry %lu (byte %llu) has a malformed %s field: not "
+                                 "NUL-padded ASCII", (unsigned long)i, at + (smpack_i_name(e, 16) ? 16 : 0),
+                                 smpack_i_name(e, 16) ? "stage" : "permutation");
+        smpack_i_copy_name(perm, e, 16, 1);
+        smpack_i_copy_name(stage, e + 16, 8, 1);
         if (i && smpack_i_cmp_entry(e, e - SMPACK_ENTRY_SIZE, e - SMPACK_ENTRY_SIZE + 16) <= 0)
-            return smpack_i_fail(pack, SMPACK_ERR_ORDER, "index entry %llu (%s %s) is out of order or repeated",
-                                 (unsigned long long)i, perm, stage);
-        if (offset < (uint64_t)pack->blobs_at || offset > size || length > size - offset) /* no offset + length: it may wrap */
-            return smpack_i_fail(pack, SMPACK_ERR_BOUNDS, "index entry %llu (%s %s) points at %llu bytes from byte %llu, "
-                                 "outside the blobs (%llu..%llu): the file is truncated or its index damaged",
-                                 (unsigned long long)i, perm, stage, (unsigned long long)length, (unsigned long long)offset,
-                                 (unsigned long long)pack->blobs_at, (unsigned long long)pack->size);
-        if (!(in_order && offset == end && !zero_at_end)) { /* an earlier entry's blob? the latest one at this offset */
+            return smpack_i_fail(pack, SMPACK_ERR_ORDER, "index entry %lu (%s %s, byte %llu) is out of order or repeated",
+                                 (unsigned long)i, perm, stage, at);
+        if (offset < (uint64_t)pack->blobs_at || offset > size || length > size - offset) /* offset + length may wrap */
+            return smpack_i_fail(pack, SMPACK_ERR_BOUNDS, "index entry %lu (%s %s) points at %llu bytes from byte %llu, "
+                                 "outside the blobs (%llu..%llu)", (unsigned long)i, perm, stage,
+                                 (unsigned long long)length, (unsigned long long)offset,
+                                 (unsigned long long)pack->blobs_at, (unsigned long long)size);
+        if (!(in_order && offset == end && !zero_at_end)) { /* an earlier entry's blob? the latest at this offset */
             const unsigned char *p = e;
-            while (!same && p != d + pack->index_at) {
-                p -= SMPACK_ENTRY_SIZE;
-                if (smpack_i_u64(p + 88) == offset) same = p;
-            }
+            while (!same && p != smpack_i_entry(pack, 0))
+                if (smpack_i_u64((p -= SMPACK_ENTRY_SIZE) + 88) == offset) same = p;
         }
-        if (same && smpack_i_u64(same + 96) == length) {
-            /* one blob shared: its bytes were hashed for the earlier entry, so only the recorded hashes differ */
-            if (memcmp(same + 56, e + 56, 32) != 0)
-                return smpack_i_fail(pack, SMPACK_ERR_HASH, "sha256 mismatch in the blob of %s %s (%llu bytes from byte "
-                                     "%llu): it is damaged", perm, stage, (unsigned long long)length, (unsigned long long)offset);
-            continue;
+        if (same && smpack_i_u64(same + 96) == length) { /* its bytes hashed already: compare the recorded hashes */
+            if (memcmp(same + 56, e + 56, 32) == 0) continue;
+            memcpy(got, same + 56, 32); /* the bytes' hash: `same` passed */
+        } else {
+            smpack_sha256(pack->data + (size_t)offset, (size_t)length, got);
         }
-        smpack_sha256(d + (size_t)offset, (size_t)length, got);
         if (memcmp(got, e + 56, 32) != 0)
-            return smpack_i_fail(pack, SMPACK_ERR_HASH, "sha256 mismatch in the blob of %s %s (%llu bytes from byte %llu): "
-                                 "it is damaged", perm, stage, (unsigned long long)length, (unsigned long long)offset);
-        if (same) /* read_pack hashes before it compares lengths: so does this */
-            return smpack_i_fail(pack, SMPACK_ERR_OVERLAP, "index entry %llu (%s %s) overlaps another blob at byte %llu",
-                                 (unsigned long long)i, perm, stage, (unsigned long long)offset);
+            return smpack_i_fail(pack, SMPACK_ERR_HASH, "sha256 mismatch in the blob of %s %s (%llu bytes from byte %llu)",
+                                 perm, stage, (unsigned long long)length, (unsigned long long)offset);
+        if (same) /* read_pack hashes before it compares the lengths */
+            return smpack_i_fail(pack, SMPACK_ERR_OVERLAP, "index entry %lu (%s %s) overlaps another blob at byte %llu",
+                                 (unsigned long)i, perm, stage, (unsigned long long)offset);
         if (in_order && offset == end && !zero_at_end) { end += length; zero_at_end = length == 0; }
         else in_order = 0;
     }
-    if (!in_order) return smpack_i_blobs_contiguous(pack);
-    if (end != size)
-        return smpack_i_fail(pack, SMPACK_ERR_OVERLAP, "%llu bytes of trailing garbage after the last blob (byte %llu)",
-                             (unsigned long long)(size - end), (unsigned long long)end);
-    return SMPACK_OK;
+    return in_order ? smpack_i_trailing(pack, end) : smpack_i_contiguous(pack);
 }
 
-static smpack_status smpack_i_open(smpack *pack, const unsigned char *d, size_t size) {
-    uint32_t reserved;
+/* ---- opening */
+
+static smpack_status smpack_i_open(smpack *pack) {
+    const unsigned char *d = pack->data;
     uint64_t meta_length, index_at, blobs_at;
+    uint32_t reserved;
+    unsigned char key[32];
     smpack_status st;
     size_t k;
-    if (size < 8 || memcmp(d, "SMPACK\r\n", 8) != 0)
-        return smpack_i_fail(pack, SMPACK_ERR_MAGIC, "bad magic (expected \"SMPACK\\r\\n\" at byte 0%s)",
-                             size < 8 ? ", the file is shorter" : "");
-    if (size < SMPACK_HEADER_SIZE)
+    if (pack->size < 8 || memcmp(d, "SMPACK\r\n", 8) != 0)
+        return smpack_i_fail(pack, SMPACK_ERR_MAGIC, "bad magic at byte 0 (expected \"SMPACK\\r\\n\")%s",
+                             pack->size < 8 ? ": the file is shorter than it" : "");
+    if (pack->size < SMPACK_HEADER_SIZE)
         return smpack_i_fail(pack, SMPACK_ERR_TRUNCATED, "truncated: %llu bytes, shorter than the %d-byte header",
-                             (unsigned long long)size, SMPACK_HEADER_SIZE);
+                             (unsigned long long)pack->size, SMPACK_HEADER_SIZE);
     pack->version = smpack_i_u32(d + 8);
     pack->count = smpack_i_u32(d + 12);
     memcpy(pack->key, d + 16, 32);
     meta_length = smpack_i_u32(d + 48);
     reserved = smpack_i_u32(d + 52);
     if (pack->version != SMPACK_FORMAT_VERSION)
-        return smpack_i_fail(pack, SMPACK_ERR_VERSION, "format version %llu, this reader reads version %d",
-                             (unsigned long long)pack->version, SMPACK_FORMAT_VERSION);
+        return smpack_i_fail(pack, SMPACK_ERR_VERSION, "format version %lu (byte 8), this reader reads version %d",
+                             (unsigned long)pack->version, SMPACK_FORMAT_VERSION);
     if (reserved != 0)
-        return smpack_i_fail(pack, SMPACK_ERR_HEADER, "reserved header field (byte 52) is %llu, not 0", (unsigned long long)reserved);
-    /* in 64 bits: a u32 meta length and a u32 count times 104 cannot wrap it, whatever size_t is */
+        return smpack_i_fail(pack, SMPACK_ERR_HEADER, "reserved header field (byte 52) is %lu, not 0", (unsigned long)reserved);
+    /* in 64 bits, whatever size_t is: a u32 length and a u32 count times 104 cannot wrap them */
     index_at = (SMPACK_HEADER_SIZE + meta_length + 7u) / 8u * 8u;
     blobs_at = index_at + (uint64_t)pack->count * SMPACK_ENTRY_SIZE;
-    if (blobs_at > (uint64_t)size)
-        return smpack_i_fail(pack, SMPACK_ERR_TRUNCATED, "truncated: the header announces %llu entries and %llu bytes of "
-                             "metadata, ending at byte %llu, but the file has %llu bytes", (unsigned long long)pack->count,
-                             (unsigned long long)meta_length, (unsigned long long)blobs_at, (unsigned long long)size);
+    if (blobs_at > (uint64_t)pack->size)
+        return smpack_i_fail(pack, SMPACK_ERR_TRUNCATED, "truncated: the header announces %lu entries and %llu bytes of "
+                             "metadata, ending at byte %llu, but the file has %llu bytes", (unsigned long)pack->count,
+                             (unsigned long long)meta_length, (unsigned long long)blobs_at,
+                             (unsigned long long)pack->size);
     pack->meta_length = (size_t)meta_length;
     pack->index_at = (size_t)index_at;
     pack->blobs_at = (size_t)blobs_at;
-    st = smpack_i_meta(pack, d + SMPACK_HEADER_SIZE, pack->meta_length);
-    if (st != SMPACK_OK) return st;
+    if ((st = smpack_i_meta(pack, d + SMPACK_HEADER_SIZE, pack->meta_length)) != SMPACK_OK) return st;
     for (k = SMPACK_HEADER_SIZE + pack->meta_length; k < pack->index_at; k++)
-        if (d[k]) return smpack_i_fail(pack, SMPACK_ERR_META, "non-zero padding after the metadata (byte %llu)", (unsigned long long)k);
-    st = smpack_i_entries(pack);
-    if (st != SMPACK_OK) return st;
-    if (!smpack_i_key_matches(pack))
-        return smpack_i_fail(pack, SMPACK_ERR_KEY, "the pack key does not match its metadata and index "
-                             "(damaged header or index)");
+        if (d[k]) return smpack_i_fail(pack, SMPACK_ERR_META, "non-zero padding after the metadata (byte %llu)",
+                                       (unsigned long long)k);
+    if ((st = smpack_i_entries(pack)) != SMPACK_OK) return st;
+    smpack_i_key(pack, key);
+    if (memcmp(key, pack->key, 32) != 0)
+        return smpack_i_fail(pack, SMPACK_ERR_KEY, "the pack key (byte 16) does not match its metadata and index");
     return SMPACK_OK;
 }
 
@@ -609,8 +580,7 @@ smpack_status smpack_open_memory(smpack *pack, const void *data, size_t size) {
     if (!data) return smpack_i_fail(pack, SMPACK_ERR_ARGUMENT, "smpack_open_memory: data is NULL");
     pack->data = (const unsigned char *)data;
     pack->size = size;
-    st = smpack_i_open(pack, pack->data, size);
-    if (st != SMPACK_OK) { /* keep the message, drop the rest: a refused pack has no entries */
+    if ((st = smpack_i_open(pack)) != SMPACK_OK) { /* a refused pack keeps its message, nothing else */
         char why[sizeof pack->error];
         memcpy(why, pack->error, sizeof why);
         memset(pack, 0, sizeof *pack);
@@ -622,42 +592,40 @@ smpack_status smpack_open_memory(smpack *pack, const void *data, size_t size) {
 smpack_status smpack_open_file(smpack *pack, const char *path) {
     FILE *f;
     unsigned char *buf;
-    size_t cap = 65536, len = 0;
+    size_t cap = 65536, len = 0, got = 1;
     long hint;
     smpack_status st;
     if (!pack) return SMPACK_ERR_ARGUMENT;
     memset(pack, 0, sizeof *pack);
     if (!path) return smpack_i_fail(pack, SMPACK_ERR_ARGUMENT, "smpack_open_file: path is NULL");
     errno = 0;
-    f = fopen(path, "rb");
-    if (!f) return smpack_i_fail(pack, SMPACK_ERR_IO, "cannot open the shader pack: %s", errno ? strerror(errno) : "fopen failed");
-    /* the size as a first guess only: a directory's or a device's may be anything, so reading decides */
+    if (!(f = fopen(path, "rb")))
+        return smpack_i_fail(pack, SMPACK_ERR_IO, "cannot open the shader pack: %s", errno ? strerror(errno) : "fopen failed");
+    /* the size is a first guess only (a directory's or a device's may be anything): reading decides */
     if (fseek(f, 0, SEEK_END) == 0 && (hint = ftell(f)) >= 0 && (unsigned long)hint < (1ul << 30)) cap = (size_t)hint + 1;
-    if (fseek(f, 0, SEEK_SET) != 0) clearerr(f);
+    rewind(f);
     buf = (unsigned char *)malloc(cap);
-    for (;;) {
-        size_t got;
-        if (buf && len == cap) {
+    while (buf && got) {
+        if (len == cap) {
             unsigned char *more = cap > (size_t)-1 / 2 ? NULL : (unsigned char *)realloc(buf, cap * 2);
             if (!more) free(buf);
             buf = more;
             cap *= 2;
+            if (!buf) break;
         }
-        if (!buf) { fclose(f); return smpack_i_fail(pack, SMPACK_ERR_NOMEM, "out of memory reading %llu bytes", (unsigned long long)len); }
         errno = 0;
-        got = fread(buf + len, 1, cap - len, f);
-        len += got;
-        if (got == 0) break;
+        len += got = fread(buf + len, 1, cap - len, f);
     }
-    if (ferror(f)) {
+    if (!buf || ferror(f)) {
         int e = errno;
+        st = buf ? smpack_i_fail(pack, SMPACK_ERR_IO, "cannot read the shader pack: %s", e ? strerror(e) : "read error")
+                 : smpack_i_fail(pack, SMPACK_ERR_NOMEM, "out of memory after reading %llu bytes", (unsigned long long)len);
         free(buf);
         fclose(f);
-        return smpack_i_fail(pack, SMPACK_ERR_IO, "cannot read the shader pack: %s", e ? strerror(e) : "read error");
+        return st;
     }
     fclose(f);
-    st = smpack_open_memory(pack, buf, len);
-    if (st != SMPACK_OK) free(buf);
+    if ((st = smpack_open_memory(pack, buf, len)) != SMPACK_OK) free(buf);
     else pack->owned = buf;
     return st;
 }
@@ -667,6 +635,8 @@ void smpack_close(smpack *pack) {
     free(pack->owned);
     memset(pack, 0, sizeof *pack);
 }
+
+/* ---- reading an open pack */
 
 const char *smpack_error(const smpack *pack) { return pack ? pack->error : "no pack (NULL)"; }
 
@@ -683,10 +653,10 @@ uint32_t smpack_count(const smpack *pack) { return pack && pack->data ? pack->co
 
 smpack_status smpack_entry_at(const smpack *pack, uint32_t i, smpack_entry *out) {
     const unsigned char *e;
-    if (!pack || !out || !pack->data || i >= pack->count) return SMPACK_ERR_ARGUMENT;
-    e = pack->data + pack->index_at + (size_t)i * SMPACK_ENTRY_SIZE;
-    smpack_i_copy_name(out->permutation, e, 16);
-    smpack_i_copy_name(out->stage, e + 16, 8);
+    if (!out || i >= smpack_count(pack)) return SMPACK_ERR_ARGUMENT;
+    e = smpack_i_entry(pack, i);
+    smpack_i_copy_name(out->permutation, e, 16, 0);
+    smpack_i_copy_name(out->stage, e + 16, 8, 0);
     memcpy(out->input_key, e + 24, 32);
     memcpy(out->sha256, e + 56, 32);
     out->offset = smpack_i_u64(e + 88);
@@ -696,20 +666,19 @@ smpack_status smpack_entry_at(const smpack *pack, uint32_t i, smpack_entry *out)
 }
 
 smpack_status smpack_find(const smpack *pack, const char *permutation, const char *stage, smpack_entry *out) {
-    unsigned char perm[17], stg[9];
-    uint32_t lo = 0, hi;
+    unsigned char perm[16], stg[8];
+    uint32_t lo = 0, hi = smpack_count(pack);
     size_t k;
     if (!pack || !permutation || !stage || !out) return SMPACK_ERR_ARGUMENT;
-    for (k = 0; k < 17 && permutation[k]; k++) perm[k] = (unsigned char)permutation[k];
-    if (k == 17) return SMPACK_ERR_ARGUMENT;
-    memset(perm + k, 0, 17 - k);
-    for (k = 0; k < 9 && stage[k]; k++) stg[k] = (unsigned char)stage[k];
-    if (k == 9) return SMPACK_ERR_ARGUMENT;
-    memset(stg + k, 0, 9 - k);
-    hi = smpack_count(pack);
-    while (lo < hi) { /* the index is sorted, checked at open */
+    for (k = 0; k < 16 && permutation[k]; k++) perm[k] = (unsigned char)permutation[k];
+    if (permutation[k]) return SMPACK_ERR_ARGUMENT; /* longer than its field */
+    memset(perm + k, 0, 16 - k);
+    for (k = 0; k < 8 && stage[k]; k++) stg[k] = (unsigned char)stage[k];
+    if (stage[k]) return SMPACK_ERR_ARGUMENT;
+    memset(stg + k, 0, 8 - k);
+    while (lo < hi) { /* the index is sorted: open checked it */
         uint32_t mid = lo + (hi - lo) / 2;
-        int c = smpack_i_cmp_entry(pack->data + pack->index_at + (size_t)mid * SMPACK_ENTRY_SIZE, perm, stg);
+        int c = smpack_i_cmp_entry(smpack_i_entry(pack, mid), perm, stg);
         if (c == 0) return smpack_entry_at(pack, mid, out);
         if (c < 0) lo = mid + 1;
         else hi = mid;
