@@ -381,8 +381,8 @@ static smpack_status smpack_i_meta(smpack *pack, const unsigned char *m, size_t 
             if (depth == SMPACK_META_DEPTH) { smpack_i_bad(&j, "nested deeper than SMPACK_META_DEPTH (32)"); break; }
             close[depth] = m[j.i] == '{' ? '}' : ']', key_end[depth] = 0, is_format = 0;
             want_key = m[j.i++] == '{';
-            if (j.i >= n || m[j.i] != close[depth++]) continue;
-            j.i++, depth--, want_key = 0;
+            if (j.i >= n || m[j.i] != close[depth]) { depth++; continue; }
+            j.i++, want_key = 0;
         } else if (!smpack_i_scalar(&j, &is_smpack)) {
             break;
         } else {

@@ -242,6 +242,10 @@ CRAFTED = {
     "meta then a space": (lambda: _meta(META_OK + b" "), "SMPACK_ERR_META"),
     "meta then another object": (lambda: _meta(META_OK + b"{}"), "SMPACK_ERR_META"),
     "meta cut short": (lambda: _meta(META_OK[:-1]), "SMPACK_ERR_META"),
+    "meta ending in an open object": (lambda: _meta(b'{"format":"smpack","x":{'), "SMPACK_ERR_META"),
+    "meta ending in an open array": (lambda: _meta(b'{"format":"smpack","x":['), "SMPACK_ERR_META"),
+    "meta ending after a key": (lambda: _meta(b'{"format":"smpack","x":'), "SMPACK_ERR_META"),
+    "meta a lone brace": (lambda: _meta(b"{"), "SMPACK_ERR_META"),
     "meta trailing comma": (lambda: _meta(b'{"format":"smpack",}'), "SMPACK_ERR_META"),
     "meta unquoted key": (lambda: _meta(b'{format:"smpack"}'), "SMPACK_ERR_META"),
     **{f"meta number {n}": ((lambda n=n: _meta(b'{"format":"smpack","n":' + n + b"}")), "SMPACK_ERR_META")
