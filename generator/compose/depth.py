@@ -63,7 +63,9 @@ def compose_depth_units(plan: DepthPlan, lib, languages, dialects=()) -> dict[st
             moments = kind == "mask_moments"
             mp = mask_program(lp, moments, lib.memo)
             bricks = {lp.resolved.packing.brick.display_path: lp.resolved.packing.brick.module.source_hash}
-            out[name] = _compose(env, name, f"depth pass: coverage of {lp.perm.canonical()}", mp.interface,
+            # the unit's kind is in its key: a permutation's mask and mask_moments units get hashes of their own
+            key = f"depth pass: coverage of {lp.perm.canonical()}" + ("; moments" if moments else "")
+            out[name] = _compose(env, name, key, mp.interface,
                                  languages, dialects, {"mask": True, "moments": moments, "fragment": True,
                                                        "call_args": mp.call_args}, mp.program, bricks)
     return out

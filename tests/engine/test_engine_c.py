@@ -104,11 +104,6 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "gltf": lambda tmp: gltf_scene(tmp / "textured.gltf"),
           # masked casters (mask and mask_moments units) and a vsm light (moments, blur)
           "depth_mask": lambda tmp: REPO / "tests" / "scenes" / "depth_mask.toml"}
-# `build --pack` refuses this scene today: a masked permutation's mask and mask_moments units carry the same
-# depth_shaders hash, so the pack would hold two entries of one name. Strict: the day it builds, this fails
-# and the mark goes.
-PACK_CLASH = pytest.mark.xfail(strict=True, raises=AssertionError,
-                               reason="build --pack: a masked permutation's two depth units share one hash")
 
 
 @pytest.fixture(scope="module")
@@ -150,7 +145,7 @@ def compare(ours: Path, theirs: Path) -> tuple[int, float]:
     return int(d.max()), float((d <= LSB).mean())
 
 
-@pytest.mark.parametrize("name", [pytest.param(n, marks=PACK_CLASH) if n == "depth_mask" else n for n in SCENES])
+@pytest.mark.parametrize("name", SCENES)
 def test_the_engine_draws_what_render_draws(engine, prepared, name, tmp_path):
     build, export, reference = prepared(name)
     r = run_engine(engine, build, export, tmp_path / "engine.png")
