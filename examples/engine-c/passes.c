@@ -1,5 +1,5 @@
-/* The render passes: the colour pass's target (its format from the permutations' output.attachment, spelled by
- * conventions.platforms.vulkan.attachments) and each shadowed light's depth pass (lights.<name>.depth_pass:
+/* The render passes: shared helpers (render passes, framebuffers, the conventions' and render state's enum
+ * names), and each shadowed light's depth pass (lights.<name>.depth_pass:
  * its map, clear, depth test and bias, cull; for kind moments a moments target and the blur's targets), with
  * the fixed-function state their pipelines are made with. As the renderer: clears from the export and the
  * description, a viewport of the whole target with Vulkan's orientation, the colour left for the readback. */
@@ -14,7 +14,7 @@
 /* A render pass of an optional colour attachment (cleared, stored, left in `color_final`) and an optional depth
  * attachment (cleared; stored and left in `depth_final` when `keep_depth`, as a shadow map is). The two
  * dependencies order it after earlier passes' reads and writes and before later shaders' and copies' reads. */
-static bool make_render_pass(gpu *g, VkFormat color, VkImageLayout color_final, VkFormat depth, bool keep_depth,
+bool make_render_pass(gpu *g, VkFormat color, VkImageLayout color_final, VkFormat depth, bool keep_depth,
                              VkImageLayout depth_final, VkRenderPass *out)
 {
     VkAttachmentDescription att[2];
@@ -61,7 +61,7 @@ static bool make_render_pass(gpu *g, VkFormat color, VkImageLayout color_final, 
     return gpu_own(g, (owned){.kind = OWN_RENDER_PASS, .u.render_pass = *out});
 }
 
-static bool make_framebuffer(gpu *g, VkRenderPass pass, const VkImageView *views, uint32_t n, uint32_t w, uint32_t h,
+bool make_framebuffer(gpu *g, VkRenderPass pass, const VkImageView *views, uint32_t n, uint32_t w, uint32_t h,
                              VkFramebuffer *out)
 {
     VkFramebufferCreateInfo info = {.sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO};
@@ -79,7 +79,7 @@ static bool make_framebuffer(gpu *g, VkRenderPass pass, const VkImageView *views
 
 /* conventions.platforms.vulkan.<group>.<key>.<member> (or .<group>.<key> when member is NULL), an enum name of
  * `family`. */
-static bool convention_enum(const engine *e, const char *group, const char *key, const char *member,
+bool convention_enum(const engine *e, const char *group, const char *key, const char *member,
                             const char *family, int32_t *out)
 {
     const json_src *src = &e->m->src;
@@ -94,7 +94,7 @@ static bool convention_enum(const engine *e, const char *group, const char *key,
     return true;
 }
 
-static bool cull_mode(const engine *e, const char *cull, VkCullModeFlags *out)
+bool cull_mode(const engine *e, const char *cull, VkCullModeFlags *out)
 {
     int32_t v;
     if (!convention_enum(e, "cull", cull, "cullMode", "VK_CULL_MODE_", &v))
@@ -103,7 +103,7 @@ static bool cull_mode(const engine *e, const char *cull, VkCullModeFlags *out)
     return true;
 }
 
-static bool front_face(const engine *e, VkFrontFace *out)
+bool front_face(const engine *e, VkFrontFace *out)
 {
     const cJSON *ff = j_opt(e->m->conv, "front_face");
     int32_t v;
@@ -118,7 +118,7 @@ static bool front_face(const engine *e, VkFrontFace *out)
     return true;
 }
 
-static bool lower_enum(const engine *e, const cJSON *obj, const char *key, const char *family, const char *where,
+bool lower_enum(const engine *e, const cJSON *obj, const char *key, const char *family, const char *where,
                        int32_t *out)
 {
     const char *v = j_str(&e->m->src, obj, key, where);
@@ -127,94 +127,6 @@ static bool lower_enum(const engine *e, const cJSON *obj, const char *key, const
     if (!vk_enum_lower(family, v, out))
         return j_fail(&e->m->src, where, "%s %s is not a %s… this engine knows", key, v, family);
     return true;
-}
-
-/* A permutation's pipeline state: its render_state, the conventions' cull modes and front face. */
-bool color_state(const engine *e, const program *p, pipeline_state *st)
-{
-    const json_src *src = &e->m->src;
-    char where[96];
-    snprintf(where, sizeof where, "permutations[%s].render_state", p->hash);
-    const cJSON *rs = j_obj(src, p->json, "render_state", p->hash);
-    const char *cull = rs ? j_str(src, rs, "cull", where) : NULL;
-    const cJSON *depth = rs ? j_obj(src, rs, "depth", where) : NULL;
-    int32_t compare;
-    memset(st, 0, sizeof *st);
-    st->render_pass = e->render_pass;
-    st->width = (uint32_t)e->f->width;
-    st->height = (uint32_t)e->f->height;
-    st->color = true;
-    if (!cull || !depth || !cull_mode(e, cull, &st->cull) || !front_face(e, &st->front_face)
-        || !j_bool(src, depth, "test", where, &st->depth_test) || !j_bool(src, depth, "write", where, &st->depth_write)
-        || !lower_enum(e, depth, "compare", "VK_COMPARE_OP_", where, &compare))
-        return false;
-    st->depth_compare = (VkCompareOp)compare;
-    const cJSON *blend = j_opt(rs, "blend");
-    if (!blend || cJSON_IsNull(blend))
-        return true;
-    const cJSON *c = j_obj(src, blend, "color", where), *a = j_obj(src, blend, "alpha", where);
-    int32_t v[6];
-    if (!c || !a || !lower_enum(e, c, "src", "VK_BLEND_FACTOR_", where, &v[0])
-        || !lower_enum(e, c, "dst", "VK_BLEND_FACTOR_", where, &v[1]) || !lower_enum(e, c, "op", "VK_BLEND_OP_", where, &v[2])
-        || !lower_enum(e, a, "src", "VK_BLEND_FACTOR_", where, &v[3])
-        || !lower_enum(e, a, "dst", "VK_BLEND_FACTOR_", where, &v[4]) || !lower_enum(e, a, "op", "VK_BLEND_OP_", where, &v[5]))
-        return false;
-    st->blend = true;
-    st->src_color = (VkBlendFactor)v[0];
-    st->dst_color = (VkBlendFactor)v[1];
-    st->color_op = (VkBlendOp)v[2];
-    st->src_alpha = (VkBlendFactor)v[3];
-    st->dst_alpha = (VkBlendFactor)v[4];
-    st->alpha_op = (VkBlendOp)v[5];
-    return true;
-}
-
-/* The colour target: one attachment for every object, so every drawn permutation must ask for the same. */
-bool color_target(engine *e)
-{
-    const manifest *m = e->m;
-    const json_src *src = &m->src;
-    const char *key = NULL;
-    for (int i = 0; i < m->nobjects; i++) {
-        const program *p = &m->perms[m->objects[i].perm];
-        const cJSON *out = j_obj(src, p->json, "output", p->hash);
-        const char *a = out ? j_str(src, out, "attachment", p->hash) : NULL;
-        if (!a)
-            return false;
-        if (key && strcmp(key, a) != 0)
-            return fail("%s: the objects' permutations draw into %s and %s colour attachments; this engine draws "
-                        "one target", m->file, key, a);
-        key = a;
-    }
-    if (!key)
-        return fail("%s: no objects to draw — give the scene objects", m->file);
-    if (strcmp(key, e->f->color_attachment) != 0)
-        return fail("%s: color_attachment %s; the manifest's permutations draw into %s — export the frame of this "
-                    "build", e->f->file, e->f->color_attachment, key);
-    int32_t color, depth;
-    if (!convention_enum(e, "attachments", "color", key, "VK_FORMAT_", &color)
-        || !convention_enum(e, "attachments", "depth", NULL, "VK_FORMAT_", &depth))
-        return false;
-    if (color != VK_FORMAT_R8G8B8A8_SRGB && color != VK_FORMAT_R8G8B8A8_UNORM)
-        return j_fail(src, "conventions.platforms.vulkan.attachments.color", "format %d: this engine reads back "
-                      "R8G8B8A8 targets only", color);
-    e->color_format = (VkFormat)color;
-    gpu *g = e->g;
-    uint32_t w = (uint32_t)e->f->width, h = (uint32_t)e->f->height;
-    if (!gpu_format_has(g, e->color_format, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT)
-        || !gpu_format_has(g, (VkFormat)depth, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))
-        return fail("%s cannot render into the colour format %d with blending, or depth format %d",
-                    g->props.deviceName, color, depth);
-    if (!gpu_image_new(g, e->color_format, w, h, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                       VK_IMAGE_ASPECT_COLOR_BIT, &e->color)
-        || !gpu_image_new(g, (VkFormat)depth, w, h, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                          VK_IMAGE_ASPECT_DEPTH_BIT, &e->depth)
-        || !make_render_pass(g, e->color_format, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, (VkFormat)depth, false, 0,
-                             &e->render_pass))
-        return false;
-    VkImageView views[2] = {e->color.view, e->depth.view};
-    return make_framebuffer(g, e->render_pass, views, 2, w, h, &e->framebuffer)
-        && gpu_buffer_new(g, 4 * (VkDeviceSize)w * h, VK_BUFFER_USAGE_TRANSFER_DST_BIT, NULL, &e->readback);
 }
 
 /* premultiply.vulkan × S, S the export's shadow_matrix (column-major: S[r][c] = s[4c + r]); column-major out. */
@@ -277,17 +189,11 @@ static bool blur_targets(engine *e, light_pass *lp, VkFormat format, const cJSON
     return true;
 }
 
-static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass *lp)
+/* The description's depth target and rasterizer state into lp->state (and the clear), checked against what this
+ * engine draws and the export's map size; the caller makes the images. */
+static bool read_depth_state(engine *e, const cJSON *dp, const char *where, light_pass *lp)
 {
     const json_src *src = &e->m->src;
-    gpu *g = e->g;
-    char where[128];
-    snprintf(where, sizeof where, "lights.%s.depth_pass", name);
-    lp->name = name;
-    lp->desc = dp;
-    if (!(lp->fl = frame_light(e->f, name)))
-        return fail("%s: lights: no %s, which the build shadows (%s) — export the frame of this build", e->f->file,
-                    name, where);
     const char *kind = j_str(src, dp, "kind", where);
     double size[2], clear, constant, slope, clamp;
     const cJSON *depth = j_obj(src, dp, "depth", where), *matrix = j_obj(src, dp, "matrix", where);
@@ -295,6 +201,8 @@ static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass 
     const char *format = depth ? j_str(src, depth, "format", where) : NULL;
     const char *cull = depth ? j_str(src, depth, "cull", where) : NULL;
     int32_t compare;
+    VkFormat dformat;
+    uint32_t bytes;
     if (!kind || !matrix || !bias || !format || !cull || !j_nums(src, dp, "size", where, size, 2)
         || !j_num(src, depth, "clear", where, &clear) || !j_bool(src, depth, "write", where, &lp->state.depth_write)
         || !lower_enum(e, depth, "compare_op", "VK_COMPARE_OP_", where, &compare)
@@ -303,19 +211,17 @@ static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass 
         return false;
     if (strcmp(kind, "depth") != 0 && strcmp(kind, "moments") != 0)
         return j_fail(src, where, "kind %s: this engine draws depth and moments passes", kind);
+    if (size[0] < 1 || size[1] < 1 || size[0] > 16384 || size[1] > 16384)
+        return j_fail(src, where, "size %g x %g", size[0], size[1]);
     lp->moments = strcmp(kind, "moments") == 0;
     lp->width = (uint32_t)size[0];
     lp->height = (uint32_t)size[1];
-    if (size[0] < 1 || size[1] < 1 || size[0] > 16384 || size[1] > 16384)
-        return j_fail(src, where, "size %g x %g", size[0], size[1]);
     if ((int)lp->width != lp->fl->size[0] || (int)lp->height != lp->fl->size[1])
         return fail("%s: lights.%s.size is %dx%d; the build's map is %ux%u (%s) — render with the build's map size",
-                    e->f->file, name, lp->fl->size[0], lp->fl->size[1], lp->width, lp->height, where);
+                    e->f->file, lp->name, lp->fl->size[0], lp->fl->size[1], lp->width, lp->height, where);
     if (clamp != 0.0)
         return j_fail(src, where, "a depth bias clamp (%g) needs the depthBiasClamp feature, which this engine does "
                       "not enable", clamp);
-    VkFormat dformat;
-    uint32_t bytes;
     if (!vk_format(format, &dformat, &bytes) || dformat != VK_FORMAT_D32_SFLOAT)
         return j_fail(src, where, "depth format %s; this engine draws D32_SFLOAT maps", format);
     if (!light_view_proj(e, where, matrix, lp) || !cull_mode(e, cull, &lp->state.cull)
@@ -327,29 +233,20 @@ static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass 
     lp->state.depth_compare = (VkCompareOp)compare;
     lp->state.bias_constant = (float)constant;
     lp->state.bias_slope = (float)slope;
-    lp->clears[0].depthStencil.depth = (float)clear;
-    /* A map the shaders sample (kind depth) is kept and filtered as the sampler row says (bilinear): the device
-     * must sample and linearly filter D32_SFLOAT (lavapipe in Mesa 25 does; the renderer refuses otherwise). */
-    VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | (lp->moments ? 0 : VK_IMAGE_USAGE_SAMPLED_BIT);
-    VkFormatFeatureFlags need = VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT
-        | (lp->moments ? 0 : VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
-    if (!gpu_format_has(g, dformat, need))
-        return fail("%s cannot %s D32_SFLOAT, which %s's map needs", g->props.deviceName,
-                    lp->moments ? "render depth into" : "render into and linearly filter", name);
-    if (!gpu_image_new(g, dformat, lp->width, lp->height, 1, usage, VK_IMAGE_ASPECT_DEPTH_BIT, &lp->depth))
-        return false;
-    if (!lp->moments) {
-        lp->state.color = false;
-        if (!make_render_pass(g, VK_FORMAT_UNDEFINED, 0, dformat, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                              &lp->render_pass))
-            return false;
-        lp->state.render_pass = lp->render_pass;
-        return make_framebuffer(g, lp->render_pass, &lp->depth.view, 1, lp->width, lp->height, &lp->framebuffer);
-    }
+    lp->clears[lp->moments ? 1 : 0].depthStencil.depth = (float)clear;
+    return true;
+}
+
+/* Kind moments: a moments target beside the depth (the casters' fragment stage writes it), then the blur's. */
+static bool moments_target(engine *e, const cJSON *dp, const char *where, light_pass *lp)
+{
+    const json_src *src = &e->m->src;
+    gpu *g = e->g;
     const cJSON *moments = j_obj(src, dp, "moments", where);
     const char *mformat = moments ? j_str(src, moments, "format", where) : NULL;
     double mclear[4];
     VkFormat cformat;
+    uint32_t bytes;
     if (!mformat || !j_nums(src, moments, "clear", where, mclear, 4))
         return false;
     if (!vk_format(mformat, &cformat, &bytes) || cformat != VK_FORMAT_R32G32B32A32_SFLOAT)
@@ -359,18 +256,48 @@ static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass 
         return fail("%s cannot render into and linearly filter %s", g->props.deviceName, mformat);
     for (int i = 0; i < 4; i++)
         lp->clears[0].color.float32[i] = (float)mclear[i];
-    lp->clears[1].depthStencil.depth = (float)clear;
     lp->state.color = true;
-    VkImageView views[2];
     if (!gpu_image_new(g, cformat, lp->width, lp->height, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
                        VK_IMAGE_ASPECT_COLOR_BIT, &lp->targets[0])
-        || !make_render_pass(g, cformat, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, dformat, false, 0, &lp->render_pass))
+        || !make_render_pass(g, cformat, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, lp->depth.format, false, 0,
+                             &lp->render_pass))
         return false;
-    views[0] = lp->targets[0].view;
-    views[1] = lp->depth.view;
+    VkImageView views[2] = {lp->targets[0].view, lp->depth.view};
     lp->state.render_pass = lp->render_pass;
     return make_framebuffer(g, lp->render_pass, views, 2, lp->width, lp->height, &lp->framebuffer)
         && blur_targets(e, lp, cformat, moments, where);
+}
+
+static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass *lp)
+{
+    gpu *g = e->g;
+    char where[128];
+    snprintf(where, sizeof where, "lights.%s.depth_pass", name);
+    lp->name = name;
+    lp->desc = dp;
+    if (!(lp->fl = frame_light(e->f, name)))
+        return fail("%s: lights: no %s, which the build shadows (%s) — export the frame of this build", e->f->file,
+                    name, where);
+    if (!read_depth_state(e, dp, where, lp))
+        return false;
+    /* A map the shaders sample (kind depth) is kept and filtered as the sampler row says (bilinear): the device
+     * must sample and linearly filter D32_SFLOAT (lavapipe in Mesa 25 does; the renderer refuses otherwise). */
+    VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | (lp->moments ? 0 : VK_IMAGE_USAGE_SAMPLED_BIT);
+    VkFormatFeatureFlags need = VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT
+        | (lp->moments ? 0 : VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
+    if (!gpu_format_has(g, VK_FORMAT_D32_SFLOAT, need))
+        return fail("%s cannot %s D32_SFLOAT, which %s's map needs", g->props.deviceName,
+                    lp->moments ? "render depth into" : "render into and linearly filter", name);
+    if (!gpu_image_new(g, VK_FORMAT_D32_SFLOAT, lp->width, lp->height, 1, usage, VK_IMAGE_ASPECT_DEPTH_BIT, &lp->depth))
+        return false;
+    if (lp->moments)
+        return moments_target(e, dp, where, lp);
+    lp->state.color = false;
+    if (!make_render_pass(g, VK_FORMAT_UNDEFINED, 0, VK_FORMAT_D32_SFLOAT, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                          &lp->render_pass))
+        return false;
+    lp->state.render_pass = lp->render_pass;
+    return make_framebuffer(g, lp->render_pass, &lp->depth.view, 1, lp->width, lp->height, &lp->framebuffer);
 }
 
 bool light_passes(engine *e)

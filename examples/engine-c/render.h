@@ -3,7 +3,8 @@
  *
  * resources.c makes what draws read: textures (KTX2), samplers (rows), meshes, the uniform blocks (Frame,
  * Object from the export; Material, Lights from the manifest's uploads, with the export's shadow matrices
- * written in). passes.c makes the render passes, pipelines, descriptor sets and records the frame. */
+ * written in). color.c makes the colour pass's target and states, passes.c the depth passes; draw.c the
+ * pipelines and the draws, and records the frame; bindings.c writes the draws' descriptor sets. */
 #ifndef ENGINE_RENDER_H
 #define ENGINE_RENDER_H
 
@@ -110,10 +111,27 @@ bool sampler_of_row(engine *e, int index, const char *where, VkSampler *out);
 bool block_buffer(engine *e, const draw_item *it, const block_ref *b, VkBuffer *out);
 void record_texture_uploads(engine *e, VkCommandBuffer cmd);
 
-/* passes.c */
+/* bindings.c */
+bool write_sets(engine *e);
+
+/* color.c */
 bool color_target(engine *e);
 bool color_state(const engine *e, const program *p, pipeline_state *st);
+
+/* passes.c: the light passes, and helpers every pass uses */
 bool light_passes(engine *e);
+bool make_render_pass(gpu *g, VkFormat color, VkImageLayout color_final, VkFormat depth, bool keep_depth,
+                      VkImageLayout depth_final, VkRenderPass *out);
+bool make_framebuffer(gpu *g, VkRenderPass pass, const VkImageView *views, uint32_t n, uint32_t w, uint32_t h,
+                      VkFramebuffer *out);
+/* conventions.platforms.vulkan.<group>.<key>[.<member>]: an enum name of `family` */
+bool convention_enum(const engine *e, const char *group, const char *key, const char *member, const char *family,
+                     int32_t *out);
+bool cull_mode(const engine *e, const char *cull, VkCullModeFlags *out);
+bool front_face(const engine *e, VkFrontFace *out);
+/* obj[key], a lower-case name of `family` ("less" of VK_COMPARE_OP_) */
+bool lower_enum(const engine *e, const cJSON *obj, const char *key, const char *family, const char *where,
+                int32_t *out);
 bool light_pass_of(const engine *e, const char *light, const light_pass **out);
 
 #endif

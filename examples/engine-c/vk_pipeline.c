@@ -101,80 +101,92 @@ static bool shader_module(gpu *g, const smpack *pack, const program *p, const ch
     return r == VK_SUCCESS || vk_failed("vkCreateShaderModule", r);
 }
 
+/* The fixed-function state of a pipeline, filled from a pipeline_state; the create infos point into it. */
+typedef struct fixed_states {
+    VkVertexInputBindingDescription vb[MAX_INPUTS];
+    VkVertexInputAttributeDescription va[MAX_INPUTS];
+    VkPipelineVertexInputStateCreateInfo vertex;
+    VkPipelineInputAssemblyStateCreateInfo assembly;
+    VkViewport viewport;
+    VkRect2D scissor;
+    VkPipelineViewportStateCreateInfo viewports;
+    VkPipelineRasterizationStateCreateInfo raster;
+    VkPipelineMultisampleStateCreateInfo multisample;
+    VkPipelineDepthStencilStateCreateInfo depth;
+    VkPipelineColorBlendAttachmentState attachment;
+    VkPipelineColorBlendStateCreateInfo blend;
+} fixed_states;
+
+static void fixed_function(const program *p, const pipeline_state *st, fixed_states *f)
+{
+    memset(f, 0, sizeof *f);
+    for (int i = 0; i < p->ninputs; i++) {  /* input k: binding k, tightly packed, per vertex */
+        f->vb[i] = (VkVertexInputBindingDescription){(uint32_t)i, p->inputs[i].bytes, VK_VERTEX_INPUT_RATE_VERTEX};
+        f->va[i] = (VkVertexInputAttributeDescription){(uint32_t)p->inputs[i].location, (uint32_t)i,
+                                                       p->inputs[i].format, 0};
+    }
+    f->vertex = (VkPipelineVertexInputStateCreateInfo){.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    f->vertex.vertexBindingDescriptionCount = f->vertex.vertexAttributeDescriptionCount = (uint32_t)p->ninputs;
+    f->vertex.pVertexBindingDescriptions = f->vb;
+    f->vertex.pVertexAttributeDescriptions = f->va;
+    f->assembly = (VkPipelineInputAssemblyStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+        .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST};
+    /* Vulkan's own clip space (conventions.platforms.vulkan.clip): no y flip in the viewport, depth 0..1 */
+    f->viewport = (VkViewport){0.0f, 0.0f, (float)st->width, (float)st->height, 0.0f, 1.0f};
+    f->scissor = (VkRect2D){{0, 0}, {st->width, st->height}};
+    f->viewports = (VkPipelineViewportStateCreateInfo){.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+        .viewportCount = 1, .pViewports = &f->viewport, .scissorCount = 1, .pScissors = &f->scissor};
+    f->raster = (VkPipelineRasterizationStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO, .polygonMode = VK_POLYGON_MODE_FILL,
+        .cullMode = st->cull, .frontFace = st->front_face,
+        .depthBiasEnable = st->bias_constant != 0.0f || st->bias_slope != 0.0f,
+        .depthBiasConstantFactor = st->bias_constant, .depthBiasSlopeFactor = st->bias_slope,
+        .depthBiasClamp = st->bias_clamp, .lineWidth = 1.0f};
+    f->multisample = (VkPipelineMultisampleStateCreateInfo){
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT};
+    f->depth = (VkPipelineDepthStencilStateCreateInfo){.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+        .depthTestEnable = st->depth_test, .depthWriteEnable = st->depth_write, .depthCompareOp = st->depth_compare,
+        .maxDepthBounds = 1.0f};
+    bool b = st->blend;  /* without blending the attachment stores what the shader writes */
+    f->attachment = (VkPipelineColorBlendAttachmentState){
+        .blendEnable = b, .srcColorBlendFactor = b ? st->src_color : VK_BLEND_FACTOR_ONE,
+        .dstColorBlendFactor = b ? st->dst_color : VK_BLEND_FACTOR_ZERO, .colorBlendOp = b ? st->color_op : VK_BLEND_OP_ADD,
+        .srcAlphaBlendFactor = b ? st->src_alpha : VK_BLEND_FACTOR_ONE,
+        .dstAlphaBlendFactor = b ? st->dst_alpha : VK_BLEND_FACTOR_ZERO, .alphaBlendOp = b ? st->alpha_op : VK_BLEND_OP_ADD,
+        .colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT
+                        | VK_COLOR_COMPONENT_A_BIT};
+    f->blend = (VkPipelineColorBlendStateCreateInfo){.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+        .attachmentCount = 1, .pAttachments = &f->attachment};
+}
+
 bool pipeline_create(gpu *g, const smpack *pack, const program *p, const program_layout *layout,
                      const pipeline_state *st, VkPipeline *out)
 {
     VkShaderModule modules[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
     VkPipelineShaderStageCreateInfo stages[2];
-    int nstages = p->has_frag ? 2 : 1;
+    int nstages = p->has_frag ? 2 : 1;  /* a depth pass's caster may be vertex-only */
     const char *names[2] = {"vert", "frag"};
     const VkShaderStageFlagBits bits[2] = {VK_SHADER_STAGE_VERTEX_BIT, VK_SHADER_STAGE_FRAGMENT_BIT};
     bool ok = true;
     for (int i = 0; i < nstages && ok; i++) {
         ok = shader_module(g, pack, p, names[i], &modules[i]);
-        stages[i] = (VkPipelineShaderStageCreateInfo){.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-        stages[i].stage = bits[i];
-        stages[i].module = modules[i];
-        stages[i].pName = p->entry[i];
+        stages[i] = (VkPipelineShaderStageCreateInfo){.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                                                      .stage = bits[i], .module = modules[i], .pName = p->entry[i]};
     }
-    VkVertexInputBindingDescription vb[MAX_INPUTS];
-    VkVertexInputAttributeDescription va[MAX_INPUTS];
-    for (int i = 0; i < p->ninputs; i++) {
-        vb[i] = (VkVertexInputBindingDescription){(uint32_t)i, p->inputs[i].bytes, VK_VERTEX_INPUT_RATE_VERTEX};
-        va[i] = (VkVertexInputAttributeDescription){(uint32_t)p->inputs[i].location, (uint32_t)i, p->inputs[i].format, 0};
-    }
-    VkPipelineVertexInputStateCreateInfo vertex = {.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
-    vertex.vertexBindingDescriptionCount = vertex.vertexAttributeDescriptionCount = (uint32_t)p->ninputs;
-    vertex.pVertexBindingDescriptions = vb;
-    vertex.pVertexAttributeDescriptions = va;
-    VkPipelineInputAssemblyStateCreateInfo assembly = {.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
-    assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    /* Vulkan's own clip space (conventions.platforms.vulkan.clip): no y flip in the viewport, depth 0..1. */
-    VkViewport viewport = {0.0f, 0.0f, (float)st->width, (float)st->height, 0.0f, 1.0f};
-    VkRect2D scissor = {{0, 0}, {st->width, st->height}};
-    VkPipelineViewportStateCreateInfo vp = {.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
-    vp.viewportCount = vp.scissorCount = 1;
-    vp.pViewports = &viewport;
-    vp.pScissors = &scissor;
-    VkPipelineRasterizationStateCreateInfo raster = {.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
-    raster.polygonMode = VK_POLYGON_MODE_FILL;
-    raster.cullMode = st->cull;
-    raster.frontFace = st->front_face;
-    raster.depthBiasEnable = st->bias_constant != 0.0f || st->bias_slope != 0.0f;
-    raster.depthBiasConstantFactor = st->bias_constant;
-    raster.depthBiasSlopeFactor = st->bias_slope;
-    raster.depthBiasClamp = st->bias_clamp;
-    raster.lineWidth = 1.0f;
-    VkPipelineMultisampleStateCreateInfo ms = {.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
-    ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-    VkPipelineDepthStencilStateCreateInfo depth = {.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
-    depth.depthTestEnable = st->depth_test;
-    depth.depthWriteEnable = st->depth_write;
-    depth.depthCompareOp = st->depth_compare;
-    depth.maxDepthBounds = 1.0f;
-    VkPipelineColorBlendAttachmentState attachment = {0};
-    attachment.blendEnable = st->blend;
-    attachment.srcColorBlendFactor = st->blend ? st->src_color : VK_BLEND_FACTOR_ONE;
-    attachment.dstColorBlendFactor = st->blend ? st->dst_color : VK_BLEND_FACTOR_ZERO;
-    attachment.colorBlendOp = st->blend ? st->color_op : VK_BLEND_OP_ADD;
-    attachment.srcAlphaBlendFactor = st->blend ? st->src_alpha : VK_BLEND_FACTOR_ONE;
-    attachment.dstAlphaBlendFactor = st->blend ? st->dst_alpha : VK_BLEND_FACTOR_ZERO;
-    attachment.alphaBlendOp = st->blend ? st->alpha_op : VK_BLEND_OP_ADD;
-    attachment.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT
-                              | VK_COLOR_COMPONENT_A_BIT;
-    VkPipelineColorBlendStateCreateInfo blend = {.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
-    blend.attachmentCount = 1;
-    blend.pAttachments = &attachment;
+    fixed_states f;
+    fixed_function(p, st, &f);
     VkGraphicsPipelineCreateInfo info = {.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
     info.stageCount = (uint32_t)nstages;
     info.pStages = stages;
-    info.pVertexInputState = &vertex;
-    info.pInputAssemblyState = &assembly;
-    info.pViewportState = &vp;
-    info.pRasterizationState = &raster;
-    info.pMultisampleState = &ms;
-    info.pDepthStencilState = &depth;
-    info.pColorBlendState = st->color ? &blend : NULL;
+    info.pVertexInputState = &f.vertex;
+    info.pInputAssemblyState = &f.assembly;
+    info.pViewportState = &f.viewports;
+    info.pRasterizationState = &f.raster;
+    info.pMultisampleState = &f.multisample;
+    info.pDepthStencilState = &f.depth;
+    info.pColorBlendState = st->color ? &f.blend : NULL;  /* a depth-only pass has no colour attachment */
     info.layout = layout->layout;
     info.renderPass = st->render_pass;
     info.basePipelineIndex = -1;
