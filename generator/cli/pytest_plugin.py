@@ -4,9 +4,13 @@
            [--shadermatrix-golden DIR]
 
 Registered through the `pytest11` entry point of the package, so installing
-shadermatrix is enough. Each test is named `<scene>::<hash>-<platform>` (vulkan, d3d12,
-gl, webgpu: what each validates is assemble/checks.py's table); a failure reads as the
-brick line that caused it. With --shadermatrix-golden, a test also fails when the
+shadermatrix is enough. A scene is a file pytest collects (a SceneFile), its tests the
+items under it, named `<hash>-<platform>` (vulkan, d3d12, gl, webgpu: what each validates
+is assemble/checks.py's table): the node id `scenes/example.toml::<hash>-vulkan` runs one
+again, alone (`--shadermatrix-scene` not needed then), and `--lf` and `-k` work as on any
+test. Given scenes and no paths, a run collects the scenes alone, not the tests of the
+directory it runs in; `pytest tests/ --shadermatrix-scene S` runs both. A failure reads as
+the brick line that caused it. With --shadermatrix-golden, a test also fails when the
 permutation's emitted sources drift from the golden directory
 (`shadermatrix check --golden DIR --update-golden` writes it). A gl test whose GLSL ES
 3.10 does not validate passes, with the note in its report section and
@@ -71,10 +75,12 @@ class PermutationItem(pytest.Item):
         return self.path, None, f"{self.scene.name}::{self.check.id}"
 
 
-class SceneCollector(pytest.Collector):
-    def __init__(self, *, scene_path, **kw):
+class SceneFile(pytest.File):
+    """A scene file as pytest collects it: its items are the scene's checks, so a node id
+    (`scenes/example.toml::<hash>-<platform>`) names one and runs it again."""
+
+    def __init__(self, **kw):
         super().__init__(**kw)
-        self.scene_path = scene_path
         self.outcomes: dict = {}  # check -> Outcome (or the batch's error), once a test of it has run
 
     def outcome(self, item):
@@ -95,36 +101,65 @@ class SceneCollector(pytest.Collector):
 
     def collect(self):
         from ..assemble.checks import checks
-        from ..lang.errors import UserError
-        from ..library.bricks import load_library
-        from ..scene.load import load_scene
-        from .commands.check import selection
-        opt = self.config.getoption
-        try:  # a bad scene, brick or option is the run's usage error, one line, not an INTERNALERROR
-            plats, langs = selection(opt("--shadermatrix-platforms"), opt("--shadermatrix-languages"),
-                                     "--shadermatrix-")
-            lib = load_library(opt("--shadermatrix-bricks"))
-            scene = load_scene(self.scene_path, lib)
-        except (UserError, ValueError) as e:
-            raise pytest.UsageError(f"--shadermatrix-scene {self.scene_path}: {e}") from None
+        scene, lib, plats, langs = self.config.stash[_LOADED][self.path.resolve()]
         for c in checks(scene, plats, langs):
             yield PermutationItem.from_parent(self, name=c.id, scene=scene, lib=lib, check=c,
-                                              golden=opt("--shadermatrix-golden"))
+                                              golden=self.config.getoption("--shadermatrix-golden"))
+
+
+_LOADED = pytest.StashKey[dict]()  # resolved scene path -> (Scene, Library, platforms, languages)
 
 
 def pytest_configure(config):
+    """Given scenes, the run collects them, and not the tests of the directory it runs in unless paths are named
+    too (`pytest tests/ --shadermatrix-scene S` runs both); a scene under a named path is found there, and a
+    scene named by a node id (`S::<hash>-vulkan`, with or without --shadermatrix-scene) runs only that test."""
     config.addinivalue_line("markers", "shadermatrix: a permutation × platform compile check of a scene")
+    scenes = list(dict.fromkeys(Path(p).resolve() for p in config.getoption("--shadermatrix-scene")))
+    named = config.args_source == pytest.Config.ArgsSource.ARGS
+    given = [Path(a.split("::", 1)[0]).resolve() for a in config.args] if named else []
+    if scenes:
+        extra = [str(s) for s in scenes if not any(s == g or g in s.parents for g in given)]
+        config.args = [*config.args, *extra] if named else extra
+    on_line = [g for g in given if g not in scenes and _is_scene(g) and g.is_file()]
+    if scenes or on_line:
+        config.stash[_LOADED] = _load(config, scenes, on_line)
 
 
-def pytest_collection_modifyitems(session, config, items):
-    seen = set()
-    for path in config.getoption("--shadermatrix-scene"):
-        p = Path(path).resolve()
-        if p in seen:
-            continue
-        seen.add(p)
-        try:  # the node id names the scene by its path from the rootdir: two scene.toml files stay apart
-            name = p.relative_to(config.rootpath).as_posix()
-        except ValueError:
-            name = p.as_posix()
-        items.extend(SceneCollector.from_parent(session, name=name, path=p, scene_path=p).collect())
+def _load(config, scenes, on_line) -> dict:
+    """Every scene of the run loaded before collection: a bad scene, brick or option is the run's usage error
+    (exit 4, one line), not a collection error or an INTERNALERROR."""
+    from ..lang.errors import UserError
+    from ..library.bricks import load_library
+    from ..scene.load import load_scene
+    from .commands.check import selection
+    opt = config.getoption
+    shown = {Path(p).resolve(): p for p in opt("--shadermatrix-scene")}
+    path = (scenes or on_line)[0]
+    try:
+        plats, langs = selection(opt("--shadermatrix-platforms"), opt("--shadermatrix-languages"), "--shadermatrix-")
+        lib = load_library(opt("--shadermatrix-bricks"))
+        out = {}
+        for path in [*scenes, *on_line]:
+            out[path] = (load_scene(path, lib), lib, plats, langs)
+    except (UserError, ValueError) as e:
+        raise pytest.UsageError(f"--shadermatrix-scene {shown[path]}: {e}" if path in shown else f"{path}: {e}") \
+            from None
+    return out
+
+
+def pytest_collect_file(file_path: Path, parent):
+    """A scene the run loaded (given by --shadermatrix-scene, or named on the command line) is a SceneFile."""
+    loaded = parent.config.stash.get(_LOADED, None)
+    if loaded and file_path.resolve() in loaded:
+        return SceneFile.from_parent(parent, path=file_path)
+    return None
+
+
+# scene/load.py's SCENE_SUFFIXES, spelled here: importing the scene loader takes ~0.4 s, and every pytest run on a
+# machine with shadermatrix installed loads this plugin (tests/cli/test_pytest_plugin.py keeps the two equal)
+SCENE_SUFFIXES = (".toml", ".gltf", ".glb")
+
+
+def _is_scene(path: Path) -> bool:
+    return path.name.lower().endswith(SCENE_SUFFIXES)

@@ -280,35 +280,6 @@ def _flat(r: Row) -> dict:
     return d
 
 
-def diff(rows: list[Row], old: list[dict], names, old_name: str) -> str:
-    """What a change cost, shader by shader: every count in `names` that differs from an earlier JSON report's
-    row of the same shader (table, subject, stage, language), and the shaders only one of them has (Markdown)."""
-    def key(d: dict) -> tuple:
-        return d["table"], d["subject"], d["stage"], d["language"]
-
-    def who(d: dict) -> str:
-        return f"`{d['subject']}`" + (f" ({', '.join(d['objects'])})" if d.get("objects") else "")
-
-    new = {key(d): d for d in (_flat(r) | {"alu_t": _value(r, "alu_t")} for r in rows)}
-    before = {key(d): d | {"alu_t": (d["alu"] + d["transcendental"]) if d.get("alu") is not None
-                           and d.get("transcendental") is not None else None} for d in old}
-    lines = []
-    for k in sorted(new.keys() & before.keys()):
-        a, b = before[k], new[k]
-        for name in names:
-            if a.get(name) is not None and b.get(name) is not None and a[name] != b[name]:
-                lines.append([f"{k[0]} {who(b)}", k[2], k[3], name, str(a[name]), str(b[name]),
-                              f"{b[name] - a[name]:+d}"])
-    only = [f"- new: {k[0]} {who(new[k])} {k[2]} {k[3]}" for k in sorted(new.keys() - before.keys())]
-    only += [f"- gone: {k[0]} {who(before[k])} {k[2]} {k[3]}" for k in sorted(before.keys() - new.keys())]
-    out = [f"# Costs against {old_name}", "",
-           f"{len({tuple(x[:3]) for x in lines})} shaders changed, {len(only)} new or gone, "
-           f"{len(new.keys() & before.keys())} compared.", ""]
-    if lines:
-        out += _md_table(["shader", "stage", "language", "count", "before", "now", "change"], lines) + [""]
-    return "\n".join(out + only + ([""] if only else []))
-
-
 def to_csv(rows: list[Row]) -> str:
     """One line per subject and language (and RADV's figures as gpu_<family>_<statistic> columns)."""
     from . import gpu as radv
