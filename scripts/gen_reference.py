@@ -28,6 +28,7 @@ import reference_frame  # noqa: E402  (likewise: the frame export's schema)
 
 COMMAND = "make reference"
 PAGES = ("README.md", "cli.md", "bricks.md", "language.md", "manifest.md", "manifest.schema.json", "frame.md")
+HANDWRITTEN = ("pack-h.md",)  # pages beside them written by hand (tests elsewhere check them), listed in the index
 WIDTH = 100  # the usage lines' width: fixed, so the page does not depend on the terminal
 
 
@@ -304,7 +305,11 @@ def render_index() -> str:
                                                "[manifest.schema.json](manifest.schema.json)"],
                 ["[frame.md](frame.md)", "every field of `render --export`'s frame.json (meshes, matrices, camera), "
                                          "from its JSON Schema"]])
-            + f"\nRegenerate them with `{COMMAND}` after changing the code they describe.\n")
+            + f"\nRegenerate them with `{COMMAND}` after changing the code they describe.\n"
+            + "\nWritten by hand (tests/native/ compiles its example and checks what it says):\n\n"
+            + table(["page", "what it documents"], [
+                ["[pack-h.md](pack-h.md)", "`include/shadermatrix/pack.h`, the C reader of the shader packs: how to "
+                                           "include it, every function and status, what opening a pack checks"]]))
 
 
 def render_all() -> dict[str, str]:

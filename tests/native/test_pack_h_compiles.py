@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import re
 import subprocess
+from pathlib import Path
 
 import pytest
 
-from .conftest import HEADER, INCLUDE, WARNINGS, compile_c, compiler
+from .conftest import HEADER, INCLUDE, REPO, WARNINGS, compile_c, compiler
 from .test_pack_h_checks import small_pack
 
 pytestmark = pytest.mark.toolchain
@@ -111,3 +112,17 @@ def test_every_function_of_the_header_is_documented():
         found = re.search(rf"\n(?:const )?\w+ +\*?{name}\(", declarations)
         assert found, f"{name} is not declared"
         assert declarations[:found.start()].rstrip().endswith("*/"), f"{name} has no comment above it"
+
+
+def test_the_reference_pages_example_compiles(tmp_path):
+    """docs/reference/pack-h.md's C example (the block that loads a module into vkCreateShaderModule), against
+    the Vulkan headers of libvulkan-dev."""
+    from tests.conftest import require
+    require(Path("/usr/include/vulkan/vulkan.h").is_file(), "no Vulkan headers — run `make setup` (libvulkan-dev)")
+    page = (REPO / "docs" / "reference" / "pack-h.md").read_text()
+    [example] = [b for b in re.findall(r"```c\n(.*?)```", page, re.S) if "vkCreateShaderModule" in b]
+    for cc, suffix, std in [("gcc", ".c", "-std=c11"), ("g++", ".cpp", "-std=c++17")]:
+        src = tmp_path / ("example" + suffix)
+        src.write_text(example)
+        compile_c([compiler(cc), std, *STRICT, f"-I{INCLUDE}", "-c", str(src), "-o", str(tmp_path / "example.o")],
+                  f"the example of docs/reference/pack-h.md does not compile with {cc}")
