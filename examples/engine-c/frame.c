@@ -184,8 +184,11 @@ bool frame_load(const char *frame_dir, const manifest *m, frame *f)
         return false;
     if (strcmp(format, "shadermatrix-frame") != 0 || version != 1)
         return j_fail(src, "format", "%s version %d; this engine reads shadermatrix-frame version 1", format, version);
-    if (!(platform = j_str(src, f->root, "platform", "frame")))
+    const char *scene = j_str(src, f->root, "scene", "frame"), *built = j_str(&m->src, m->root, "scene", "manifest");
+    if (!(platform = j_str(src, f->root, "platform", "frame")) || !scene || !built)
         return false;
+    if (strcmp(scene, built) != 0)
+        return j_fail(src, "scene", "%s; the build %s is of %s", scene, m->file, built);
     if (strcmp(platform, "vulkan") != 0)
         return j_fail(src, "platform", "%s; this engine draws the vulkan platform's frame", platform);
     double sz[2], color[4], depth;

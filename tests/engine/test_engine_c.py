@@ -272,6 +272,8 @@ BAD = {
         lambda b, x: _json_edit(b / "manifest.json", lambda m: _perm(m, "bench")["interface"]["frag"]
                                 ["uniform_blocks"][2].update(name="Environment")),
         "uniform block 'Environment'"),
+    "another scene's export": (lambda b, x: _json_edit(x / "frame.json", lambda d: d.update(scene="elsewhere")),
+                               "scene: elsewhere; the build"),
     "an object the manifest lacks": (
         lambda b, x: _json_edit(x / "frame.json", lambda d: d["objects"][0].update(name="sofa")),
         "object sofa; the manifest's object 0 is bench"),
