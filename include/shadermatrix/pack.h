@@ -392,7 +392,8 @@ static smpack_status smpack_i_meta(smpack *pack, const unsigned char *m, size_t 
         while (depth && j.i < n && m[j.i] == close[depth - 1]) j.i++, depth--;
         if (!depth && j.i != n) { smpack_i_bad(&j, "bytes after the object"); break; }
         if (!depth && !format_ok)
-            return smpack_i_fail(pack, SMPACK_ERR_META, "the metadata is not a shader pack's (no \"format\":\"smpack\")");
+            return smpack_i_fail(pack, SMPACK_ERR_META, "the metadata (%llu bytes at byte %d) is not a shader pack's: no "
+                                 "\"format\":\"smpack\"", (unsigned long long)n, SMPACK_HEADER_SIZE);
         if (!depth) return SMPACK_OK;
         if (j.i >= n || m[j.i++] != ',') { smpack_i_bad(&j, "no ',' or close after a value"); break; }
         want_key = close[depth - 1] == '}';

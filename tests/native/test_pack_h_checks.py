@@ -7,6 +7,7 @@ from __future__ import annotations
 import hashlib
 import json
 import random
+import re
 import struct
 import subprocess
 
@@ -30,14 +31,16 @@ def small_pack() -> bytes:
 
 
 def agree(pack_check, env, tmp_path, cases: dict[str, bytes], expect: dict[str, str] | None = None) -> dict:
-    """Both readers' verdicts on every case must agree (and equal `expect`'s where given); {name: status}."""
+    """Both readers' verdicts on every case must agree (and equal `expect`'s where given), and every refusal
+    of the C reader must name a byte or an entry; {name: status}."""
     names = list(cases)
     c = c_verdicts(pack_check, [cases[n] for n in names], env)
     wrong = []
     for name, (c_status, c_message) in zip(names, c):
         py_status, py_message = python_verdict(cases[name], tmp_path / "case.smpack")
         want = (expect or {}).get(name, py_status)
-        if not c_status == py_status == want or (c_status == "SMPACK_OK") != (c_message == ""):
+        where = c_status == "SMPACK_OK" or re.search(r"\d+ bytes?|\bbytes? \d+|\bentry \d+", c_message)
+        if not c_status == py_status == want or (c_status == "SMPACK_OK") != (c_message == "") or not where:
             wrong.append(f"{name}: C {c_status} ({c_message}) · Python {py_status} ({py_message}) · expected {want}")
     assert not wrong, "\n".join(wrong)
     return {n: s for n, (s, _) in zip(names, c)}
@@ -110,15 +113,20 @@ def test_every_corruption_of_the_pack_tests_is_refused_alike(pack_check, sanitiz
     assert "SMPACK_OK" not in got.values()
 
 
-def test_a_pack_cut_at_any_byte_is_refused_alike(pack_check, sanitizer_env, tmp_path, example_packs):
+def test_a_pack_cut_at_any_byte_or_boundary_is_refused_alike(pack_check, sanitizer_env, tmp_path, example_packs):
+    """The format-only pack cut at every byte; the real vulkan pack at every field's boundary (header, metadata,
+    each index entry's fields, each blob), a byte either side."""
     small, real = small_pack(), example_packs[0].read_bytes()
     lay = layout(real)
-    blob_ends = {o + n for _, _, _, _, o, n in (ENTRY.unpack_from(real, lay["index_at"] + 104 * i)
-                                                for i in range(lay["count"]))}
+    bounds = [*range(9), 12, 16, 48, 52, 56, 56 + lay["meta_len"], lay["index_at"]]
+    for i in range(lay["count"]):
+        at = lay["index_at"] + 104 * i
+        _, _, _, _, offset, length = ENTRY.unpack_from(real, at)
+        bounds += [at + f for f in (0, 16, 24, 56, 88, 96)] + [offset, offset + length]
     cuts = {f"format pack cut at {n}": small[:n] for n in range(len(small))}
-    cuts |= {f"vulkan pack cut at {n}": real[:n] for n in [*range(lay["blobs_at"] + 105),
-                                                           *(e + d for e in blob_ends for d in (-1, 1)
-                                                             if e + d < len(real))]}
+    cuts |= {f"vulkan pack cut at {n}": real[:n] for n in sorted({b + d for b in bounds for d in (-1, 0, 1)})
+             if 0 <= n < len(real)}
+    assert len(cuts) > len(small) + 200
     got = agree(pack_check, sanitizer_env, tmp_path, cuts)
     assert "SMPACK_OK" not in got.values()
 

@@ -126,3 +126,13 @@ def test_the_reference_pages_example_compiles(tmp_path):
         src.write_text(example)
         compile_c([compiler(cc), std, *STRICT, f"-I{INCLUDE}", "-c", str(src), "-o", str(tmp_path / "example.o")],
                   f"the example of docs/reference/pack-h.md does not compile with {cc}")
+
+
+def test_a_missing_compiler_skips_and_fails_under_ci(monkeypatch):
+    monkeypatch.setenv("PATH", "/nonexistent")
+    monkeypatch.setenv("CI", "true")
+    with pytest.raises(pytest.fail.Exception, match="gcc not found .*CI=true"):
+        compiler("gcc")
+    monkeypatch.setenv("CI", "")
+    with pytest.raises(pytest.skip.Exception, match="gcc not found"):
+        compiler("gcc")
