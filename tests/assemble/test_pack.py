@@ -296,3 +296,14 @@ def test_only_ok_entries_are_packed_and_a_damaged_tree_is_refused(tmp_path):
     (tmp_path / "glsl" / "aaaaaaaaaaaa.spv").write_bytes(SPV[2])
     with pytest.raises(PackError, match=r"aaaaaaaaaaaa\.spv: its sha256 is not the manifest's"):
         write_packs(tmp_path, manifest)
+
+
+@pytest.mark.parametrize("text,why", [(b" 12 ", "not canonical JSON"), (b"1.00", "not JSON"), (b"[[[]", "not JSON")])
+def test_metadata_not_exactly_as_the_encoder_writes_it_is_refused(tmp_path, text, why):
+    """The key is hashed over the metadata's bytes as they are by the C reader (include/shadermatrix/pack.h),
+    which cannot re-encode JSON: both readers take only the canonical form (no spaces, no floats)."""
+    from generator.assemble.pack import PackError, encode_pack, read_pack
+    data, _ = encode_pack(META, _entries())
+    assert data.count(b":null,") == 1  # META's "platform", the same length as each replacement
+    with pytest.raises(PackError, match=f"the metadata is {why}"):
+        read_pack(_write(tmp_path, data.replace(b":null,", b":" + text + b",")))
