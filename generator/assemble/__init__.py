@@ -54,6 +54,8 @@ class BuildResult:
     costs: dict = field(default_factory=dict)  # SPIR-V sha256 -> cost dict: each module analysed once per build
     templates: set = field(default_factory=set)  # the templates this build composed with, by name
     platforms: tuple = PLATFORMS  # what this build writes (assemble/platforms.py)
+    explain: object = None  # why it rebuilt what it did (inputs.Rebuild: .explained()); None on a no-op
+    shaders: dict = field(default_factory=dict)  # job key -> (cache key, compile seconds or None): what each cost
     _manifest: dict | None = None
 
     @property
@@ -136,6 +138,7 @@ class _Build:
         self.old: dict[str, dict] = {}  # the previous manifest's entries by hash
         self.built: dict[str, dict] = {}
         self.uber_kept = False
+        self.kept: set[str] = set()
 
     def run(self) -> BuildResult:
         scene, out, res, keys = self.scene, self.out, self.res, self.keys
@@ -151,6 +154,7 @@ class _Build:
         uber_kept = (old_uber.get("input_key") == keys.ubershader and old_uber.get("status") == "ok"
                      and state.intact(out, old_uber))
         self.uber_kept = uber_kept  # the record keeps the last build's templates for it (it is not composed)
+        self.kept = set(kept)  # what the explanation of this build leaves out (inputs.py)
         uber_unit = None if uber_kept else _compose_ubershader(scene, self.ctx.library, self.ctx.languages)
         extra = []
         if isinstance(uber_unit, tuple):
@@ -159,6 +163,7 @@ class _Build:
         todo = {h: p for h, p in scene.permutations.items() if h not in kept}
         compiled = compile_permutations(self.ctx, todo, extra, self._written, res.compile, res.costs)
         res.templates.update(compiled.templates)
+        res.shaders = {k: (r.cache_key, r.seconds) for k, r in compiled.results.items()}
         res.kept = len(kept)
         entries = []
         for h in sorted(scene.permutations):
@@ -248,6 +253,8 @@ class _Build:
         collect_packs(out, res.manifest)
         collect_tables(out, res.manifest)
         collect_textures(out, res.manifest)
+        from .inputs import record as record_inputs  # what the keys were made of: the next build's --explain
+        res.explain = record_inputs(self)
         state.record(out, res.manifest, text, self.keys, res.kept + self.uber_kept,  # units kept, not composed
                      res.templates)  # last: the no-op check trusts it
 

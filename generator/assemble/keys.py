@@ -4,12 +4,16 @@ A permutation's key covers its key text, the source of every brick it reads, the
 that use it, the generator's own sources and templates, the tools' versions, the languages and platforms; the
 ubershader's the same without the scene values (it reads none); the scene's what the manifest's scene-wide
 tables hold beyond the permutations.
+
+A key is a digest: it says that an input changed, not which. What it was made of is kept too (Keys.bricks,
+build_inputs) for the build's record of its inputs (inputs.py), which the next build diffs to say why it
+rebuilt what it did.
 """
 from __future__ import annotations
 
 import functools
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..io import content_key
@@ -28,22 +32,34 @@ class Keys:
     permutations: dict[str, str]  # hash -> input key
     ubershader: str
     scene: str
+    # hash -> {brick display path: its source's sha256} of every brick it reads ({"error": why} when it does not
+    # resolve): what its key holds of the bricks
+    bricks: dict[str, dict[str, str]] = field(default_factory=dict, compare=False)
 
 
 @functools.lru_cache(maxsize=1)
+def source_files() -> dict[str, str]:
+    """{relative path: sha256} of the generator's own code and templates (the built-in bricks aside: they are
+    keyed per permutation, by the permutations that read them)."""
+    return {str(p.relative_to(_PACKAGE.parent)): hashlib.sha256(p.read_bytes()).hexdigest()
+            for p in sorted(_PACKAGE.rglob("*"))
+            if p.is_file() and p.suffix in (".py", ".j2", ".toml") and BUILTIN_BRICKS not in p.parents}
+
+
 def own_sources() -> str:
-    """sha256 of the generator's own code and templates (relative path and bytes of every file)."""
-    h = hashlib.sha256()
-    for p in sorted(_PACKAGE.rglob("*")):
-        # the built-in bricks (package data inside generator/ when installed) are keyed per permutation
-        if p.is_file() and p.suffix in (".py", ".j2", ".toml") and BUILTIN_BRICKS not in p.parents:
-            h.update(str(p.relative_to(_PACKAGE.parent)).encode() + b"\0" + p.read_bytes() + b"\0")
-    return h.hexdigest()
+    """sha256 of the generator's own code and templates (every file's relative path and sha256)."""
+    return content_key("sources-v1", sorted(source_files().items()))
+
+
+def build_inputs(version: str, tools: dict, languages, platforms) -> dict:
+    """What every output of a build depends on, item by item: this generator (its version, each of its own source
+    and template files), the tools' versions, the languages, the platforms and their tools' versions."""
+    return {"generator": version, "sources": source_files(), "tools": dict(tools), "languages": list(languages),
+            "platforms": list(platforms), "platform_tools": all_tools(platforms)}
 
 
 def build_key(version: str, tools: dict, languages, platforms) -> str:
-    """What every output of a build depends on: this generator (its version and its own sources), the tools'
-    versions, the languages and platforms. The version and tools are those the manifest records."""
+    """build_inputs as one digest (the version and tools: those the manifest records)."""
     return content_key("build-v1", version, own_sources(), tools, list(languages), list(platforms),
                        all_tools(platforms))
 
@@ -53,20 +69,20 @@ def scene_keys(base: str, scene: Scene, lib: Library, keep_removed: bool, pack: 
     users: dict[str, list[dict]] = {}
     for o in scene.objects:
         users.setdefault(o["permutation"], []).append(o)
-    keys, shapes = {}, {}
+    keys, shapes, bricks = {}, {}, {}
     for h, perm in sorted(scene.permutations.items()):
-        keys[h], shapes[h] = _perm_key(base, scene, lib, perm, users.get(h, []))
+        keys[h], shapes[h], bricks[h] = _perm_key(base, scene, lib, perm, users.get(h, []))
     uber = content_key(base, "ubershader", [shapes[h] for h in sorted(shapes)])
     tables = content_key(base, scene.name, sorted((k, list(v)) for k, v in scene.light_sets.items()),
                          [[o["name"], o["material"], o["light_set"], o["permutation"]] for o in scene.objects],
                          sorted(repr(m) for m in scene.materials.values()),
                          sorted(repr(x) for x in scene.lights.values()), keep_removed, *(["pack"] if pack else []))
-    return Keys(keys, uber, tables)
+    return Keys(keys, uber, tables, bricks)
 
 
-def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> tuple[str, str]:
-    """(Everything a permutation's outputs depend on, the same without the scene values); objs: the objects
-    drawn with it."""
+def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> tuple[str, str, dict]:
+    """(Everything a permutation's outputs depend on, the same without the scene values, the bricks it reads with
+    their sources' sha256); objs: the objects drawn with it."""
     try:
         bricks = _bricks_of(resolve(perm, lib))
     except (SourceError, SpecError) as e:  # it will fail to compose too: key it by the error
@@ -76,7 +92,7 @@ def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> 
     values = {"objects": [[o["name"], o["material"], o["light_set"], list(o["lights"])] for o in objs],
               "materials": [repr(scene.materials[m]) for m in mats], "lights": [repr(scene.lights[ln]) for ln in lights]}
     shape = content_key(base, perm.canonical(), sorted(bricks.items()))
-    return content_key(shape, values), shape
+    return content_key(shape, values), shape, bricks
 
 
 def _bricks_of(r: Resolved) -> dict[str, str]:

@@ -87,7 +87,7 @@ class Store:
     sha256 (32 bytes). Entries are written atomically (a temporary name, then a rename) and verified on
     every read: a short or damaged entry is counted as corrupt, removed and reported as a miss, so it is
     rebuilt, never served. Safe to share between threads and between concurrent processes (a rename
-    replaces an entry whole; two writers of one key write the same bytes).
+    replaces an entry whole; two writers of one key write the same result, their times aside).
     """
 
     def __init__(self, root):

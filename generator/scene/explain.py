@@ -14,6 +14,12 @@ precision. Four counts:
 4. merged — used permutations whose optimized SPIR-V is identical in every
    language and stage are one shader (needs a build; its cache makes it cheap).
 
+What each axis value costs: the permutations it adds (the used permutations that carry it: each carries one
+value per axis, so the scene has these only because of it) and, from a build through the compile cache, the
+compile time of the shaders only those permutations use (what dropping the value would save: a shader shared
+with other permutations is compiled for them anyway), summed from the times the cache records per shader
+(toolchain/cache.py). A record stored before times were kept has none: the report counts those shaders.
+
 The constraints are data (spec/constraints.py): one Constraint per rule, each a
 predicate over a permutation's resolved bricks with the message and the fix it
 gives (Filament's variant filters, Unity's stripping log made readable);
@@ -67,9 +73,11 @@ def _lights_text(config) -> str:
     return ",".join(f"{t}/{s}" for t, s in config) or "-"
 
 
-def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) -> dict:
+def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None,
+           shaders: dict[str, dict[str, float | None]] | None = None) -> dict:
     """The pruning report as data. spirv: {permutation hash: identity of its optimized SPIR-V (every language
-    and stage)} from a build, or None to leave the merged stage out."""
+    and stage)} from a build, or None to leave the merged stage out. shaders: {permutation hash: {cache key:
+    recorded compile seconds or None}} of every shader of it, from the same build, or None: no compile costs."""
     from ..spec.permutation import LightKey
 
     ax = axes(scene)
@@ -138,15 +146,59 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None) ->
             else:
                 why = f"dropped: material(s) {_names(mats)} are drawn by no object"
             text = _lights_text(v) if axis == "lights" else _surface_text(v) if axis == "surface" else v
-            values.append({"axis": axis, "value": text,
-                           "kept": bool(objs), "why": why, "declared_by": mats, "permutations": hs})
+            values.append({"axis": axis, "value": text, "kept": bool(objs), "why": why, "declared_by": mats,
+                           "permutations": hs, "adds": len(hs), **_cost(hs, shaders)})
     invalid = [{"brdf": b, "packing": p, "why": [f"{n}: {w}" for n, w in pairs[(b, p)]]}
                for (b, p) in pairs if pairs[(b, p)]]
     perms = [{"hash": h, "key": p.canonical(), "materials": materials_of.get(h, []), "objects": scene.users.get(h, []),
               **({"merged_into": merged_into[h]} if h in merged_into and merged_into[h] != h else {})}
              for h, p in scene.permutations.items()]
     return {"scene": scene.name, "stages": stages, "axes": values, "invalid": invalid, "permutations": perms,
-            "constraints": [{"name": c.name, "doc": c.doc} for c in CONSTRAINTS], "notes": list(scene.notes)}
+            "constraints": [{"name": c.name, "doc": c.doc} for c in CONSTRAINTS], "notes": list(scene.notes),
+            "compile_records": _records(shaders)}
+
+
+def _cost(hs: list[str], shaders: dict | None) -> dict:
+    """The compile seconds of the shaders only permutations `hs` use (by cache key: one compile serves every job
+    of a key), and how many of those have no recorded time; {} without a build's shaders."""
+    if shaders is None:
+        return {}
+    mine = set(hs)
+    users: dict[str, set] = {}
+    for h, keys in shaders.items():
+        for k in keys:
+            users.setdefault(k, set()).add(h)
+    own = {k: t for h in hs for k, t in shaders.get(h, {}).items() if users[k] <= mine}
+    return {"compile_seconds": round(sum(t for t in own.values() if t is not None), 3), "shaders": len(own),
+            "untimed": sum(1 for t in own.values() if t is None)}
+
+
+def _records(shaders: dict | None) -> dict | None:
+    """The compile-time records the costs come from: distinct shaders, those with a time, their sum."""
+    if shaders is None:
+        return None
+    times = {k: t for keys in shaders.values() for k, t in keys.items()}
+    known = [t for t in times.values() if t is not None]
+    return {"shaders": len(times), "timed": len(known), "seconds": round(sum(known), 3)}
+
+def _costs_note(records: dict | None) -> str:
+    head = ("adds: the used permutations that carry the value (the scene has them only because of it); compile s: "
+            "the recorded compile time of the shaders only those permutations use (what dropping the value saves)")
+    if records is None:
+        return head + " — not known without a build (--no-compile): the times come from the compile cache's records."
+    missing = records["shaders"] - records["timed"]
+    return (head + f" — from the compile cache's records of {records['timed']:,} of {records['shaders']:,} distinct "
+            f"shaders ({records['seconds']:.2f} s in all)"
+            + (f"; {missing:,} have no recorded time (cached before times were recorded: `shadermatrix cache clear` "
+               "and build again to time them)" if missing else "") + ".")
+
+
+def _seconds(v: dict) -> str:
+    if "compile_seconds" not in v:
+        return "—"
+    if v["shaders"] and v["untimed"] == v["shaders"]:
+        return "?"
+    return f"{v['compile_seconds']:.2f}" + ("+?" if v["untimed"] else "")
 
 
 def _names(xs, limit: int = 6) -> str:
@@ -159,8 +211,10 @@ def markdown(rep: dict, explain: bool) -> str:
     out += [f"| {s['stage']} | {s['count']:,} | {s['of']} |" for s in rep["stages"]]
     if not explain:
         return "\n".join(out) + "\n"
-    out += ["", "## Axis values", "", "| axis | value | kept | why |", "|---|---|---|---|"]
-    out += [f"| {v['axis']} | `{v['value']}` | {'yes' if v['kept'] else 'no'} | {v['why']} |" for v in rep["axes"]]
+    out += ["", "## Axis values", "", _costs_note(rep.get("compile_records")), "",
+            "| axis | value | kept | adds | compile s | why |", "|---|---|---|---:|---:|---|"]
+    out += [f"| {v['axis']} | `{v['value']}` | {'yes' if v['kept'] else 'no'} | {v['adds']:,} | {_seconds(v)} | "
+            f"{v['why']} |" for v in rep["axes"]]
     out += ["", "## Combinations the constraints forbid", ""]
     out += ([f"- `{x['brdf']}` with `{x['packing']}`: {'; '.join(x['why'])}" for x in rep["invalid"]]
             or ["None: every BRDF × packing pair of the scene is valid."])

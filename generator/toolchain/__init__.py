@@ -43,11 +43,12 @@ from __future__ import annotations
 
 import os
 import tempfile
+import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from typing import Iterable
 
-from .cache import COMPILE_NAMESPACE, cache_key, decode, encode, renamed
+from .cache import COMPILE_NAMESPACE, apportion, cache_key, decode, encode, renamed
 from .frontends import DRIVERS, check, front_end
 from .locate import TOOLS_ENV, pinned_versions, tool_dirs
 from .model import SPIRV_MAGIC, SPIRV_VERSION, STAGES, TARGET_ENV, CompileJob, CompileResult, Diagnostic
@@ -78,8 +79,10 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
 
     Jobs with the same :func:`cache_key` are compiled once (identical shaders, e.g. vertex shaders whose
     sources differ only in their provenance header). store: an io.Store; a job whose key is there is
-    served from it (no tool runs) and every successful compile is put there. Failures are not stored
-    (their diagnostics name each job's own lines), and a job whose twin failed is compiled on its own.
+    served from it (no tool runs) and every successful compile is put there, with its compile time (cache.py:
+    a batch's time apportioned over its shaders; CompileResult.seconds, the stored time when served from
+    there). Failures are not stored (their diagnostics name each job's own lines), and a job whose twin failed
+    is compiled on its own.
     memo: a dict (cache key -> result) shared by several calls of one build: a shader another call
     compiled is not compiled again (and not counted distinct again).
     stats: a CompileStats to fill in. workers: how many tool processes run at once (default: the core
@@ -152,7 +155,20 @@ def compile_many(jobs: Iterable[CompileJob], *, optimize: bool = True, validate:
     if again:  # a failed shader's twins: each reports its own lines
         stats.compiled += len(again)
         results.update(run(again))
+    for job in jobs:
+        results[job.key].cache_key = keys[job.key]
     return {job.key: results[job.key] for job in jobs}
+
+
+def _timed(step, *args, front_s: float | None = None):
+    """(wall seconds, step(*args)); with front_s (a shader's share of its front end), the result is a
+    CompileResult and its seconds are set to that share plus this step's own time."""
+    started = time.perf_counter()
+    value = step(*args)
+    seconds = time.perf_counter() - started
+    if front_s is not None:
+        value.seconds = front_s + seconds
+    return seconds, value
 
 
 def compile_all(jobs: list[CompileJob], optimize: bool, validate: bool, progress: bool,
@@ -180,19 +196,21 @@ def compile_all(jobs: list[CompileJob], optimize: bool, validate: bool, progress
     with tempfile.TemporaryDirectory(prefix=f"shadermatrix-{os.getpid()}-") as tmp, \
             ThreadPoolExecutor(max_workers=workers) as pool, \
             tqdm(total=len(jobs), disable=not progress, unit="shader", leave=False) as bar:
-        front = [pool.submit(DRIVERS[name].batch, tools[name], tmp, part, gate)
+        front = [pool.submit(_timed, DRIVERS[name].batch, tools[name], tmp, part, gate)
                  for name in used for part in DRIVERS[name].parts(by_driver[name], workers)]
         back = []
         for fut in as_completed(front):
-            for job, spv, diags in fut.result():
+            seconds, done = fut.result()
+            share = apportion(seconds, [job for job, _, _ in done])  # the batch's time, over its shaders
+            for job, spv, diags in done:
                 if spv is None:
-                    results[job.key] = CompileResult(job.key, False, None, None, diags)
+                    results[job.key] = CompileResult(job.key, False, None, None, diags, share[job.key])
                     bar.update()
                 else:
-                    back.append(pool.submit(spirv_steps, tools, tmp, index[job.key], job, spv,
-                                            diags, optimize, validate, gate))
+                    back.append(pool.submit(_timed, spirv_steps, tools, tmp, index[job.key], job, spv,
+                                            diags, optimize, validate, gate, front_s=share[job.key]))
         for fut in as_completed(back):
-            res = fut.result()
+            seconds, res = fut.result()
             results[res.key] = res
             bar.update()
     return {job.key: results[job.key] for job in jobs}

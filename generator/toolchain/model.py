@@ -2,7 +2,7 @@
 tool is held to."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 TARGET_ENV = "vulkan1.1"      # every tool gets this target environment
 SPIRV_VERSION = "1.3"         # what glslc emits for vulkan1.1; naga is told the same
@@ -47,6 +47,11 @@ class CompileResult:
     spirv: bytes | None        # validated SPIR-V (optimized when optimize=True); None unless ok
     spirv_unopt: bytes | None  # front-end output, kept whenever the front end produced one
     diagnostics: list[Diagnostic]
+    # the tools' seconds for this shader (cache.apportion: its share of its front-end batch and its own SPIR-V
+    # steps), as the store recorded them when it was served from there; None when not known (an entry stored
+    # before times were recorded). Not compared: two compiles of one shader are the same result.
+    seconds: float | None = field(default=None, compare=False)
+    cache_key: str | None = field(default=None, compare=False)  # compile_many's: the jobs one compile served
 
     def errors(self) -> list[str]:
         """The error diagnostics as text; never empty for a failed job."""

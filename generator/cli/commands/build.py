@@ -41,6 +41,10 @@ def add_arguments(p) -> None:
                         "\"packs\"")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
+    p.add_argument("--explain", action="store_true",
+                   help="say why: each permutation rebuilt and the input that changed (a brick, template or source "
+                        "file with its old and new sha256, a tool version, a scene value), and how many permutations "
+                        "each changed input reached (with --json: the summary's \"explain\")")
     p.add_argument("--json", action="store_true",
                    help="print the summary as one JSON object on stdout (counts, seconds, failures) instead of text")
     p.add_argument("--validate-ir", action="store_true",
@@ -66,6 +70,15 @@ def summary(scene, res, out, seconds: float, pack: bool = False) -> dict:
             "spirv_shared": res.aliased, "seconds": round(seconds, 3), "ok": res.ok,
             "failures": list(res.failures),
             **({"packs": [p["path"] for p in res.manifest.get("packs", [])]} if pack else {})}
+
+
+def _explained(scene, res):
+    """Why the build rebuilt what it did (assemble/inputs.py); a no-op rebuilt nothing."""
+    from ...assemble.inputs import Explained
+    if res.explain is None:
+        ids = {h: p.canonical() for h, p in scene.permutations.items()}
+        return Explained(len(ids), False, ids, {}, None)
+    return res.explain.explained()
 
 
 def _interrupter(gate):
@@ -135,11 +148,15 @@ def run(args) -> int:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
     seconds = time.perf_counter() - started
+    why = _explained(scene, res) if args.explain else None
     if args.json:
-        print(json.dumps(summary(scene, res, args.out, seconds, args.pack), indent=2))
+        print(json.dumps({**summary(scene, res, args.out, seconds, args.pack),
+                          **({"explain": why.as_dict()} if why is not None else {})}, indent=2))
         for f in res.failures:
             print(f"error: {f}", file=sys.stderr)
         return 0 if res.ok else 1
+    for line in why.lines() if why is not None else []:
+        print(line)
     if res.up_to_date:
         print(f"{scene.name}: {len(scene.permutations)} permutations up to date: 0 composed, 0 compiled; "
               f"0 files written, {res.unchanged} unchanged → {args.out}/manifest.json ({seconds:.2f} s)")

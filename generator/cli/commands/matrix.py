@@ -5,7 +5,8 @@ configurations, output, precision), those the bricks' constraints allow, those
 the objects draw, and — after a build through the compile cache — those left
 when permutations with identical optimized SPIR-V merge. With --explain: every
 axis value kept or dropped and why, the combinations the constraints forbid and
-why, and the objects of every permutation.
+why, and the objects of every permutation; and what each value costs: the permutations it adds and the compile
+time of their own shaders, from the times the compile cache records (scene/explain.py).
 """
 from __future__ import annotations
 
@@ -20,8 +21,8 @@ HELP = "how a scene's matrix is pruned: full product, valid, used, merged; --exp
 def add_arguments(p) -> None:
     p.add_argument("scene", help="scene file (TOML, or glTF 2.0 .gltf/.glb)")
     p.add_argument("--explain", action="store_true",
-                   help="every axis value kept or dropped and why, the forbidden combinations, each permutation's "
-                        "objects")
+                   help="every axis value kept or dropped and why, the permutations it adds and their shaders' "
+                        "recorded compile time, the forbidden combinations, each permutation's objects")
     p.add_argument("--format", choices=("md", "json"), default="md", help="report format (default md)")
     p.add_argument("--no-compile", action="store_true",
                    help="leave out the merged count (it builds the scene, through the compile cache)")
@@ -31,9 +32,10 @@ def add_arguments(p) -> None:
                    help="an extra brick directory (repeatable)")
 
 
-def spirv_identities(scene, lib, cache_dir, no_cache: bool = False) -> tuple[dict[str, tuple], list[str]]:
-    """({permutation hash: its SPIR-V (sha256 per language and stage)}, the build's failures), from a build into a
-    temporary directory through the compile cache."""
+def spirv_identities(scene, lib, cache_dir, no_cache: bool = False) -> tuple[dict[str, tuple], list[str], dict]:
+    """({permutation hash: its SPIR-V (sha256 per language and stage)}, the build's failures, {permutation hash:
+    {cache key: recorded compile seconds or None}}), from a build into a temporary directory through the compile
+    cache."""
     from ...assemble import BuildContext, build
     from ...assemble.checks import default_store
     from ...io import show_progress
@@ -43,7 +45,12 @@ def spirv_identities(scene, lib, cache_dir, no_cache: bool = False) -> tuple[dic
         ids = {p["hash"]: tuple(sorted((lang, stage, item.get("spirv_sha256") or item["spirv"])
                                        for lang, stages in p["languages"].items() for stage, item in stages.items()))
                for p in res.manifest["permutations"] if p.get("status") == "ok"}
-        return ids, list(res.failures)
+        shaders: dict[str, dict] = {}
+        for job, (key, seconds) in res.shaders.items():
+            unit = job.split(".", 1)[0]  # toolchain/jobs.py: <unit>.<stage>.<language>
+            if unit in scene.permutations and key is not None:
+                shaders.setdefault(unit, {})[key] = seconds
+        return ids, list(res.failures), shaders
 
 
 def run(args) -> int:
@@ -53,8 +60,9 @@ def run(args) -> int:
 
     lib = load_library(args.bricks)
     scene = load_scene(args.scene, lib)
-    spirv, failures = (None, []) if args.no_compile else spirv_identities(scene, lib, args.cache_dir, args.no_cache)
-    rep = report(scene, lib, spirv)
+    spirv, failures, shaders = (None, [], None) if args.no_compile else \
+        spirv_identities(scene, lib, args.cache_dir, args.no_cache)
+    rep = report(scene, lib, spirv, shaders)
     sys.stdout.write(markdown(rep, args.explain) if args.format == "md" else json.dumps(rep, indent=1) + "\n")
     for f in failures:  # a permutation that does not compile is not merged with anything: say so, exit 1
         print(f"error: {f}", file=sys.stderr)
