@@ -116,7 +116,7 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None,
                        "of": "used permutations with identical optimized SPIR-V in every language and stage "
                              "are one shader"})
 
-    values = []
+    values, users = [], _users(shaders)
     for axis, vals in ax.items():
         for v in vals:
             if axis == "brdf":
@@ -147,7 +147,7 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None,
                 why = f"dropped: material(s) {_names(mats)} are drawn by no object"
             text = _lights_text(v) if axis == "lights" else _surface_text(v) if axis == "surface" else v
             values.append({"axis": axis, "value": text, "kept": bool(objs), "why": why, "declared_by": mats,
-                           "permutations": hs, "adds": len(hs), **_cost(hs, shaders)})
+                           "permutations": hs, "adds": len(hs), **_cost(hs, shaders, users)})
     invalid = [{"brdf": b, "packing": p, "why": [f"{n}: {w}" for n, w in pairs[(b, p)]]}
                for (b, p) in pairs if pairs[(b, p)]]
     perms = [{"hash": h, "key": p.canonical(), "materials": materials_of.get(h, []), "objects": scene.users.get(h, []),
@@ -158,16 +158,21 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None,
             "compile_records": _records(shaders)}
 
 
-def _cost(hs: list[str], shaders: dict | None) -> dict:
+def _users(shaders: dict | None) -> dict[str, set]:
+    """{cache key: the permutations whose shaders have it}."""
+    users: dict[str, set] = {}
+    for h, keys in (shaders or {}).items():
+        for k in keys:
+            users.setdefault(k, set()).add(h)
+    return users
+
+
+def _cost(hs: list[str], shaders: dict | None, users: dict[str, set]) -> dict:
     """The compile seconds of the shaders only permutations `hs` use (by cache key: one compile serves every job
     of a key), and how many of those have no recorded time; {} without a build's shaders."""
     if shaders is None:
         return {}
     mine = set(hs)
-    users: dict[str, set] = {}
-    for h, keys in shaders.items():
-        for k in keys:
-            users.setdefault(k, set()).add(h)
     own = {k: t for h in hs for k, t in shaders.get(h, {}).items() if users[k] <= mine}
     return {"compile_seconds": round(sum(t for t in own.values() if t is not None), 3), "shaders": len(own),
             "untimed": sum(1 for t in own.values() if t is None)}

@@ -153,6 +153,20 @@ def test_a_changed_tool_version_is_named(tree, monkeypatch):
     assert why.lines()[-1] == "  tool spirv-tools changed → 3 of 3 permutations and the ubershader"
 
 
+def test_a_changed_template_is_named_with_its_hashes(tree, monkeypatch):
+    import generator.assemble.keys as keys
+    root, cache = tree
+    real = keys.source_files()
+    template = "generator/backends/glsl/templates/fragment.glsl.j2"
+    assert template in real  # as if it had been edited: the build keys it by its sha256
+    monkeypatch.setattr(keys, "source_files", lambda: {**real, template: "0" * 64})
+    _, res = _build(root, cache)
+    why = res.explain.explained()
+    change = f"{template} changed (sha256 {real[template][:12]} → sha256 000000000000)"
+    assert len(why.rebuilt) == 3 and all([str(c) for c in cs] == [change] for cs in why.rebuilt.values())
+    assert why.lines()[-1] == f"  {template} changed → 3 of 3 permutations and the ubershader"
+
+
 def test_a_damaged_output_and_a_no_op_say_so_on_the_command_line(tree):
     root, cache = tree
     m = json.loads((root / "out" / "manifest.json").read_text())
