@@ -87,15 +87,14 @@ static bool material_texture(engine *e, const draw_item *it, const texture_ref *
                 it->pipe->prog->name, t->name, o->material);
 }
 
-/* The blur pass k reads the previous image: the moments target, then the last pass's. The manifest names no
- * sampler row for it (the blur unit's reflection has no sampler_state): the row the light's map is read with
- * (bilinear, level 0, clamped) stands in, which at the texel centres the blur reads is exact. */
+/* The blur pass k reads the previous image: the moments target, then the last pass's, through the sampler row
+ * the light's depth_pass.moments.blur names (bilinear, level 0, clamped: the passes read texel centres). */
 static bool blur_texture(engine *e, const draw_item *it, VkImageView *view, int *row)
 {
     const light_pass *lp = &e->passes[it->pass];
     *view = lp->targets[it->blur].view;
-    const cJSON *b = cJSON_GetArrayItem(j_opt(lp->desc, "binds"), 0);
-    return j_int(&e->m->src, b, "sampler_state", "depth_pass.binds[0]", 0, 1 << 20, row);
+    const cJSON *blur = j_opt(j_opt(lp->desc, "moments"), "blur");
+    return j_int(&e->m->src, blur, "sampler_state", "depth_pass.moments.blur", 0, 1 << 20, row);
 }
 
 /* ------------------------------------------------------------------ descriptor sets */

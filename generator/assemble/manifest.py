@@ -20,7 +20,7 @@ import os
 from importlib import resources
 
 from ..lang.errors import UserError
-from ..runtime.pipeline_state import object_block, output_state, render_state  # noqa: F401 (the build's)
+from ..runtime.pipeline_state import frame_block, object_block, output_state, render_state  # noqa: F401 (the build's)
 
 FORMAT_VERSION = 1
 SCHEMA_FILE = "manifest.schema.json"
@@ -45,7 +45,7 @@ def conventions(platforms) -> dict:
     written its clip space, front face, cull modes, attachment formats and the Object block's binding, in its
     API's words (each platform class's declarations: assemble/platform_base.py conventions_section)."""
     from .platforms import PLATFORM_TABLE
-    return {"object_block": object_block(), "platforms": {p: PLATFORM_TABLE[p].conventions_section() for p in platforms}}
+    return {"frame_block": frame_block(), "object_block": object_block(), "platforms": {p: PLATFORM_TABLE[p].conventions_section() for p in platforms}}
 
 
 @functools.lru_cache(maxsize=1)

@@ -16,6 +16,7 @@ Shadow maps are the renderer's (or engine's) images, not artifacts: each platfor
 descriptor of a light texture gets ``sampler_state``, the row of ``samplers`` its brick reads with —
 bilinear, level 0, clamped; a ``texture2d_shadow`` (pcf_hardware) a comparison sampler, less-or-equal. Each
 light's ``depth_pass.binds`` row names the same row by ``sampler_state``: the state is described once, here.
+A vsm light's ``depth_pass.moments.blur`` names the row its passes read the moments through, likewise.
 
 Baked tables (assemble/tables.py) are read as their bricks' texel-centre arithmetic assumes: bilinear, level
 0, clamped to the edge. Each row of the manifest's ``tables`` gets ``sampler`` (that state with ``index``, its
@@ -164,6 +165,9 @@ def _light_samplers(manifest: dict, samplers: _Samplers) -> None:
                       if t.get("light") == b.get("light_index") and t.get("name") == b.get("texture")), None)
             if t is not None:
                 b["sampler_state"] = samplers(_light_state(t))
+        blur = (((light or {}).get("depth_pass") or {}).get("moments") or {}).get("blur")
+        if isinstance(blur, dict):  # the blur's passes read the moments as the renderer's blur does
+            blur["sampler_state"] = samplers(SHADOW_SAMPLER)
 
 
 def _light_state(t: dict) -> Sampler:

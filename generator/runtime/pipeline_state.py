@@ -65,6 +65,23 @@ def output_state(brick) -> dict:
     return {"brick": brick.id, "encodes": brick.encodes, "attachment": attachment(brick.encodes)}
 
 
+# The per-view Frame block (link/interface.FRAME_BLOCK), read by both stages: what the engine writes there.
+FRAME_HOLDS = {"view_proj": "world to the platform's clip space (its `conventions.platforms.<p>.clip`); the vertex stage "
+                            "writes view_proj × model × (position, 1). A depth pass writes its light's shadow_matrix "
+                            "premultiplied as its depth_pass.matrix says",
+               "camera_pos": "the camera's world position in xyz, w = 1: the view direction is camera_pos.xyz − the "
+                             "surface's world position (a depth pass: the light's, or the centre of the casters)"}
+
+
+def frame_block() -> dict:
+    """The Frame block as the manifest states it: its name, stages, layout, size and members."""
+    from ..link.interface import FRAME_BLOCK
+    members = [{"name": m["name"], "type": m["type"], "offset": m["offset"], "size": m["size"],
+                "holds": FRAME_HOLDS[m["name"]]} for m in FRAME_BLOCK]
+    return {"name": "Frame", "stages": ["vert", "frag"], "layout": "std140", "matrices": "column_major",
+            "size": max(m["offset"] + m["size"] for m in FRAME_BLOCK), "members": members}
+
+
 def object_block() -> dict:
     """The Object block as the manifest states it: its name, stage, layout, size and members."""
     from ..link.interface import OBJECT_BLOCK
