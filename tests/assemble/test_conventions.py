@@ -37,11 +37,14 @@ def example(tmp_path_factory) -> tuple[Path, dict]:
 @pytest.mark.toolchain
 def test_every_platform_written_states_its_conventions_from_its_class(example):
     from generator.assemble.platforms import PLATFORM_TABLE
-    from generator.runtime.pipeline_state import object_block
+    from generator.link.interface import FRAME_BLOCK
+    from generator.runtime.pipeline_state import frame_block, object_block
     _, m = example
     conv = m["conventions"]
     assert list(conv["platforms"]) == m["platforms"] == list(PLATFORM_TABLE)
-    assert conv["object_block"] == object_block()
+    assert conv["object_block"] == object_block() and conv["frame_block"] == frame_block()
+    assert [(x["name"], x["offset"], x["size"]) for x in conv["frame_block"]["members"]] == \
+        [(x["name"], x["offset"], x["size"]) for x in FRAME_BLOCK]  # what every permutation's Frame declares
     for name, p in PLATFORM_TABLE.items():
         c = conv["platforms"][name]
         assert c == p.conventions_section()
