@@ -8,7 +8,8 @@ fails (brick error, compiler error) is reported and the others still build.
 The stage, in the order a build runs it: context.py (BuildContext: what every step reads), keys.py (the
 input keys), state.py (what the last build left), loop.py (the compile loop: in this process, or in worker
 processes through parallel.py and workers.py), write.py (content-named artifacts), platforms.py,
-reflection.py, tables.py, pack.py, outputs.py (the output tree: lock, leftovers, garbage, depfile).
+reflection.py, tables.py, pack.py, outputs.py (the output tree: lock, leftovers, garbage), depfile.py (the depfile,
+the stamp and the versions file a build system reads).
 """
 from __future__ import annotations
 
@@ -17,7 +18,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..backends import template_file
 from ..lang import SourceError
 from ..library.bricks import Library
 from ..link.uber import coverage
@@ -30,7 +30,7 @@ from .context import BuildContext
 from .keys import build_key, scene_keys
 from .loop import compile_permutations
 from .manifest import FORMAT_VERSION, check as check_manifest, conventions, material_states, output_state, render_state
-from .outputs import clean_leftovers, collect_garbage, locked, shown, write_depfile
+from .outputs import clean_leftovers, collect_garbage, locked
 from .platforms import PLATFORMS
 from .reflection import scene_tables
 from .write import Writer, validate_dialects
@@ -75,12 +75,14 @@ class BuildResult:
 
 
 def build(scene: Scene, out: Path, ctx: BuildContext, depfile=None, keep_removed: bool = False,
-          pack: bool = False) -> BuildResult:
+          pack: bool = False, stamp=None) -> BuildResult:
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     ctx: the library, languages, platforms, compile cache, progress bar, jobs and executor (context.py).
     The store (the content-addressed cache) serves compiled shaders and their costs and takes new ones; jobs and
-    the executor change no byte of the output. depfile: where to write a Make-syntax depfile (or None).
+    the executor change no byte of the output. depfile: where to write a Make-syntax depfile (or None), for the
+    target `stamp` when one is given (else OUT/manifest.json). stamp: a file replaced after every build that
+    succeeds (none when it fails), so that a build system compares the inputs with the build's end (depfile.py).
     keep_removed: the outputs of permutations that
     left the scene stay, listed under the manifest's ``removed`` (marked so), instead of being deleted.
     pack: also write one shader pack per platform (assemble/pack.py), listed under the manifest's ``packs``.
@@ -102,22 +104,18 @@ def build(scene: Scene, out: Path, ctx: BuildContext, depfile=None, keep_removed
     One build at a time per output directory (outputs.locked); an interrupted build's leftovers are
     removed by the next one.
     """
+    from .depfile import VERSIONS, inputs, shown, touch, write_depfile, write_versions
     out = Path(out)
     with locked(out):
         clean_leftovers(out)
+        write_versions(out / VERSIONS)  # before any output: a depfile names it, the stamp comes after it
         res = _Build(scene, out, ctx, keep_removed, pack).run()
-        if depfile is not None:
-            write_depfile(depfile, shown(out / "manifest.json"), _deps(scene, ctx.library, out))
+        if depfile is not None:  # the templates: recorded by this build, and by the last ones for what it kept
+            write_depfile(depfile, str(stamp) if stamp is not None else shown(out / "manifest.json"),
+                          inputs(scene, ctx.library, out, state.read(out).get("templates", [])))
+        if stamp is not None and res.ok:
+            touch(stamp)
     return res
-
-
-def _deps(scene: Scene, lib: Library, out: Path) -> list[str]:
-    """Every file the build read: the scene, the images its materials name, every brick the library loaded,
-    every template composed with (recorded by this build, and by the last ones for what it kept)."""
-    from .texture_outputs import image_files
-    templates = state.read(out).get("templates", [])
-    return [shown(scene.path), *(shown(f) for f in image_files(scene)), *(shown(b.path) for b in lib.bricks.values()),
-            *(shown(template_file(t)) for t in sorted(templates))]
 
 
 class _Build:

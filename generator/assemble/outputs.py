@@ -1,4 +1,4 @@
-"""The output tree as a build system needs it: one build at a time, leftovers removed, depfiles.
+"""The output tree as a build system needs it: one build at a time, leftovers removed, what it no longer names.
 
 - ``locked(out)``: an exclusive ``flock`` on ``out/.shadermatrix-lock`` for the whole build; a second
   build into the same directory says it is waiting (one line on stderr) and runs after the first —
@@ -9,7 +9,8 @@
 - ``collect_garbage(out, manifest)``: artifacts are content-named, so a rebuild never overwrites a file
   the current manifest names; once the new manifest is in place, the files it no longer names
   (superseded versions, permutations that left the scene) are removed.
-- ``write_depfile(path, target, deps)``: Make syntax, which Ninja reads (``deps = gcc``).
+
+The depfile, the stamp and the versions file a build system reads: depfile.py.
 """
 from __future__ import annotations
 
@@ -24,7 +25,6 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..io import atomic_write
 from ..backends import LANGUAGES
 from .platforms import LANGUAGE_TREE, PLATFORM_TABLE
 
@@ -126,22 +126,3 @@ def collect_garbage(out: Path, manifest: dict) -> int:
             except OSError:  # not empty
                 pass
     return gone
-
-
-def _escape(path: str) -> str:
-    return path.replace("\\", "\\\\").replace(" ", "\\ ").replace("#", "\\#").replace("$", "$$")
-
-
-def shown(path) -> str:
-    """A dependency as the build system invoked us sees it: relative to the working directory when inside it."""
-    p = Path(path).resolve()
-    try:
-        return str(p.relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(p)
-
-
-def write_depfile(path: Path, target: str, deps) -> bool:
-    """``target: dep dep ...`` (one dependency per line), atomically; False when it was already so."""
-    lines = [f"{_escape(target)}:"] + [f"  {_escape(d)}" for d in sorted(set(deps))]
-    return atomic_write(Path(path), (" \\\n".join(lines) + "\n").encode())

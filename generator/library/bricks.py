@@ -93,12 +93,24 @@ class Library:
     errors: list[SourceError] = field(default_factory=list)
     memo: dict = field(default_factory=dict)  # what later stages derive from these bricks (linked programs)
     serial: int = field(default_factory=lambda: next(_SERIALS))  # names this library in other caches; never reused
+    dirs: tuple = ()  # the brick directories it was loaded from (a build's depfile lists them)
 
     def get(self, kind: str, brick_id: str) -> Brick | None:
-        return self.bricks.get((kind, brick_id))
+        b = self.bricks.get((kind, brick_id))
+        if b is None:
+            self._refuse_broken(brick_id)
+        return b
 
     def of_kind(self, kind: str) -> list[Brick]:
         return sorted((b for (k, _), b in self.bricks.items() if k == kind), key=lambda b: b.id)
+
+    def _refuse_broken(self, brick_id: str) -> None:
+        """A lookup of a brick that did not load (load_library(strict=False)) raises that brick's own located
+        error: the brick is reached, so its error is the build's. Matched by id (the file stem) alone: a brick
+        that does not load may not even say its kind."""
+        for e in self.errors:
+            if Path(e.path).stem == brick_id:
+                raise e
 
     def tables(self) -> dict[str, dict]:
         """{texture name: its declaration, "brick" and the brick's "tolerance"} of every texture a brick declares as a baked table
@@ -108,7 +120,10 @@ class Library:
                 for name, d in b.textures.items() if d.get("table")}
 
     def find(self, brick_id: str, kinds) -> list[Brick]:
-        return [self.bricks[(k, brick_id)] for k in kinds if (k, brick_id) in self.bricks]
+        found = [self.bricks[(k, brick_id)] for k in kinds if (k, brick_id) in self.bricks]
+        if not found:
+            self._refuse_broken(brick_id)
+        return found
 
 
 def display(path: Path, root: Path | None = None) -> str:
@@ -134,9 +149,13 @@ def display(path: Path, root: Path | None = None) -> str:
 
 
 def load_library(extra_dirs=(), strict: bool = True) -> Library:
-    """Parse every brick in bricks/ and the extra directories (an engine's own bricks)."""
-    lib = Library()
+    """Parse every brick in bricks/ and the extra directories (an engine's own bricks).
+
+    strict: the first brick that does not load raises its located error. Otherwise (a build: a broken brick no
+    permutation reaches must not fail it) the errors are kept in ``errors`` and the brick is left out; looking
+    it up by id (Library.get, Library.find: what resolving a scene does) raises its error then."""
     dirs = [BUILTIN_BRICKS, *[Path(d) for d in extra_dirs]]
+    lib = Library(dirs=tuple(dirs))
     for d in dirs:
         if not d.is_dir():
             raise SourceError(str(d), 1, 1, "brick directory not found", "check the path of the extra brick directory")

@@ -43,22 +43,31 @@ def _consistent(out: Path, exact: bool = True) -> dict:
     return m
 
 
-def test_the_depfile_lists_the_scene_every_brick_and_every_template_read(tmp_path):
+def test_the_depfile_lists_the_scene_the_bricks_its_permutations_read_and_every_template_read(tmp_path):
     dep = tmp_path / "out.d"
     r = _cli("build", EXAMPLE, "--out", tmp_path / "out", "--depfile", dep)
     assert r.returncode == 0, r.stderr
     text = dep.read_text()
-    target, _, rest = text.partition(":")
+    rule, _, phony = text.partition("\n\n")  # the rule, then an empty rule per dependency (gcc's -MP)
+    target, _, rest = rule.partition(":")
     assert target == str(tmp_path / "out" / "manifest.json")
     deps = [d.strip().rstrip("\\").strip() for d in rest.splitlines() if d.strip().rstrip("\\").strip()]
+    assert phony.split() == [f"{d}:" for d in deps]
     assert "scenes/example.toml" in deps  # relative to the working directory, as the build system sees it
-    bricks = {str(p.relative_to(REPO)) for p in (REPO / "bricks").rglob("*.py")}
-    assert bricks <= set(deps)
+    m = json.loads((tmp_path / "out" / "manifest.json").read_text())
+    read = {b for e in m["permutations"] for b in e["bricks"]}  # what the composed permutations read
+    assert {d for d in deps if d.endswith(".py")} == read
+    unused = {str(p.relative_to(REPO)) for p in (REPO / "bricks").rglob("*.py")} - read
+    assert unused and not unused & set(deps)  # editing a brick no permutation uses reruns nothing
+    folders = {str(p.relative_to(REPO)) for p in [REPO / "bricks", *(REPO / "bricks").rglob("*")]
+               if p.is_dir() and p.name != "__pycache__"}
+    assert folders <= set(deps)  # a brick added to one is a change
+    assert str(tmp_path / "out" / ".shadermatrix-versions") in deps
     templates = {d for d in deps if d.endswith(".j2")}
     for lang in ("glsl", "hlsl", "wgsl"):  # what was composed with: vertex, fragment, the ubershader, macros
         assert {f"generator/backends/{lang}/templates/{stage}.{lang}.j2"
                 for stage in ("vertex", "fragment", "macros")} <= templates
-    assert all(Path(REPO / d).is_file() for d in deps)
+    assert all(Path(REPO / d).exists() for d in deps)
     again = _cli("build", EXAMPLE, "--out", tmp_path / "out", "--depfile", tmp_path / "again.d")
     assert "up to date" in again.stdout and (tmp_path / "again.d").read_text() == text  # composed nothing, same deps
 

@@ -52,7 +52,11 @@ def add_arguments(p) -> None:
                         "the emitters' invariants (generator/lang/validate.py) before compiling; a violation is a "
                         "generator bug, reported and exit 1")
     p.add_argument("--depfile", metavar="PATH",
-                   help="write a Make-syntax depfile (Ninja: deps = gcc): OUT/manifest.json and every file read")
+                   help="write a Make-syntax depfile (Ninja: deps = gcc) for the --stamp file (else OUT/manifest.json):"
+                        " what the scene's permutations read, the brick directories and OUT/.shadermatrix-versions")
+    p.add_argument("--stamp", metavar="FILE",
+                   help="replace FILE after every build that succeeds (not after one that fails): the target of a "
+                        "Make, Ninja or CMake rule, which then reruns only when an input is newer than it")
 
 
 def summary(scene, res, out, seconds: float, pack: bool = False) -> dict:
@@ -111,12 +115,15 @@ def run(args) -> int:
     except ValueError as e:
         raise UsageError(f"--platform: {e}") from None
     try:
-        lib = load_library(args.bricks or ())
+        lib = load_library(args.bricks or (), strict=False)  # a broken brick fails the build once a scene reaches it
         scene = load_scene(args.scene, lib)
     except UserError as e:
         if args.json:  # a script reading stdout gets its answer too
             print(json.dumps({"ok": False, "failures": [str(e)]}, indent=2))
         raise
+    for e in lib.errors:  # what the scene reaches has loaded (resolving it raises a broken brick's error)
+        print(f"warning: {e} (no permutation of this scene uses the brick; `shadermatrix bricks --check` checks "
+              "every brick)", file=sys.stderr)
     from ...spec.resolve import fp16_warnings
     for w in fp16_warnings(scene.permutations.values(), lib):  # bricks marked "fp16": "unsafe: ..."
         print(f"warning: {w}", file=sys.stderr)
@@ -141,7 +148,8 @@ def run(args) -> int:
                        jobs=args.jobs, executor=executor)
     handlers = {sig: signal.signal(sig, _interrupter(ctx.gate)) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        res = build(scene, Path(args.out), ctx, depfile=args.depfile, keep_removed=args.keep_removed, pack=args.pack)
+        res = build(scene, Path(args.out), ctx, depfile=args.depfile, keep_removed=args.keep_removed, pack=args.pack,
+                    stamp=args.stamp)
     finally:
         if executor is not None:
             executor.close()
