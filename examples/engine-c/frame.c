@@ -150,6 +150,9 @@ static bool load_lights(frame *f)
         if (!j_nums(src, l, "shadow_matrix", at, x->shadow_matrix, 16) || !j_nums(src, l, "size", at, size, 2)
             || !j_nums(src, l, "eye", at, x->eye, 3))
             return false;
+        if (!(size[0] >= 1 && size[0] <= 16384 && size[1] >= 1 && size[1] <= 16384) || size[0] != floor(size[0])
+            || size[1] != floor(size[1]))
+            return j_fail(src, at, "size %g x %g is not a map of 1 to 16384 texels a side", size[0], size[1]);
         x->size[0] = (int)size[0];
         x->size[1] = (int)size[1];
         const cJSON *texel = j_opt(l, "pcf_texel");

@@ -53,6 +53,9 @@ bool ktx2_parse(const unsigned char *data, size_t size, const char *shown, ktx2_
                     FORMATS[f].name, HINT);
     if (scheme != 0)
         return fail("%s: supercompressionScheme %u; this engine reads uncompressed files — %s", shown, scheme, HINT);
+    if (width > KTX2_MAX_SIDE || height > KTX2_MAX_SIDE)  /* so that W x H x 16 bytes cannot wrap below */
+        return fail("%s: %u x %u texels; this engine reads images of at most %u a side — %s", shown, width, height,
+                    KTX2_MAX_SIDE, HINT);
     if (width == 0 || height == 0 || depth != 0 || layers != 0 || faces != 1)
         return fail("%s: %u x %u, depth %u, %u layers, %u faces: this engine reads one 2D image (no arrays, no "
                     "cube maps, not 1D) — %s", shown, width, height, depth, layers, faces, HINT);

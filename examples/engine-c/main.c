@@ -4,8 +4,8 @@
  *   engine-c [--device NAME] BUILD_DIR FRAME_DIR OUT.png
  *
  * Exit status: 0 drawn and written; 1 bad input or a Vulkan failure (a message says which); 2 bad usage;
- * 3 the validation layer reported something (each message is printed; OUT.png is still written so it can be
- * looked at, but the run has failed). */
+ * 3 the validation layer reported something (each message is printed). OUT.png is written only on 0: a failed
+ * run leaves no picture that could be taken for a good one. */
 #include <shadermatrix/pack.h>
 
 #include <stdio.h>
@@ -103,7 +103,7 @@ int main(int argc, char **argv)
     }
     gpu_close(&g);  /* before the PNG: whatever the layer says at tear-down (a leak) fails the run too */
     engine_free(&e);
-    if (ok)
+    if (ok && !g.messages)
         ok = png_write_rgba(args[2], rgba, (uint32_t)f.width, (uint32_t)f.height);
     free(rgba);
     smpack_close(&pack);

@@ -53,7 +53,7 @@ static bool load_texture(engine *e, const texture_want *w, const char *where, Vk
     char *path = path_join(e->m->dir, w->path);
     size_t size = 0;
     unsigned char *data = path ? read_file(path, &size) : NULL;
-    ktx2_image k;
+    ktx2_image k = {0};  /* read below (its format) even when the file could not be read */
     bool ok = data && check_sha256(path, data, size, w->sha256) && ktx2_parse(data, size, path, &k);
     if (ok && (strcmp(k.format, w->format) != 0 || (int)k.width != w->width || (int)k.height != w->height
                || (w->levels >= 0 && (int)k.levels != w->levels)))
@@ -110,6 +110,8 @@ bool texture_of_row(engine *e, const cJSON *row, const char *where, VkImageView 
             return w.format ? false : j_fail(src, where, "table format %s is not unorm8, fp16 or fp32", f);
         if (strcmp(dim, "2d") != 0)
             return j_fail(src, where, "a %s table; this engine binds 2D ones", dim);
+        if (!(size[0] >= 1 && size[0] <= 1 << 16 && size[1] >= 1 && size[1] <= 1 << 16))
+            return j_fail(src, where, "a table of %g x %g texels", size[0], size[1]);
         w.width = (int)size[0];
         w.height = (int)size[1];
         w.levels = -1;

@@ -209,7 +209,8 @@ bool j_int(const json_src *src, const cJSON *obj, const char *key, const char *w
     double d;
     if (!j_num(src, obj, key, where, &d))
         return false;
-    if (d != (double)(long)d || d < (double)lo || d > (double)hi) {
+    /* the range first: converting a double outside long's range (1e300 in a crafted file) is undefined */
+    if (!(d >= (double)lo && d <= (double)hi) || d != (double)(long)d) {
         char at[512];
         snprintf(at, sizeof at, "%s.%s", where, key);
         return j_fail(src, at, "%g is not a whole number from %ld to %ld", d, lo, hi);

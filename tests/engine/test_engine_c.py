@@ -223,6 +223,7 @@ def test_a_layout_unlike_the_shaders_is_a_validation_failure(engine, prepared, t
     r = run_engine(engine, _edited(build, tmp_path / "b", move), export, tmp_path / "out.png")
     assert r.returncode == 3, f"exit {r.returncode}: {r.stderr[-3000:]}"
     assert "VUID-" in r.stderr and "validation layer" in r.stderr, r.stderr
+    assert not (tmp_path / "out.png").exists()
 
 
 @pytest.mark.parametrize("what", ["material", "shadow_matrix", "sampler"])
@@ -274,6 +275,9 @@ BAD = {
         "uniform block 'Environment'"),
     "another scene's export": (lambda b, x: _json_edit(x / "frame.json", lambda d: d.update(scene="elsewhere")),
                                "scene: elsewhere; the build"),
+    "a light's map of 1e300 texels": (
+        lambda b, x: _json_edit(x / "frame.json", lambda d: d["lights"]["sun"].update(size=[1e300, 1e300])),
+        "lights.sun: size 1e+300 x 1e+300 is not a map of 1 to 16384 texels a side"),
     "an object the manifest lacks": (
         lambda b, x: _json_edit(x / "frame.json", lambda d: d["objects"][0].update(name="sofa")),
         "object sofa; the manifest's object 0 is bench"),
