@@ -108,20 +108,21 @@ def write_export(directory, export: FrameExport) -> Path:
     if d.exists() and not d.is_dir():
         from ..lang.errors import UserError
         raise UserError(f"{d} is a file — give --export a directory")
-    (d / "meshes").mkdir(parents=True, exist_ok=True)
-    rows = []
+    rows, files = [], {}
     for name, mesh in export.meshes:
         data, attributes, indices = mesh_bytes(mesh)
         sha = hashlib.sha256(data).hexdigest()
         rel = f"meshes/{name}.{sha[:12]}.bin"
-        atomic_write(d / rel, data)
+        files[rel] = data
         rows.append({"name": name, "path": rel, "sha256": sha, "bytes": len(data), "vertex_count": int(mesh.vertex_count),
                      "attributes": attributes, "indices": indices})
     doc = frame_document(export, rows)
-    check_document(doc)
-    keep = {r["path"] for r in rows}
-    for old in (d / "meshes").glob("*.bin"):  # an earlier export's meshes this one does not name
-        if f"meshes/{old.name}" not in keep:
-            old.unlink(missing_ok=True)
+    check_document(doc)  # before anything is written: a document the schema refuses leaves the folder as it was
+    (d / "meshes").mkdir(parents=True, exist_ok=True)
+    for rel, data in files.items():  # the meshes first, so that frame.json never names a file not there yet
+        atomic_write(d / rel, data)
     atomic_write(d / "frame.json", (json.dumps(doc, indent=1, sort_keys=True) + "\n").encode())
+    for old in (d / "meshes").glob("*.bin"):  # then an earlier export's meshes, which frame.json no longer names
+        if f"meshes/{old.name}" not in files:
+            old.unlink(missing_ok=True)
     return d / "frame.json"

@@ -96,3 +96,20 @@ def test_the_schema_is_closed():
         check_document({**doc, "extra": 1})
     with pytest.raises(ValueError, match="/camera"):
         check_document({**doc, "camera": {"eye": [0, 0, 1]}})
+
+
+def test_an_export_the_schema_refuses_writes_nothing_and_a_new_one_drops_stale_meshes(tmp_path):
+    from generator.runtime.frame_export import FrameExport, write_export
+    from generator.runtime.placement import make_mesh
+
+    def export(attachment, mesh):
+        return FrameExport("s", (4, 4), attachment, (0, 0, 0, 1), [0, 0, 1], [0.0] * 16, meshes=[("m", mesh)],
+                           objects=[{"name": "o", "mesh": 0, "model": [0.0] * 16, "mirrored": False}], draw_order=[0])
+    write_export(tmp_path, export("srgb", make_mesh("plane")))
+    before = {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    with pytest.raises(ValueError, match="color_attachment"):
+        write_export(tmp_path, export("bogus", make_mesh("box")))
+    assert {p: p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+    write_export(tmp_path, export("srgb", make_mesh("box")))
+    doc = json.loads((tmp_path / "frame.json").read_text())
+    assert sorted(p.name for p in (tmp_path / "meshes").iterdir()) == [Path(doc["meshes"][0]["path"]).name]
