@@ -20,8 +20,11 @@ APT_PKGS=(
   "glslc=$GLSLC_V"                         # shaderc: batches many GLSL/HLSL compiles in one process
   "glslang-tools=$GLSLANG_V"               # glslangValidator (HLSL front end, version reporting)
   "spirv-tools=$SPIRV_TOOLS_V"             # spirv-val, spirv-opt, spirv-as, spirv-dis
-  # The C side (include/shadermatrix/pack.h, examples/engine-c): Vulkan's headers, cJSON, and clang for
-  # AddressSanitizer, UndefinedBehaviorSanitizer and libFuzzer (gcc builds the engine itself)
+  # The C side (include/shadermatrix/pack.h, examples/engine-c): gcc builds the engine, gcc and g++ compile
+  # pack.h as C and C++17 in its tests; Vulkan's headers, cJSON, and clang for AddressSanitizer,
+  # UndefinedBehaviorSanitizer and libFuzzer
+  "gcc=4:12.2.0-3"
+  "g++=4:12.2.0-3"
   "libvulkan-dev=1.3.239.0-1"
   "libcjson-dev=1.7.15-1+deb12u4"
   "libcjson1=1.7.15-1+deb12u4"
@@ -77,10 +80,11 @@ if ((${#missing[@]} + ${#missing_bpo[@]})); then
     exit 1
   fi
 fi
-# gcc and libc's headers build the C engine and pack.h's tests (and naga's build scripts below)
-command -v cc >/dev/null 2>&1 && [[ -e /usr/include/stdio.h ]] || {
+# libc's headers (gcc only recommends them, and they follow libc6's own version): the C engine, pack.h's tests
+# and naga's build scripts below include them
+[[ -e /usr/include/stdio.h ]] || {
   export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq && apt-get install -y -qq --no-install-recommends gcc libc6-dev >/dev/null
+  apt-get update -qq && apt-get install -y -qq --no-install-recommends libc6-dev >/dev/null
 }
 
 # naga (WGSL front end + validator), pinned, from crates.io into .tools/bin, which the end of this
