@@ -51,6 +51,27 @@ class FrameExport:
     lights: dict = field(default_factory=dict)
 
 
+def placed_meshes(objects, key_of, meshes: dict) -> tuple[list, list]:
+    """(FrameExport.meshes, FrameExport.objects) of placed objects (runtime/placement.Placed), `key_of` each one's key
+    into `meshes` ({(mesh name or id, mirrored): the Mesh drawn}, in order of first use)."""
+    keys = list(meshes)
+    named = [(_mesh_name(k, objects[key_of.index(k)]), m) for k, m in meshes.items()]
+    rows = [{"name": o.name, "mesh": keys.index(k), "model": _columns(o.model), "mirrored": o.mirrored}
+            for o, k in zip(objects, key_of)]
+    return named, rows
+
+
+def _mesh_name(key, placed) -> str:
+    """A mesh's name in the export: the placement's mesh name, or the glTF primitive's, '_mirrored' when so."""
+    base = key[0] if isinstance(key[0], str) else (getattr(placed.mesh, "name", None) or placed.name)
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in str(base)) + ("_mirrored" if key[1] else "")
+
+
+def _columns(m) -> list[float]:
+    from .camera import column_major
+    return column_major(m)
+
+
 def _floats(xs) -> list[float]:
     return [float(x) for x in np.asarray(xs, np.float64).reshape(-1)]
 

@@ -60,6 +60,31 @@ def attachment(encodes: str) -> str:
     return "srgb" if encodes == "linear" else "unorm"
 
 
+# The renderer's background, display-encoded: on an sRGB attachment it clears with the linear values, which the
+# attachment encodes back, so a frame has the same background bytes whatever the scene's output.
+CLEAR = (0.06, 0.07, 0.09, 1.0)
+
+
+def color_attachment(lib, perms) -> str:
+    """The colour attachment (a key of COLOR_FORMATS) the permutations' output brick asks for, as the build writes it
+    into each one's ``output``; every permutation of a scene ends in the scene's output brick, so they agree."""
+    from ..lang.errors import UserError
+
+    kinds = {output_state(lib.get("output", p.output))["attachment"] for p in perms}
+    if len(kinds) > 1:
+        raise UserError(f"the permutations ask for colour attachments {', '.join(sorted(kinds))}: one target cannot "
+                        "store both — give the scene one output brick")
+    return kinds.pop() if kinds else "unorm"
+
+
+def clear_color(attachment: str) -> tuple:
+    """CLEAR as the floats given to the clear of an `attachment` target."""
+    if attachment != "srgb":
+        return CLEAR
+    decode = lambda c: c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4  # noqa: E731 (IEC 61966-2-1)
+    return (*(decode(c) for c in CLEAR[:3]), CLEAR[3])
+
+
 def output_state(brick) -> dict:
     """{"brick", "encodes", "attachment"} of a permutation's output brick (library/bricks.Brick)."""
     return {"brick": brick.id, "encodes": brick.encodes, "attachment": attachment(brick.encodes)}

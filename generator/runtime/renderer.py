@@ -186,7 +186,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..link import link_permutation
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
     from .material_textures import BuildOutputs, MaterialTextures
-    from .pipeline_state import COLOR_FORMATS, render_state
+    from .pipeline_state import COLOR_FORMATS, clear_color, color_attachment, render_state
     from .shadow_pass import (VULKAN_CONVENTIONS, depth_pass, depth_plan, fit_shadow_matrix, pass_units,
                               shadowed_lights)
 
@@ -260,7 +260,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     try:
         cache = PipelineCacheFile(device, out / f"pipeline_cache.{language}.bin")
         report.cache_problem = cache.problem
-        attachment = color_attachment(scene, lib, perms)
+        attachment = color_attachment(lib, perms.values())
         target = gx.OffscreenTarget(device, W, H, color_format=COLOR_FORMATS[attachment])
         clear = clear_color(attachment)
         owned += [target, cache]
@@ -476,16 +476,14 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         # blended surfaces after the opaque ones, in scene order otherwise (no sorting by depth: docs/design/runtime.md)
         blended_last = sorted(range(len(draws)), key=lambda i: perms[draws[i][0]].surface.alpha == "blend")
         draws = [draws[i] for i in blended_last]
-        if export is not None:
-            from .frame_export import FrameExport, write_export
-            write_export(export, FrameExport(
-                scene.name, (W, H), attachment, clear, eye, gx.column_major(vp),
-                meshes=[(_mesh_name(k, placed.objects[key_of.index(k)]), m) for k, m in cpu_meshes.items()],
-                objects=[{"name": o.name, "mesh": list(cpu_meshes).index(k), "model": gx.column_major(o.model),
-                          "mirrored": o.mirrored} for o, k in zip(placed.objects, key_of)],
-                draw_order=blended_last,
-                lights={ln: {"shadow_matrix": matrices[ln], "pcf_texel": texels.get(ln), "size": passes_of[ln]["size"],
-                             "eye": points.mean(0)} for ln in shadowed}))
+        frame_export = None
+        if export is not None:  # written once the frames are drawn: a failed render leaves the last export alone
+            from .frame_export import FrameExport, placed_meshes
+            frame_export = FrameExport(scene.name, (W, H), attachment, clear, eye, gx.column_major(vp),
+                                       *placed_meshes(placed.objects, key_of, cpu_meshes), draw_order=blended_last,
+                                       lights={ln: {"shadow_matrix": matrices[ln], "pcf_texel": texels.get(ln),
+                                                    "size": passes_of[ln]["size"], "eye": points.mean(0)}
+                                               for ln in shadowed})
         specialized: dict[str, object] = {}
         order = list(dict.fromkeys(h for h, _, _, _ in draws))  # first use
         start = time.perf_counter()
@@ -544,6 +542,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             raise failed[0]
         report.steady = draw_frame(None)
         cache.save()
+        if frame_export is not None:
+            from .frame_export import write_export
+            write_export(export, frame_export)
     finally:
         for obj in reversed(owned):
             obj.destroy()
@@ -556,34 +557,6 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     import json
     atomic_write(out / "report.json", (json.dumps(report.as_dict(), indent=2) + "\n").encode())
     return report
-
-
-# The background, display-encoded: on an sRGB attachment the render clears with its linear values, which the
-# attachment encodes back, so every output's frame has the same background bytes.
-CLEAR = (0.06, 0.07, 0.09, 1.0)
-
-
-def color_attachment(scene, lib, perms) -> str:
-    """The colour attachment (pipeline_state.COLOR_FORMATS key) the scene's output brick asks for, as the build writes
-    it into each permutation's ``output``: every permutation of a scene ends in the scene's output brick."""
-    from .pipeline_state import output_state
-
-    kinds = {output_state(lib.get("output", p.output))["attachment"] for p in perms.values()}
-    return kinds.pop() if len(kinds) == 1 else "unorm"
-
-
-def clear_color(attachment: str) -> tuple:
-    """CLEAR as the floats given to the clear of an `attachment` target."""
-    if attachment != "srgb":
-        return CLEAR
-    decode = lambda c: c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4  # noqa: E731 (IEC 61966-2-1)
-    return (*(decode(c) for c in CLEAR[:3]), CLEAR[3])
-
-
-def _mesh_name(key, placed) -> str:
-    """A mesh's name in the frame export: the placement's mesh name, or the glTF primitive's, '_mirrored' when so."""
-    base = key[0] if isinstance(key[0], str) else (getattr(placed.mesh, "name", None) or placed.name)
-    return "".join(c if c.isalnum() or c in "-_" else "_" for c in str(base)) + ("_mirrored" if key[1] else "")
 
 
 def _light_specs(lib, light) -> dict:
