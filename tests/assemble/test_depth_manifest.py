@@ -58,8 +58,11 @@ def test_every_shadowed_light_has_a_depth_pass_naming_written_units(built):
     assert {h: c["unit"] for h, c in sun["casters"]["masked"].items()} == {h: f"{h}.mask" for h in masked}
     assert {h: c["unit"] for h, c in moon["casters"]["masked"].items()} == {h: f"{h}.mask_moments" for h in masked}
     assert moon["moments"]["format"] == "R32G32B32A32_SFLOAT" and moon["moments"]["clear"] == [1.0, 1.0, 0.0, 1.0]
-    assert moon["moments"]["blur"] == {"unit": "blur", "filter": "box", "size": 5, "radius": 2, "edges": "clamp",
-                                       "passes": [{"axis": [0, 1]}, {"axis": [1, 0]}]}
+    blur = moon["moments"]["blur"]
+    assert blur == {"unit": "blur", "filter": "box", "size": 5, "radius": 2, "edges": "clamp",
+                    "passes": [{"axis": [0, 1]}, {"axis": [1, 0]}], "sampler_state": blur["sampler_state"]}
+    row = m["samplers"][blur["sampler_state"]]  # its passes read texel centres: bilinear, clamped, level 0
+    assert (row["min_filter"], row["mipmap"], row["wrap_u"], row["wrap_v"]) == ("linear", "none", "clamp", "clamp")
     for dp in (sun, moon):
         assert dp["size"] == [512, 512]
         assert dp["depth"] == {"format": "D32_SFLOAT", "clear": 1.0, "compare_op": "less", "write": True, "cull": "none",
