@@ -7,7 +7,8 @@ fails (brick error, compiler error) is reported and the others still build.
 
 The stage, in the order a build runs it: context.py (BuildContext: what every step reads), keys.py (the
 input keys), state.py (what the last build left), loop.py (the compile loop: in this process, or in worker
-processes through parallel.py and workers.py), write.py (content-named artifacts), platforms.py,
+processes through parallel.py and workers.py, or on a Dask cluster through cluster.py), entries.py (a chunk's
+manifest entries and files, made where it compiled), write.py (content-named artifacts), platforms.py,
 reflection.py, tables.py, pack.py, outputs.py (the output tree: lock, leftovers, garbage), depfile.py (the depfile,
 the stamp and the versions file a build system reads).
 """
@@ -18,22 +19,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .. import __version__
-from ..lang import SourceError
-from ..library.bricks import Library
-from ..link.uber import coverage
-from ..link.values import uploads
 from ..scene.load import Scene
 from ..toolchain import CompileStats, tool_versions
 from ..toolchain.jobs import source_jobs
 from . import state
 from .context import BuildContext
+from .entries import Entries, compose_ubershader, replay
 from .keys import build_key, scene_keys
-from .loop import compile_permutations
-from .manifest import FORMAT_VERSION, check as check_manifest, conventions, material_states, output_state, render_state
+from .loop import compile_permutations, in_workers
+from .manifest import FORMAT_VERSION, check as check_manifest, conventions, material_states
 from .outputs import clean_leftovers, collect_garbage, locked
 from .platforms import PLATFORMS
 from .reflection import scene_tables
-from .write import Writer, validate_dialects
+from .write import Writer
 
 STATE = state.STATE
 
@@ -132,6 +130,7 @@ class _Build:
         self.tools = tool_versions()
         self.base = build_key(__version__, self.tools, ctx.languages, ctx.platforms)
         self.keys = scene_keys(self.base, scene, ctx.library, keep_removed, pack)
+        self.entries = Entries(scene, self.keys.permutations, self.keys.ubershader, self.users)  # entries.py
         self.previous: dict = {}
         self.old: dict[str, dict] = {}  # the previous manifest's entries by hash
         self.built: dict[str, dict] = {}
@@ -153,13 +152,15 @@ class _Build:
                      and state.intact(out, old_uber))
         self.uber_kept = uber_kept  # the record keeps the last build's templates for it (it is not composed)
         self.kept = set(kept)  # what the explanation of this build leaves out (inputs.py)
-        uber_unit = None if uber_kept else _compose_ubershader(scene, self.ctx.library, self.ctx.languages)
+        todo = {h: p for h, p in scene.permutations.items() if h not in kept}
+        remote = in_workers(self.ctx, len(todo))  # then the ubershader is composed where the chunks are
+        uber_unit = None if uber_kept or remote else compose_ubershader(scene, self.ctx.library, self.ctx.languages)
         extra = []
         if isinstance(uber_unit, tuple):
             extra = source_jobs("ubershader", uber_unit[0].sources)
             res.templates.update(uber_unit[0].templates)
-        todo = {h: p for h, p in scene.permutations.items() if h not in kept}
-        compiled = compile_permutations(self.ctx, todo, extra, self._written, res.compile, res.costs)
+        compiled = compile_permutations(self.ctx, todo, extra, self._written, res.compile, res.costs, self.entries,
+                                        ubershader=remote and not uber_kept)
         res.templates.update(compiled.templates)
         res.shaders = {k: (r.cache_key, r.seconds) for k, r in compiled.results.items()}
         res.kept = len(kept)
@@ -177,7 +178,9 @@ class _Build:
             uber = old_uber
             res.unchanged += state.files(uber)
         else:
-            uber = self._ubershader(uber_unit, compiled.results, old_uber)
+            made = compiled.ubershader if remote else self.entries.ubershader(self.ctx, uber_unit, compiled.results,
+                                                                              res.costs)
+            uber = self._ubershader(made, old_uber)
         res.manifest = {
             "format_version": FORMAT_VERSION,
             "generator": f"shadermatrix {__version__}",
@@ -196,28 +199,17 @@ class _Build:
         return res
 
     def _head(self, h: str) -> dict:
-        perm = self.scene.permutations[h]
-        head = {"id": perm.canonical(), "hash": h, "input_key": self.keys.permutations[h],
-                "objects": self.scene.users.get(h, []), "languages": {}, "render_state": render_state(perm.surface)}
-        out = self.ctx.library.get("output", perm.output)  # None: an unknown brick, which fails the permutation
-        if out is not None:
-            head["output"] = output_state(out)
-        return head
+        return self.entries.head(self.ctx.library, h)
 
-    def _written(self, pairs, part) -> None:
-        """A compiled chunk: written and analysed while the next chunks compile."""
-        checked = validate_dialects(pairs, self.ctx.store, self.ctx.gate) if self.ctx.dialects else {}
-        for h, c in pairs:
-            objs = self.users.get(h, [])
-            entry = {**self._head(h), "bricks": dict(sorted(c.bricks.items())), "interface": c.interface.as_dict(),
-                     "uploads": uploads(self.scene, h, c, objs)}
-            errs = self.writer.unit(h, c.sources, part, entry)
-            if not errs:
-                errs = self.writer.platforms(h, c, entry, checked, self.scene.permutations[h].precision)
-                if errs:  # failed_sources stays: a failing GL core source is written beside (write_platforms)
-                    entry.pop("platforms", None)
-                    entry["languages"] = {}
-            self.built[h] = self._settle(entry, errs, self.old.get(h), _failure_head(self.scene, h, objs))
+    def _written(self, pairs, part, made=None) -> None:
+        """A compiled chunk: its entries made (entries.py; `made`: by the worker that compiled it), its files written
+        and each entry settled, while the next chunks compile."""
+        if made is None:
+            made = self.entries.make(self.ctx, pairs, part, self.res.costs)
+        for h, m in made.items():
+            replay(self.writer, m.files)
+            self.built[h] = self._settle(m.entry, m.errors, self.old.get(h),
+                                         _failure_head(self.scene, h, self.users.get(h, [])))
 
     def _finish(self) -> None:
         """The removed entries, tables and packs, then the manifest, then what it no longer names goes, then the
@@ -274,23 +266,13 @@ class _Build:
             return {**old, "status": "stale", "errors": errs, "failed_sources": failed}
         return {**entry, "languages": {}, "status": "failed", "errors": errs, "failed_sources": failed}
 
-    def _ubershader(self, unit, results, old: dict) -> dict:
-        """The fallback ubershader of the scene's matrix: sources, SPIR-V, its tables and Interface.
-
-        The build fails, naming the value, when an axis value of the matrix is not reachable in it.
-        """
-        key, where = self.keys.ubershader, _uber_failure_head(self.scene)
-        if unit is None:
+    def _ubershader(self, made, old: dict) -> dict:
+        """The fallback ubershader of the scene's matrix (entries.Entries.ubershader: made here or by a worker):
+        its files written, its entry settled."""
+        if made is None:
             return {}
-        if isinstance(unit, str):
-            return self._settle({"input_key": key, "languages": {}}, [unit], old, where)
-        c, u = unit
-        perms = [p for _, p in sorted(self.scene.permutations.items())]
-        entry = {"input_key": key, "hash": c.hash, "languages": {}, "tables": u.tables(),
-                 "interface": c.interface.as_dict()}
-        errs = [f"coverage: {p}" for p in coverage(u, perms, self.ctx.library)]
-        errs += self.writer.unit("ubershader", c.sources, results, entry)
-        return self._settle(entry, errs, old, where)
+        replay(self.writer, made.files)
+        return self._settle(made.entry, made.errors, old, _uber_failure_head(self.scene))
 
 
 def _failure_head(scene: Scene, h: str, objs: list[dict]) -> tuple[str, str]:
@@ -307,15 +289,3 @@ def _uber_failure_head(scene: Scene) -> tuple[str, str]:
     line, col = scene.head_at
     return (f"{scene.path}:{line}:{col}: the scene's ubershader (the fallback for all {len(scene.permutations)} "
             "permutations) does not build", "")
-
-
-def _compose_ubershader(scene: Scene, lib: Library, languages):
-    """(Composed, Uber) of the scene's ubershader, the compose error as text, or None without permutations."""
-    from ..compose.uber import compose_ubershader
-    perms = [p for _, p in sorted(scene.permutations.items())]
-    if not perms:
-        return None
-    try:
-        return compose_ubershader(perms, lib, languages)
-    except SourceError as e:
-        return str(e)

@@ -23,7 +23,7 @@ class BuildContext:
     store: object = None  # the content-addressed compile cache (io.Store), or None: compile everything
     progress: bool = False  # draw progress bars (on stderr)
     jobs: int | None = None  # worker processes (from MIN_PERMUTATIONS), else tool processes; None: the core count
-    executor: object = None  # where compiles run instead of here (toolchain/dask.py), or None
+    executor: object = None  # a Dask cluster the chunks run on (toolchain/dask.py, assemble/cluster.py), or None
     # this build's switch for its tools (toolchain.Gate): the build's signal handler stops it, which kills them
     gate: Gate = field(default_factory=Gate, compare=False, repr=False)
 

@@ -42,6 +42,7 @@ class Compiled:
     results: dict[str, CompileResult] = field(default_factory=dict)
     costs: dict = field(default_factory=dict)
     templates: set[str] = field(default_factory=set)
+    ubershader: object = None  # its entry as a worker made it (entries.Made), when the workers composed it
 
     def add(self, composed: dict, errors: dict) -> None:
         self.composed.update(composed)
@@ -57,19 +58,27 @@ def compose_chunk(ctx: BuildContext, items) -> tuple[dict[str, Composed], dict[s
     return composed, errors, [j for h, c in composed.items() for j in source_jobs(h, c.sources)]
 
 
+def in_workers(ctx: BuildContext, permutations: int) -> bool:
+    """Whether a build of this many permutations runs its chunks in worker processes or on the cluster."""
+    n = ctx.jobs or os.cpu_count() or 1
+    return ctx.executor is not None or (n > 1 and permutations >= MIN_PERMUTATIONS)
+
+
 def compile_permutations(ctx: BuildContext, permutations: dict, extra=(), on_done=None,
-                         stats: CompileStats | None = None, costs: dict | None = None) -> Compiled:
+                         stats: CompileStats | None = None, costs: dict | None = None, entries=None,
+                         ubershader: bool = False) -> Compiled:
     """Compose and compile every permutation of `permutations` (hash -> Permutation), and the CompileJobs of
-    `extra`. on_done([(hash, Composed)], results by job key) is called on this thread for every compiled chunk,
-    in chunk order; stats (a CompileStats) is filled in; costs: the dict Compiled.costs is (the writer's, so
-    that what the workers analysed is there before it writes the chunk)."""
+    `extra`. on_done([(hash, Composed)], results by job key, entries made or None) is called on this thread for
+    every compiled chunk, in chunk order; stats (a CompileStats) is filled in; costs: the dict Compiled.costs is
+    (the writer's). entries (entries.Entries): what makes the chunks' manifest entries, given to the workers when
+    they run the chunks (in_workers); ubershader: there, compose and compile the ubershader too (Compiled.ubershader)."""
     stats = stats if stats is not None else CompileStats()
     out = Compiled(costs=costs if costs is not None else {})
     items = sorted(permutations.items())
-    n = ctx.jobs or os.cpu_count() or 1
-    if ctx.executor is None and n > 1 and len(items) >= MIN_PERMUTATIONS:
+    if entries is not None and in_workers(ctx, len(items)):
         from .parallel import compile_in_workers
-        compile_in_workers(ctx, items, list(extra), on_done, stats, n, out)
+        compile_in_workers(ctx, items, list(extra), on_done, stats, ctx.jobs or os.cpu_count() or 1, out, entries,
+                           ubershader)
     else:
         _here(ctx, items, list(extra), on_done, stats, out)
     return out

@@ -1,17 +1,21 @@
-"""Compose, compile and analyse a scene's permutations in worker processes (`build -j N`, N > 1).
+"""Compose, compile and analyse a scene's permutations in worker processes (`build -j N`, N > 1), or on a Dask
+cluster (`--executor dask://`, cluster.py): the same tasks either way.
 
-The building process composes, compiles and analyses nothing itself: each task is one chunk of
-permutations, composed, compiled (through this build's content-addressed store, `workers=1` tool process
-per worker) and its SPIR-V analysed in a worker process; the building process writes the results, in
-chunk order, as they come back. So N processes do the Python work that one did before, and a build is
-no longer limited by the building process (benchmarks/results/build.md).
+The building process composes, compiles and analyses nothing itself: each task is one chunk of permutations,
+composed, compiled (through this build's content-addressed store, `workers=1` tool process per worker),
+its SPIR-V analysed and its manifest entries and files made (entries.py: the platform dialects validated, the
+uploads packed) in a worker (run_chunk); one more task composes and compiles the ubershader. The building
+process writes what comes back, in chunk order, as it comes back. So N processes do the Python work that one
+did before, and a build is no longer limited by the building process (benchmarks/results/dask.md measures what
+is left there).
 
-The workers (assemble/workers.py: a pool the build can end at once, on Ctrl-C, SIGTERM or a dead worker) are
-started by a forkserver (never a fork of this process, which has threads), with this process's environment,
-and receive the build's context pickled (BuildContext.for_workers, the Library in it): every worker composes
-from exactly the bricks this build parsed, not from files that may have changed since. Results are pure functions of their
-inputs, so the output is byte-identical for any N (tested), and the build's counts are the same: a
-shader is counted distinct, cached or compiled where it first appears in chunk order.
+The local workers (assemble/workers.py: a pool the build can end at once, on Ctrl-C, SIGTERM or a dead worker)
+are started by a forkserver (never a fork of this process, which has threads), with this process's
+environment, and receive the build's context and the scene pickled once (pack: BuildContext.for_workers, the
+Library in it, and entries.Entries): every worker composes from exactly the bricks this build parsed, not from
+files that may have changed since. Results are pure functions of their inputs, so the output is byte-identical
+for any N (tested), and the build's counts are the same: a shader is counted distinct, cached or compiled
+where it first appears in chunk order.
 """
 from __future__ import annotations
 
@@ -20,17 +24,18 @@ import pickle
 import shutil
 import tempfile
 import threading
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 
-from ..io import Store, sha256
+from ..io import Store
 from ..lang.errors import EnvironmentMissing, UserError
-from ..toolchain import CompileStats, cache_key, compile_many
+from ..toolchain import CompileStats, compile_many
 from .context import BuildContext
+from .entries import Entries, compose_ubershader
 from .loop import Compiled, compose_chunk
 from .workers import Workers
 
 _PRELOAD = ["generator.assemble.parallel", "generator.compose", "generator.analysis", "jinja2"]
-_CONTEXT: list[BuildContext] = []  # in a worker: the build's context (set once, by _start)
+_CONTEXT: list[tuple] = []  # in a worker: the build's (context, entries), set once by _start
 
 
 def chunk_size(permutations: int, workers: int) -> int:
@@ -38,7 +43,7 @@ def chunk_size(permutations: int, workers: int) -> int:
     return max(4, min(64, -(-permutations // (workers * 8))))
 
 
-def _start(ctx_bytes: bytes, env: dict, store_root: str | None) -> None:
+def _start(payload: bytes, env: dict, store_root: str | None) -> None:
     os.environ.clear()
     os.environ.update(env)  # the build's (PATH and the settings its tools read), not the forkserver's
     # A worker's progress bars never draw (BuildContext.for_workers), so their lock is a thread's: tqdm's default, a
@@ -47,76 +52,141 @@ def _start(ctx_bytes: bytes, env: dict, store_root: str | None) -> None:
     # after the build's one line.
     from tqdm import tqdm
     tqdm.set_lock(threading.RLock())
-    ctx = pickle.loads(ctx_bytes)
-    lib = type(ctx.library)(bricks=ctx.library.bricks, errors=ctx.library.errors)  # this process's own caches
-    _CONTEXT.append(replace(ctx, library=lib, store=Store(store_root) if store_root else None))
+    _CONTEXT.append(unpack(payload, Store(store_root) if store_root else None))
 
 
-def _task(items: list, extra: list) -> tuple:
-    """One chunk, in a worker: (composed, compose errors, results, costs by SPIR-V sha256, cache key by job
-    key, cache keys compiled here) — every value picklable."""
-    from ..analysis import cost_dict
+def pack(ctx: BuildContext, entries: Entries) -> bytes:
+    """What every worker of a build is given once: its context and what makes the entries (the scene, the keys)."""
+    return pickle.dumps((ctx.for_workers(), entries), protocol=pickle.HIGHEST_PROTOCOL)
 
-    ctx = _CONTEXT[0]
+
+def unpack(payload: bytes, store) -> tuple[BuildContext, Entries]:
+    """A worker's (context, entries) from pack's bytes, with this process's own store and library caches."""
+    ctx, entries = pickle.loads(payload)
+    lib = type(ctx.library)(bricks=ctx.library.bricks, errors=ctx.library.errors)
+    return replace(ctx, library=lib, store=store), entries
+
+
+def _task(hashes: list | None, extra: list) -> Chunk:
+    return run_chunk(*_CONTEXT[0], hashes, extra)
+
+
+@dataclass
+class Chunk:
+    """What a task sends back (every value picklable): its permutations composed (without their sources: the
+    tables read the rest), their compose errors, the entries made (hash -> entries.Made), the compile results
+    (without SPIR-V, which is in the entries' files; extra's whole, which the building process writes), the cache
+    key of every job, the cache keys compiled here, the templates composed with and the ubershader's entry."""
+
+    composed: dict
+    errors: dict
+    made: dict
+    results: dict
+    keys: dict
+    fresh: set
+    templates: set = field(default_factory=set)
+    ubershader: object = None
+
+
+def run_chunk(ctx: BuildContext, entries: Entries, hashes: list | None, extra: list, memo: dict | None = None) -> Chunk:
+    """One task, wherever it runs (a worker process, a Dask worker): the permutations `hashes` composed, compiled
+    (with the CompileJobs `extra`), analysed and their entries made (entries.py); hashes None: the ubershader."""
+    if hashes is None:
+        return _ubershader(ctx, entries, memo)
     try:
-        composed, errors, jobs = compose_chunk(ctx, items)
-        jobs = list(extra) + jobs
+        composed, errors, jobs = compose_chunk(ctx, [(h, entries.scene.permutations[h]) for h in hashes])
         stats = CompileStats()
-        results = compile_many(jobs, optimize=True, validate=True, store=ctx.store, stats=stats, workers=1)
-        costs = {}
-        for r in results.values():
-            if r.ok and r.spirv:
-                digest = sha256(r.spirv)
-                if digest not in costs:
-                    costs[digest] = cost_dict(r.spirv, ctx.store)
-    except UserError as e:  # a missing tool (exit 3) or another error: its class and message, as they pickle
-        raise (EnvironmentMissing if isinstance(e, EnvironmentMissing) else UserError)(str(e)) from None
-    keys = {j.key: cache_key(j, True, True) for j in jobs}
-    return composed, errors, results, costs, keys, stats.fresh
+        results = compile_many(list(extra) + jobs, optimize=True, validate=True, store=ctx.store, stats=stats,
+                               workers=1, memo=memo)
+        made = entries.make(ctx, list(composed.items()), results, {}) if composed else {}
+    except UserError as e:
+        raise _portable(e) from None
+    mine = {j.key for j in extra}
+    templates = {t for c in composed.values() for t in c.templates}
+    return Chunk({h: replace(c, sources=[], dialects=[]) for h, c in composed.items()}, errors, made,
+                 {k: r if k in mine else _slim(r) for k, r in results.items()},
+                 {k: r.cache_key for k, r in results.items()}, stats.fresh, templates)
+
+
+def _ubershader(ctx: BuildContext, entries: Entries, memo: dict | None) -> Chunk:
+    """The ubershader composed, its shaders compiled (as many tools at once as it has shaders: they are the largest
+    of the build) and its entry made."""
+    from ..toolchain.jobs import source_jobs
+    try:
+        unit = compose_ubershader(entries.scene, ctx.library, ctx.languages)
+        jobs = source_jobs("ubershader", unit[0].sources) if isinstance(unit, tuple) else []
+        stats = CompileStats()
+        results = compile_many(jobs, optimize=True, validate=True, store=ctx.store, stats=stats,
+                               workers=max(1, min(len(jobs), os.cpu_count() or 1)), memo=memo)
+        made = entries.ubershader(ctx, unit, results, {})
+    except UserError as e:
+        raise _portable(e) from None
+    return Chunk({}, {}, {}, {k: _slim(r) for k, r in results.items()}, {k: r.cache_key for k, r in results.items()},
+                 stats.fresh, set(unit[0].templates) if isinstance(unit, tuple) else set(), made)
+
+
+def _slim(r):
+    return replace(r, spirv=None, spirv_unopt=None, diagnostics=[])
+
+
+def _portable(e: UserError) -> UserError:
+    """A missing tool (exit 3) or another error: its class and message, as they pickle."""
+    return (EnvironmentMissing if isinstance(e, EnvironmentMissing) else UserError)(str(e))
 
 
 def compile_in_workers(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileStats, workers: int,
-                       out: Compiled) -> None:
-    """loop.compile_permutations in `workers` processes (items: sorted (hash, Permutation) pairs), into `out`."""
+                       out: Compiled, entries: Entries, ubershader: bool = False) -> None:
+    """loop.compile_permutations in `workers` processes, or on the Dask cluster of ctx.executor (cluster.py), into
+    `out` (items: sorted (hash, Permutation) pairs; entries: what makes their manifest entries)."""
     from tqdm import tqdm
 
-    size = chunk_size(len(items), workers)
-    chunks = [items[k:k + size] for k in range(0, len(items), size)]
     seen: set[str] = set()  # the cache keys of every job
     fresh: set[str] = set()  # those some worker compiled (the others came from the cache)
 
-    def take(value) -> dict:
-        composed, errors, part, costs, keys, compiled = value
-        out.add(composed, errors)
-        out.results.update(part)
-        out.costs.update(costs)
-        stats.jobs += len(keys)
-        seen.update(keys.values())
-        fresh.update(compiled)
-        return part
+    def take(value: Chunk) -> tuple:
+        out.add(value.composed, value.errors)
+        out.templates.update(value.templates)
+        out.results.update(value.results)
+        if value.ubershader is not None:
+            out.ubershader = value.ubershader
+        stats.jobs += len(value.keys)
+        seen.update(value.keys.values())
+        fresh.update(value.fresh)
+        return value.results, value.made
 
-    # without a cache (--no-cache), the workers share a private one for this build alone, so that a shader is
+    if not items and not ubershader and not extra:
+        return
+    # without a cache (--no-cache), the local workers share a private one for this build alone, so that a shader is
     # compiled once whichever chunks have it (the in-process build's memo); named like the toolchain's temp dirs, a
     # killed build's is removed by the next
-    private = None if ctx.store is not None else tempfile.mkdtemp(prefix=f"shadermatrix-{os.getpid()}-build-")
-    init = (pickle.dumps(ctx.for_workers()), dict(os.environ), str(ctx.store.root) if ctx.store else private)
-    # the ubershader's large shaders first, one task each: they spread over the workers
-    tasks = [([], [job]) for job in extra] + [(chunk, []) for chunk in chunks]
-    done: dict[int, tuple] = {}  # chunks back before an earlier one: written when it is
-    following = 0  # the next chunk to write
+    local = ctx.executor is None
+    private = None if ctx.store is not None or not local else tempfile.mkdtemp(
+        prefix=f"shadermatrix-{os.getpid()}-build-")
+    payload = pack(ctx, entries)
     try:
-        with Workers(workers, _start, init, _task, _PRELOAD) as pool, \
-                tqdm(total=len(items), disable=not ctx.progress, unit="permutation", leave=False) as bar:
-            for k, value in pool.unordered(tasks):
-                if k < len(extra):
+        if local:
+            pool = Workers(workers, _start, (payload, dict(os.environ), str(ctx.store.root) if ctx.store else private),
+                           _task, _PRELOAD)
+        else:
+            from .cluster import Cluster
+            pool = Cluster(ctx.executor, payload, ctx.platforms, cached=ctx.store is not None)
+        with pool, tqdm(total=len(items), disable=not ctx.progress, unit="permutation", leave=False) as bar:
+            size = chunk_size(len(items), workers if local else pool.threads())
+            chunks = [[h for h, _ in items[k:k + size]] for k in range(0, len(items), size)]
+            # the ubershader first (composed there, or its large shaders one task each: they spread over the workers)
+            first = [(None, [])] if ubershader else [([], [job]) for job in extra]
+            done: dict[int, Chunk] = {}  # chunks back before an earlier one: written when it is
+            following = 0  # the next chunk to write
+            for k, value in pool.unordered(first + [(chunk, []) for chunk in chunks]):
+                if k < len(first):
                     take(value)
                     continue
-                done[k - len(extra)] = value
+                done[k - len(first)] = value
                 while following in done:  # written in chunk order, each as soon as it and those before are back
-                    part = take(done.pop(following))
+                    part, made = take(done.pop(following))
                     chunk = chunks[following]
                     if on_done is not None:
-                        on_done([(h, out.composed[h]) for h, _ in chunk if h in out.composed], part)
+                        on_done([(h, out.composed[h]) for h in chunk if h in out.composed], part, made)
                     bar.update(len(chunk))
                     following += 1
     finally:

@@ -34,6 +34,14 @@ class Writer:
     def put(self, rel: str, data: bytes) -> None:
         self.count(atomic_write(self.out / rel, data))
 
+    def put_shared(self, rel: str, data: bytes) -> None:
+        """Write a SPIR-V module that identical ones share: once per build, the others counted as aliased."""
+        if rel in self._done:
+            self.res.aliased += 1
+        else:
+            self._done.add(rel)
+            self.put(rel, data)
+
     def unit(self, name: str, sources, results, entry: dict) -> list[str]:
         """Write a unit's sources and SPIR-V into `entry` only when every one compiled; else write the failing
         sources beside and return the errors."""
@@ -68,11 +76,7 @@ class Writer:
         # one file, and every manifest item that has them names it (aliased); sources keep their own header
         rel_spv = f"{LANGUAGE_TREE}/{src.language}/{spv_sha[:16]}.{src.stage}.spv"
         self.put(rel_src, data)
-        if rel_spv in self._done:
-            self.res.aliased += 1
-        else:
-            self._done.add(rel_spv)
-            self.put(rel_spv, r.spirv)
+        self.put_shared(rel_spv, r.spirv)
         return {"source": rel_src, "source_sha256": src_sha, "spirv": rel_spv, "spirv_sha256": spv_sha,
                 "cost": self.cost(spv_sha, r.spirv)}
 

@@ -1,16 +1,16 @@
-"""Compile jobs on a Dask distributed cluster (`build --executor dask://HOST:PORT`).
+"""A Dask distributed cluster (`build --executor dask://HOST:PORT`): the connection, and compile jobs run there.
 
-A compile job is a pure function of its inputs (source, language, stage, flags, tool versions: the
-cache key), so any worker can run it. The jobs are cut into chunks (four per worker), each chunk is
-compiled on a worker by the same code as a local build (toolchain.compile_all), and the results come
-back to this process, which deduplicates, serves and fills the content-addressed store exactly as it
-does for a local build: the output is byte-identical.
+A build sends its workers whole chunks — compose, compile, analyse, the manifest entries made — through
+assemble/cluster.py, which holds this module's DaskExecutor for the connection (the scheduler's address, its
+workers) and refuses a worker whose generator or tools differ from the build's (WorkerMismatch).
 
-A worker needs what a build machine needs: this shadermatrix version (importable: same code) and the
-pinned tools (glslc, naga, spirv-opt, spirv-val: `make setup`). Each chunk first checks the worker's tool
-versions against this build's (they are part of every cache key); a worker without a tool, or with
-another version, fails the build with one line naming the worker and the tool — a result from another
-compiler is never taken.
+compile_many(executor=DaskExecutor(...)) runs only the compiles there: a compile job is a pure function of
+its inputs (source, language, stage, flags, tool versions: the cache key), so any worker can run it. The
+jobs are cut into chunks (four per worker), each compiled on a worker by the same code as a local build
+(toolchain.compile_all), and the results come back to this process, which deduplicates, serves and fills the
+content-addressed store as it does for a local build. Each chunk first checks the worker's tool versions
+against this process's; a worker without a tool, or with another version, fails with one line naming the
+worker and the tool — a result from another compiler is never taken.
 """
 from __future__ import annotations
 

@@ -1,0 +1,141 @@
+"""A compiled chunk's manifest entries and files, made wherever the chunk was compiled, written by the build.
+
+Making a permutation's entry (its head, bricks, interface, uploads, the languages' and platforms' items, the
+platform dialects validated, the d3d12 binary step) is most of what writing a chunk costs; writing its files is
+the rest. So the two are apart: `make` runs where the chunk was composed and compiled — in this process for an
+in-process build, in the worker for `-j N` and on a Dask worker for `--executor dask://` — through a Recorder,
+which records the files a Writer would write instead of writing them; the building process then `replay`s them
+through its own Writer, in chunk order, and settles each entry (ok, or its last good entry kept, stale). One
+code path makes every entry, so the bytes are the same wherever it ran.
+
+What the workers need for it beside the build's context is an Entries value: the scene (its objects and their
+values, for the uploads) and every permutation's input key, sent once per build.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..lang import SourceError
+from ..link.uber import coverage
+from ..link.values import uploads
+from ..scene.load import Scene
+from .manifest import output_state, render_state
+from .write import Writer, validate_dialects
+
+
+@dataclass
+class Made:
+    """One permutation's entry as made (not yet settled), the errors that fail it, and the files to write:
+    (path in the output, bytes or None, whether it is a SPIR-V module that identical ones share: None for one the
+    chunk made already, written once)."""
+
+    entry: dict
+    errors: list[str]
+    files: list[tuple[str, bytes | None, bool]]
+
+
+@dataclass
+class Entries:
+    """What a permutation's entry is made of besides its compiled unit (sent to the workers once per build)."""
+
+    scene: Scene
+    keys: dict[str, str]  # permutation hash -> input key
+    uber_key: str = ""  # the ubershader's input key
+    users: dict[str, list[dict]] = field(default_factory=dict)  # hash -> the objects drawn with it
+
+    def __post_init__(self):
+        if not self.users:
+            for o in self.scene.objects:
+                self.users.setdefault(o["permutation"], []).append(o)
+
+    def __getstate__(self):  # the users are the scene's objects again: not sent twice
+        return {"scene": self.scene, "keys": self.keys, "uber_key": self.uber_key}
+
+    def __setstate__(self, state):
+        self.__init__(state["scene"], state["keys"], state["uber_key"])
+
+    def head(self, library, h: str) -> dict:
+        """What the entry of permutation h says before anything is composed (a failed one keeps this much)."""
+        perm = self.scene.permutations[h]
+        head = {"id": perm.canonical(), "hash": h, "input_key": self.keys[h],
+                "objects": self.scene.users.get(h, []), "languages": {}, "render_state": render_state(perm.surface)}
+        out = library.get("output", perm.output)  # None: an unknown brick, which fails the permutation
+        if out is not None:
+            head["output"] = output_state(out)
+        return head
+
+    def make(self, ctx, pairs, part: dict, costs: dict) -> dict[str, Made]:
+        """{hash: Made} of a compiled chunk: pairs, its (hash, Composed) in chunk order; part, its compile results by
+        job key; costs, the SPIR-V costs by sha256 (filled in with any not analysed yet)."""
+        checked = validate_dialects(pairs, ctx.store, ctx.gate) if ctx.dialects else {}
+        out, rec = {}, Recorder(ctx, costs)
+        for h, c in pairs:
+            rec.files = []
+            entry = {**self.head(ctx.library, h), "bricks": dict(sorted(c.bricks.items())),
+                     "interface": c.interface.as_dict(), "uploads": uploads(self.scene, h, c, self.users.get(h, []))}
+            errs = rec.unit(h, c.sources, part, entry)
+            if not errs:
+                errs = rec.platforms(h, c, entry, checked, self.scene.permutations[h].precision)
+                if errs:  # failed_sources stays: a failing GL core source is written beside (write_platforms)
+                    entry.pop("platforms", None)
+                    entry["languages"] = {}
+            out[h] = Made(entry, errs, rec.files)
+        return out
+
+
+    def ubershader(self, ctx, unit, results: dict, costs: dict) -> Made | None:
+        """The ubershader's entry as made from `unit` (compose_ubershader's) and its compile results; None without
+        permutations. The build fails, naming the value, when an axis value of the matrix is not reachable in it."""
+        if unit is None:
+            return None
+        if isinstance(unit, str):
+            return Made({"input_key": self.uber_key, "languages": {}}, [unit], [])
+        c, u = unit
+        perms = [p for _, p in sorted(self.scene.permutations.items())]
+        entry = {"input_key": self.uber_key, "hash": c.hash, "languages": {}, "tables": u.tables(),
+                 "interface": c.interface.as_dict()}
+        rec = Recorder(ctx, costs)
+        errs = [f"coverage: {p}" for p in coverage(u, perms, ctx.library)]
+        errs += rec.unit("ubershader", c.sources, results, entry)
+        return Made(entry, errs, rec.files)
+
+
+def compose_ubershader(scene: Scene, lib, languages):
+    """(Composed, Uber) of the scene's ubershader, the compose error as text, or None without permutations."""
+    from ..compose.uber import compose_ubershader as compose
+    perms = [p for _, p in sorted(scene.permutations.items())]
+    if not perms:
+        return None
+    try:
+        return compose(perms, lib, languages)
+    except SourceError as e:
+        return str(e)
+
+
+class _Counts:
+    """The part of a BuildResult a Recorder's Writer methods touch: the costs (the chunk's), nothing counted."""
+
+    def __init__(self, costs: dict):
+        self.costs, self.written, self.unchanged, self.aliased = costs, 0, 0, 0
+
+
+class Recorder(Writer):
+    """A Writer that records the files it would write (`files`) instead of writing them."""
+
+    def __init__(self, ctx, costs: dict):
+        super().__init__(None, ctx, _Counts(costs))
+        self.files: list[tuple[str, bytes | None, bool]] = []
+        self._sent: set[str] = set()  # the shared modules of this chunk recorded with their bytes
+
+    def put(self, rel: str, data: bytes) -> None:
+        self.files.append((rel, data, False))
+
+    def put_shared(self, rel: str, data: bytes) -> None:
+        self.files.append((rel, None if rel in self._sent else data, True))  # its bytes travel once per chunk
+        self._sent.add(rel)
+
+
+def replay(writer: Writer, files) -> None:
+    """Write a Made's files through the build's writer, as the Writer would have written them."""
+    for rel, data, shared in files:
+        (writer.put_shared if shared else writer.put)(rel, data)  # a shared module without bytes: written already
