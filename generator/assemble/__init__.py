@@ -24,7 +24,7 @@ from ..toolchain import CompileStats, tool_versions
 from ..toolchain.jobs import source_jobs
 from . import state
 from .context import BuildContext
-from .entries import Entries, compose_ubershader, replay
+from .entries import Entries, compose_ubershader, encode_manifest, replay
 from .keys import build_key, scene_keys
 from .loop import compile_permutations, in_workers
 from .manifest import FORMAT_VERSION, check as check_manifest, conventions, material_states
@@ -134,6 +134,7 @@ class _Build:
         self.previous: dict = {}
         self.old: dict[str, dict] = {}  # the previous manifest's entries by hash
         self.built: dict[str, dict] = {}
+        self.texts: dict[str, tuple] = {}  # hash -> (its built entry, its text, its holes): encode_manifest
         self.uber_kept = False
         self.kept: set[str] = set()
 
@@ -210,6 +211,8 @@ class _Build:
             replay(self.writer, m.files)
             self.built[h] = self._settle(m.entry, m.errors, self.old.get(h),
                                          _failure_head(self.scene, h, self.users.get(h, [])))
+            if m.text is not None:
+                self.texts[h] = (self.built[h], m.text, m.holes)
 
     def _finish(self) -> None:
         """The removed entries, tables and packs, then the manifest, then what it no longer names goes, then the
@@ -235,7 +238,7 @@ class _Build:
             self.writer.count(False)
             text = (out / "manifest.json").read_bytes()
         else:
-            text = (json.dumps(res.manifest, indent=2, sort_keys=False) + "\n").encode()
+            text = encode_manifest(res.manifest, self.texts)  # json.dumps(indent=2), the entries' texts made already
             self.writer.put("manifest.json", text)
         collect_garbage(out, res.manifest)  # the new manifest is in place: drop what it no longer names
         from .pack import collect_packs

@@ -13,13 +13,15 @@ values, for the uploads) and every permutation's input key, sent once per build.
 """
 from __future__ import annotations
 
+import json
+import os
 from dataclasses import dataclass, field
 
 from ..lang import SourceError
 from ..link.uber import coverage
 from ..link.values import uploads
 from ..scene.load import Scene
-from .manifest import output_state, render_state
+from .manifest import CHECK_ENV, output_state, render_state
 from .write import Writer, validate_dialects
 
 
@@ -32,6 +34,10 @@ class Made:
     entry: dict
     errors: list[str]
     files: list[tuple[str, bytes | None, bool]]
+    # a permutation that built: its entry as the manifest's text holds it, cut where its sampler descriptors are
+    # (split_text), and those descriptors, in order
+    text: list[str] | None = None
+    holes: list[dict] | None = None
 
 
 @dataclass
@@ -79,7 +85,12 @@ class Entries:
                 if errs:  # failed_sources stays: a failing GL core source is written beside (write_platforms)
                     entry.pop("platforms", None)
                     entry["languages"] = {}
-            out[h] = Made(entry, errs, rec.files)
+            text = holes = None
+            if not errs:  # as the build settles it (status ok), encoded here: most of writing the manifest
+                entry["status"] = "ok"
+                entry.pop("failed_sources", None)
+                text, holes = split_text(entry)
+            out[h] = Made(entry, errs, rec.files, text, holes)
         return out
 
 
@@ -98,6 +109,73 @@ class Entries:
         errs = [f"coverage: {p}" for p in coverage(u, perms, ctx.library)]
         errs += rec.unit("ubershader", c.sources, results, entry)
         return Made(entry, errs, rec.files)
+
+
+_HOLE = "\0shadermatrix: a sampler descriptor\0"
+_PLACE = "\0shadermatrix: the permutations\0"
+
+
+def _indented(entry: dict) -> str:
+    """A permutation entry as json.dumps(manifest, indent=2) writes it inside the manifest's list."""
+    return json.dumps(entry, indent=2).replace("\n", "\n    ")
+
+
+def split_text(entry: dict) -> tuple[list[str], list[dict]]:
+    """(The entry's text (_indented) cut where each sampler descriptor of its platforms' reflections stands, those
+    descriptors in the text's order). The build sets a light or table sampler's ``sampler_state`` in them once the
+    scene's samplers are numbered (texture_outputs.py), after the entry was made: they are encoded then, the rest
+    of the entry here."""
+    from .texture_outputs import _sampler_descriptors  # what texture_outputs may change: the same rows
+    holes: list[dict] = []
+    platforms = {}
+    for name, p in (entry.get("platforms") or {}).items():
+        refl = (p or {}).get("reflection")
+        wanted = {id(d) for d in _sampler_descriptors(refl)}
+        if not wanted:
+            platforms[name] = p
+            continue
+        cut = {}
+        for k, v in refl.items():
+            if isinstance(v, list) and any(id(d) in wanted for d in v):
+                holes += [d for d in v if id(d) in wanted]
+                v = [_HOLE if id(d) in wanted else d for d in v]
+            cut[k] = v
+        platforms[name] = {**p, "reflection": cut}
+    text = _indented({**entry, "platforms": platforms} if holes else entry)
+    parts = text.split(json.dumps(_HOLE))
+    assert len(parts) == len(holes) + 1
+    return parts, holes
+
+
+def _joined(parts: list[str], holes: list[dict]) -> str:
+    out = [parts[0]]
+    for d, after in zip(holes, parts[1:]):
+        indent = out[-1][out[-1].rfind("\n") + 1:]  # where the descriptor stands: its line's indentation
+        out += [json.dumps(d, indent=2).replace("\n", "\n" + indent), after]
+    return "".join(out)
+
+
+def encode_manifest(manifest: dict, texts: dict) -> bytes:
+    """json.dumps(manifest, indent=2) + "\n", as bytes, taking each permutation entry's text from `texts` (hash ->
+    (the entry, its Made.text, its Made.holes)) where it is that very entry: json's indented encoder is Python, and
+    encoding the entries is most of what writing the manifest costs, so the workers encode them (split_text). An
+    entry is not changed once settled but for its sampler descriptors' states, which are encoded here. With
+    SHADERMATRIX_CHECK_MANIFEST set (the tests), the text is compared with json.dumps's."""
+    perms = manifest["permutations"]
+    if not perms:
+        return (json.dumps(manifest, indent=2) + "\n").encode()
+    parts = []
+    for e in perms:
+        known = texts.get(e.get("hash"))
+        parts.append(_joined(known[1], known[2]) if known is not None and known[0] is e else _indented(e))
+    shell = json.dumps({**manifest, "permutations": _PLACE}, indent=2)
+    placed = json.dumps(_PLACE)
+    assert shell.count(placed) == 1
+    text = shell.replace(placed, "[\n    " + ",\n    ".join(parts) + "\n  ]") + "\n"
+    if os.environ.get(CHECK_ENV) and text != json.dumps(manifest, indent=2) + "\n":
+        raise AssertionError("the manifest's text is not json.dumps(manifest, indent=2): an entry changed after its "
+                             "text was made (entries.split_text)")
+    return text.encode()
 
 
 def compose_ubershader(scene: Scene, lib, languages):
