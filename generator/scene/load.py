@@ -20,88 +20,16 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..io.bulk import collector_paused
 from ..library.bricks import Library
 from ..lang import SourceError
-from ..lang.errors import read_text
+from ..lang.errors import MAX_INPUT_BYTES, read_text
 from ..spec.permutation import PRECISIONS, LightKey, Permutation, SpecError, canonical, parse_brdf, parse_spec
 from ..spec.resolve import Resolved, check_packing, light_params, resolve
 from ..spec.surface import DEFAULT as DEFAULT_SURFACE, Surface
 from ..spec.where import Origin, Where
+from .locate import Locator
 from .textures import declared, toml_bindings
-
-
-class Locator:
-    """Finds line:col of tables and keys in TOML text (tomllib keeps no positions).
-
-    Knows the forms a scene is written in: [a.b] and [[a]] headers (quoted parts too: [materials."m"]),
-    keys inside inline tables (params = { n = 1 }), dotted keys (params.n = 1) and sub-tables
-    ([materials.m.params]). What it cannot find is located at its table's header, or at 1:1."""
-
-    _HEADER = re.compile(r"^\s*\[\[?\s*([^\[\]]*?)\s*\]\]?")
-
-    def __init__(self, path: str, text: str):
-        self.path, self.lines = path, text.splitlines()
-        self._headers: dict[str, list[int]] | None = None  # "a.b" -> the lines of its [a.b] / [[a.b]] headers
-
-    @staticmethod
-    def _name(header: str) -> str:
-        return ".".join(p.strip().strip("\"'") for p in header.split("."))
-
-    def _header(self, header: str, nth: int = 0) -> int:
-        if self._headers is None:  # one pass over the text, on the first lookup: every lookup is then O(1)
-            self._headers = {}
-            for i, line in enumerate(self.lines):
-                m = self._HEADER.match(line)
-                if m:
-                    self._headers.setdefault(self._name(m[1]), []).append(i)
-        hits = self._headers.get(self._name(header), [])
-        return hits[nth] if len(hits) > nth else -1
-
-    @staticmethod
-    def _key(k: str) -> str:
-        e = re.escape(k)
-        return rf"(?:{e}|\"{e}\"|'{e}')"
-
-    def find(self, header: str, *keys: str, nth: int = 0) -> tuple[int, int]:
-        """(line, col) of header's key path (keys may continue inside an inline table)."""
-        if header and keys and header != "objects":
-            for j in range(len(keys), 0, -1):  # the deepest sub-table: [materials.m.params], [materials.m.samplers.t]
-                sub = ".".join((header, *keys[:j]))
-                if self._header(sub) >= 0:
-                    return self.find(sub, *keys[j:])
-        start = self._header(header, nth) if header else -1
-        if header and start < 0:
-            return 1, 1
-        line_no, col = start + 1, 1
-        i = start + 1
-        while i < len(self.lines) and keys:
-            line = self.lines[i]
-            if re.match(r"^\s*\[", line):
-                break
-            for j in range(len(keys), 0, -1):  # the longest dotted prefix of the path: params.n = 1
-                m = re.match(r"^\s*" + r"\s*\.\s*".join(self._key(k) for k in keys[:j]) + r"\s*=", line)
-                if m:
-                    break
-            if m:
-                last = re.search(self._key(keys[j - 1]) + r"\s*=", line[:m.end()])
-                line_no, col = i + 1, (last.start() if last else line.index(keys[0])) + 1
-                for k in keys[j:]:
-                    km = re.search(r"(?<![\w.])" + self._key(k) + r"\s*=", line[col:])
-                    if km:
-                        col = col + km.start() + 1
-                return line_no, col
-            i += 1
-        return line_no, col
-
-    def top(self, key: str) -> tuple[int, int]:
-        """(line, col) of a top-level table [key] / [[key]] or a top-level `key =`."""
-        for i, line in enumerate(self.lines):
-            if re.match(r"^\s*\[\[?\s*" + re.escape(key) + r"\b", line) or re.match(r"^\s*" + re.escape(key) + r"\s*=", line):
-                return i + 1, line.index(key) + 1
-        return 1, 1
-
-    def error(self, where: tuple[int, int], message: str, hint: str = "") -> SourceError:
-        return SourceError(self.path, where[0], where[1], message, hint)
 
 
 @dataclass
@@ -144,10 +72,11 @@ class Scene:
     extra: dict = field(default_factory=dict)  # an importer's own data: glTF's extensions and pygltflib document
 
 
-def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]:
-    """A TOML file's data and a Locator over its text; a syntax error is a located SourceError."""
+def read_toml(path: Path, what: str, syntax_hint: str, limit: int = MAX_INPUT_BYTES) -> tuple[dict, "Locator"]:
+    """A TOML file's data and a Locator over its text (at most `limit` bytes); a syntax error is a located
+    SourceError."""
     shown = str(path)
-    text = read_text(path, what)
+    text = read_text(path, what, limit)
     try:
         data = tomllib.loads(text)
     except (RecursionError, MemoryError):  # tomllib recurses on nested arrays and inline tables
@@ -161,6 +90,9 @@ def read_toml(path: Path, what: str, syntax_hint: str) -> tuple[dict, "Locator"]
     return data, Locator(shown, text)
 
 
+# a scene file larger than this is refused: one of 100,000 permutations written plainly (scenegen.py) is 17 MB,
+# and reading one takes about 0.6 s per MB
+MAX_SCENE_BYTES = 64 << 20
 SCENE_SUFFIXES = (".toml", ".gltf", ".glb")  # what a SCENE argument may be: TOML, or glTF 2.0 (scene/gltf.py)
 MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed SPIR-V's 255 function arguments
 
@@ -171,10 +103,15 @@ def load_scene(path, lib: Library) -> Scene:
     if path.suffix.lower() in SCENE_SUFFIXES[1:]:
         from .gltf import load_gltf
         return load_gltf(path, lib)
+    with collector_paused():  # what loading makes lives on: io/bulk.py
+        return _load_toml(path, lib)
+
+
+def _load_toml(path: Path, lib: Library) -> Scene:
     shown = str(path)
     if path.is_dir():
         raise SourceError(shown, 1, 1, "is a directory, not a scene file", "pass a .toml scene file")
-    data, loc = read_toml(path, "scene", "fix the scene file's syntax")
+    data, loc = read_toml(path, "scene", "fix the scene file's syntax", MAX_SCENE_BYTES)
     from .schema import check
     check(data, loc)  # the shape first: keys and types (scene/schema.py), then what the names mean
     head = data.get("scene", {})
@@ -193,7 +130,9 @@ def load_scene(path, lib: Library) -> Scene:
 
     # where each part of a permutation key was asked for (spec/where.py): errors resolving or linking it point there
     parts: dict[str, tuple] = {}
-    image_cache: dict = {}  # resolved path -> DecodedImage: a file several materials name is read once
+    # resolved path -> DecodedImage: a file several materials name is read once; ("generated", texture name) ->
+    # (image, digest): the image a texture no file is named for gets (scene/textures.py)
+    image_cache: dict = {}
     for name, m in _table(loc, data, "materials").items():
         where = loc.find(f"materials.{name}")
         if not isinstance(m, dict) or "brdf" not in m:

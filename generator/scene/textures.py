@@ -160,8 +160,12 @@ def toml_bindings(loc, header: str, m: dict, decls: dict, base: Path, cache: dic
     out = {}
     for tname, decl in decls.items():
         sampler = toml_sampler(loc, header, tname, samplers.get(tname, {}))
-        if tname not in textures:
-            out[tname] = generated(tname, decl, sampler)
+        if tname not in textures:  # the generated image: made and digested once per texture name, not per
+            if ("generated", tname) not in cache:  # material (10,000 materials left 10,000 equal images)
+                image = generated_image(tname)
+                cache[("generated", tname)] = (image, image_digest(image))
+            image, digest = cache[("generated", tname)]
+            out[tname] = TextureBinding(tname, "generated", *holds_of(decl), sampler, digest, image)
             continue
         where = loc.find(header, "textures", tname)
         text = textures[tname]

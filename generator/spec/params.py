@@ -65,10 +65,17 @@ def _error(brick, message: str, hint: str) -> SourceError:
     return SourceError(brick.display_path, loc.line, loc.col, message, hint)
 
 
-def _merge(nodes) -> Params:
-    """The policy over every brick below `nodes` (spec Nodes, callers first), in order."""
-    out: dict[str, ParamSpec] = {}
-    first: dict[str, object] = {}
+def _merge(nodes, start: tuple[dict, dict] | None = None) -> Params:
+    """The policy over every brick below `nodes` (spec Nodes, callers first), in order; from `start` (the state
+    _merged left after the nodes before these: the merge goes brick by brick, so a permutation's material group
+    continues from its BRDF's instead of walking the BRDF's bricks again)."""
+    return _merged(nodes, start)[0]
+
+
+def _merged(nodes, start: tuple[dict, dict] | None = None) -> tuple[Params, tuple[dict, dict]]:
+    """(_merge's Params, the state it ends in: {name: ParamSpec}, {name: the brick that declared it first})."""
+    out: dict[str, ParamSpec] = dict(start[0]) if start else {}
+    first: dict[str, object] = dict(start[1]) if start else {}
     for top in nodes:
         for node in top.walk():
             b = node.brick
@@ -96,7 +103,7 @@ def _merge(nodes) -> Params:
                     raise _error(first[name], f"default of '{name}' does not fit {b.display_path}'s range: {problem}",
                                  "move the default inside the range every brick of the spec allows")
                 out[name] = ParamSpec(name, old.ty, old.default, rng, old.doc or p.doc, old.owners + (b.display_path,))
-    return Params(out)
+    return Params(out), (out, first)
 
 
 @dataclass(frozen=True)
@@ -120,15 +127,35 @@ class Policy:
     lights: tuple[LightPolicy, ...] = ()
 
 
-def spec_params(brdf=(), packing=None, output=None, lights=()) -> Policy:
+def spec_params(brdf=(), packing=None, output=None, lights=(), memo: dict | None = None) -> Policy:
     """The one parameter policy of a permutation: brdf (its term Nodes), packing and output (a Node each, or
-    None), lights ((light Node, shadow Node) per light). Raises a SourceError at the brick that breaks it."""
-    own = _merge(brdf)
-    material = _merge([*brdf, *([packing] if packing is not None else []), *([output] if output is not None else [])])
-    packed = _merge([packing]) if packing is not None else Params()
-    out = _merge([output]) if output is not None else Params()
-    groups = tuple(LightPolicy(_merge([ln, sh]), _merge([ln]), _merge([sh])) for ln, sh in lights)
+    None), lights ((light Node, shadow Node) per light). Raises a SourceError at the brick that breaks it.
+
+    memo (the library's): each group of bricks merged once — a scene's permutations share their BRDFs, packings,
+    lights and output, and only the material group (BRDF, packing and output together) is theirs alone."""
+    def merged(nodes):
+        return _merged(nodes) if memo is None else _cached(nodes, memo)
+
+    own, state = merged(brdf)
+    material = _merge([*([packing] if packing is not None else []), *([output] if output is not None else [])], state)
+    packed = merged([packing])[0] if packing is not None else Params()
+    out = merged([output])[0] if output is not None else Params()
+    groups = tuple(LightPolicy(merged([ln, sh])[0], merged([ln])[0], merged([sh])[0]) for ln, sh in lights)
     return Policy(own, Params({k: s for k, s in packed.items() if k not in own}), out, material, groups)
+
+
+def _cached(nodes, memo: dict):
+    """_merged(nodes), kept in `memo` per these very Node objects (the entry holds them, so their ids name no
+    other node while it lives): the spec stage keeps one Node per spec string and brick (parse_spec's memo), made
+    again when a brick is replaced, so a hit is always a merge of the bricks the nodes hold. A merge that raises
+    is not kept."""
+    key = ("params", *map(id, nodes))
+    hit = memo.get(key)
+    if hit is not None:
+        return hit[1]
+    value = _merged(nodes)
+    memo[key] = (tuple(nodes), value)
+    return value
 
 
 def flat(specs: dict[str, ParamSpec]) -> list[tuple[str, str, int | None, Type, ParamSpec]]:

@@ -128,19 +128,52 @@ def light_params(lib: Library, light: str, shadow: str) -> Params:
 
 
 def resolve(perm: Permutation, lib: Library) -> Resolved:
-    """Everything `perm` means (module docstring); errors are located at the part of the key that is wrong."""
+    """Everything `perm` means (module docstring); errors are located at the part of the key that is wrong.
+
+    The value depends on the key alone: where it was asked for (its origin) only locates errors. So a key
+    resolved once, from anywhere, is the same value for another origin (its perm and origin swapped in), and a
+    scene's 10,000 materials and the matrix report's every BRDF × packing pair each resolve once."""
     key = ("resolved", perm, perm.origin)
     hit = lib.memo.get(key)
     if hit is not None and _fresh(_bricks(hit), lib):
         return hit
+    same = lib.memo.get(("resolved", perm, None))
+    if same is not None and _fresh(_bricks(same), lib):
+        r = lib.memo[key] = replace(same, perm=perm, origin=perm.origin)
+        return r
     with within(perm.origin, perm.canonical()):
         r = lib.memo[key] = _resolve(perm, lib)
+    if perm.origin is not None:
+        lib.memo[("resolved", perm, None)] = replace(r, perm=replace(perm, origin=None), origin=None)
     return r
 
 
 def _bricks(r: Resolved) -> list[Brick]:
     return [x.brick for x in _walk(*r.brdf, r.packing, *(lt.shadow for lt in r.lights))] \
         + [lt.brick for lt in r.lights] + [r.output]
+
+
+def _kept(lib: Library, what: str, nodes, make):
+    """make(), kept in the library's memo per these very Node objects (as params._cached: the entry holds them,
+    and parse_spec makes new ones when a brick is replaced)."""
+    key = (what, *map(id, nodes))
+    hit = lib.memo.get(key)
+    if hit is not None:
+        return hit[1]
+    value = make()
+    lib.memo[key] = (tuple(nodes), value)
+    return value
+
+
+def _node(lib: Library, brick: Brick) -> Node:
+    """The Node of a brick without fillers (a light, an output), one per brick: what _kept and the parameter
+    memo key on."""
+    key = ("node", brick.kind, brick.id)
+    hit = lib.memo.get(key)
+    if hit is not None and hit.brick is brick:
+        return hit
+    node = lib.memo[key] = Node(brick, ())
+    return node
 
 
 def _resolve(perm: Permutation, lib: Library) -> Resolved:
@@ -155,13 +188,13 @@ def _resolve(perm: Permutation, lib: Library) -> Resolved:
         if lb is None:
             raise KeyProblem(f"light{i}", f"unknown light brick '{lk.light}'",
                              f"known: {', '.join(b.id for b in lib.of_kind('light'))}")
-        pairs.append((lb, Node(lb, ()), parse_spec(lk.shadow, lib, ("shadow",))[0]))
+        pairs.append((lb, _node(lib, lb), parse_spec(lk.shadow, lib, ("shadow",))[0]))
     out = lib.get("output", perm.output)
     if out is None:
         raise KeyProblem("output", f"unknown output brick '{perm.output}'",
                          f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
-    out_node = Node(out, ())
-    policy = spec_params(brdf, packing, out_node, [(ln, sh) for _, ln, sh in pairs])
+    out_node = _node(lib, out)
+    policy = spec_params(brdf, packing, out_node, [(ln, sh) for _, ln, sh in pairs], memo=lib.memo)
     lights = tuple(LightPart(lb, ln, sh, lk.dynamic, lp.params, lp.light, lp.shadow,
                              tuple(t for x in sh.tree for t in x.brick.textures))
                    for (lb, ln, sh), lk, lp in zip(pairs, perm.lights, policy.lights))
@@ -169,12 +202,17 @@ def _resolve(perm: Permutation, lib: Library) -> Resolved:
     for top in (*brdf, packing, out_node):
         for name, d in top.textures.items():
             textures.setdefault(name, d)
+    # what the BRDF reads and whether the packing supplies a tangent: the same for every permutation sharing them
+    tangent, inputs = _kept(lib, "brdf_inputs", brdf, lambda: (_tangent(brdf), _inputs(brdf)))
+    frame = _kept(lib, "packing_tangent", (packing,), lambda: supplies_tangent(packing))
     key = perm.canonical()
     r = Resolved(perm, key, perm.hash, brdf, "+".join(n.key for n in brdf), packing, dict(packing.fillers)["normal"],
                  lights, out, out_node, perm.surface, policy.brdf, policy.packing, policy.output, policy.material,
-                 Params(perm.surface.params()), Frozen(textures), _tangent(brdf), supplies_tangent(packing),
-                 _inputs(brdf), (), perm.origin)
-    return replace(r, problems=tuple(_problems(r)))
+                 Params(perm.surface.params()), Frozen(textures), tangent, frame, inputs, (), perm.origin)
+    # the verdict reads the value it belongs to: set before the value leaves here (a second dataclass made by
+    # replace() cost as much as the rest of a resolve that the memos serve)
+    object.__setattr__(r, "problems", tuple(_problems(r)))
+    return r
 
 
 def _problems(r: Resolved):
