@@ -4,7 +4,7 @@ Each task is one chunk of permutations, run on a Dask worker by the same functio
 (parallel.run_chunk): composed, compiled, analysed and its manifest entries and files made (entries.py). The
 building process plans (the keys, what is up to date) and writes what comes back, in chunk order: no composing,
 compiling or analysing there, so the cluster's size, not the building process, bounds the build
-(benchmarks/dask.py measures the building process's CPU per permutation).
+(benchmarks/dask_build.py measures the building process's CPU per permutation).
 
 What a chunk needs besides its hashes — the build's context (the bricks as this build parsed them) and the
 scene with every permutation's input key — is pickled once and scattered to every worker (parallel.pack); each
@@ -19,8 +19,9 @@ through its own cache ($SHADERMATRIX_CACHE_DIR there, else its default; none wit
 process remembers what it compiled for this build): the cache keys are the same everywhere.
 
 A worker that dies while it runs a chunk: Dask runs the chunk again on another worker (up to the scheduler's
-allowed failures, then the build fails in one line); a cluster with no worker left for NO_WORKERS_S fails the
-build instead of waiting. Run workers with one thread each (`dask worker --nworkers N --nthreads 1`): composing
+allowed failures, then the build fails in one line). A cluster that loses every worker loses the build's data
+with them, and the build fails in one line at once; one left without workers for NO_WORKERS_S fails it too,
+instead of waiting (tested: never a hang). Run workers with one thread each (`dask worker --nworkers N --nthreads 1`): composing
 is Python, which the threads of one process do not run in parallel.
 """
 from __future__ import annotations
@@ -127,10 +128,14 @@ class Cluster:
 
     def _refuse_mismatched(self) -> None:
         try:
-            reports = self.client.run(_report, self.platforms)
-        except Exception as e:  # noqa: BLE001 — a worker without shadermatrix cannot even unpickle the call
-            raise self._failed("cannot run this build's shadermatrix", e) from None
+            reports = self.client.run(_report, self.platforms, on_error="return")
+        except Exception as e:  # noqa: BLE001 — the scheduler went away
+            raise self._failed("stopped answering", e) from None
         for address, here in sorted(reports.items()):
+            if isinstance(here, OSError):  # it died as it was asked (CommClosedError): the scheduler drops it
+                continue
+            if isinstance(here, BaseException):  # one without this shadermatrix cannot even unpickle the call
+                raise _refusal(address, f"cannot run this build's shadermatrix ({type(here).__name__}: {here})")
             wrong = _differences(self.expected, here)
             if wrong:
                 raise _refusal(address, wrong)
@@ -193,5 +198,5 @@ class Cluster:
             raise e.with_traceback(f.traceback())
         try:
             return f.result()
-        except Exception as e:  # noqa: BLE001 — cancelled, or the result lost with its worker
-            raise self._failed("lost a chunk's result", e) from None
+        except Exception as e:  # noqa: BLE001 — cancelled: what it needed went with the workers that held it
+            raise self._failed("lost a chunk (its workers died, and the build's data with them)", e) from None

@@ -21,29 +21,42 @@ def sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def atomic_write(path: Path, data: bytes) -> bool:
+def atomic_write(path: Path, data: bytes, dirs: set | None = None) -> bool:
     """Write `data` to `path` atomically; returns False (and touches nothing) when unchanged.
 
     Atomic against the process dying at any instant (Ctrl-C, SIGTERM, kill -9): a reader sees the old
     file or the new one, never a part. Not fsync'ed: a power cut may leave a recent file empty, which
     the next build notices (a size or sha256 that is not the recorded one) and rebuilds; fsync per file
     cost more than the rest of writing a 1,000-permutation build (docs/design/build.md, "No fsync").
+    dirs: directories the caller knows exist (its set, filled in here), not made again: a build writes
+    thousands of files into a few directories. Plain os calls, no pathlib: a build's writing is mostly this
+    function, and the kernel's part (five calls for a new file) is all of it that is left.
     """
-    path = Path(path)
+    path = os.fspath(path)
     try:
-        if path.read_bytes() == data:
-            return False
+        with open(path, "rb") as f:
+            if f.read() == data:
+                return False
     except OSError:
         pass
-    path.parent.mkdir(parents=True, exist_ok=True)
+    parent, name = os.path.split(path)
+    parent = parent or "."
+    if dirs is None or parent not in dirs:
+        os.makedirs(parent, exist_ok=True)
+        if dirs is not None:
+            dirs.add(parent)
     # Created with mode 0666 and O_EXCL: the kernel applies the umask, as for any file a program writes
     # (tempfile.mkstemp would give 0600). The random part: a killed process's leftover of the same pid
     # (containers reuse pids run after run) never stands in the way.
-    tmp = path.parent / f".{path.name}.{os.getpid()}-{next(_TMP_SERIAL)}-{os.urandom(4).hex()}.tmp"
+    tmp = os.path.join(parent, f".{name}.{os.getpid()}-{next(_TMP_SERIAL)}-{os.urandom(4).hex()}.tmp")
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o666)
     try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view):]
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
     except BaseException:
         try:
