@@ -73,7 +73,7 @@ class BuildResult:
 
 
 def build(scene: Scene, out: Path, ctx: BuildContext, depfile=None, keep_removed: bool = False,
-          pack: bool = False, stamp=None) -> BuildResult:
+          pack: bool = False, stamp=None, request=None) -> BuildResult:
     """Build every permutation of `scene` into `out`; see the module docstring.
 
     ctx: the library, languages, platforms, compile cache, progress bar, jobs and executor (context.py).
@@ -81,6 +81,9 @@ def build(scene: Scene, out: Path, ctx: BuildContext, depfile=None, keep_removed
     the executor change no byte of the output. depfile: where to write a Make-syntax depfile (or None), for the
     target `stamp` when one is given (else OUT/manifest.json). stamp: a file replaced after every build that
     succeeds (none when it fails), so that a build system compares the inputs with the build's end (depfile.py).
+    request: what the command line asked for (noop.Request), or None: a build that succeeds then records what it
+    read (in ctx.store), so that the next one with the same request knows it is a no-op before loading the scene
+    (noop.py).
     keep_removed: the outputs of permutations that
     left the scene stay, listed under the manifest's ``removed`` (marked so), instead of being deleted.
     pack: also write one shader pack per platform (assemble/pack.py), listed under the manifest's ``packs``.
@@ -113,6 +116,12 @@ def build(scene: Scene, out: Path, ctx: BuildContext, depfile=None, keep_removed
                           inputs(scene, ctx.library, out, state.read(out).get("templates", [])))
         if stamp is not None and res.ok:
             touch(stamp)
+        if request is not None and ctx.store is not None:  # last, under the lock: what the next build checks first
+            from . import noop
+            if res.ok:
+                noop.record(out, request, scene, ctx.library, res, state.read(out).get("templates", []), ctx.store)
+            else:
+                noop.forget(out, ctx.store)
     return res
 
 
@@ -137,6 +146,11 @@ class _Build:
         self.texts: dict[str, tuple] = {}  # hash -> (its built entry, its text, its holes): encode_manifest
         self.uber_kept = False
         self.kept: set[str] = set()
+        self.pack_only = pack == "only"  # build --pack-only: the artifacts go to the packs alone (spool.py)
+        self.packed = None  # then: what the last build's packs hold (spool.Packed)
+        if self.pack_only:
+            from .spool import Spool
+            self.writer.spool = Spool(out)
 
     def run(self) -> BuildResult:
         scene, out, res, keys = self.scene, self.out, self.res, self.keys
@@ -145,12 +159,15 @@ class _Build:
             res.up_to_date, res.kept, res.unchanged = True, len(keys.permutations), files + 1
             return res
         self.previous = state.previous(out)
+        if self.pack_only:
+            from .spool import Packed
+            self.packed = Packed(out, self.previous)
         self.old = {e["hash"]: e for e in self.previous.get("permutations", [])}
         kept = {h: e for h in sorted(scene.permutations) if (e := self.old.get(h)) is not None
-                and e.get("input_key") == keys.permutations[h] and e.get("status") == "ok" and state.intact(out, e)}
+                and e.get("input_key") == keys.permutations[h] and e.get("status") == "ok" and self.intact(e, h)}
         old_uber = self.previous.get("ubershader") or {}
         uber_kept = (old_uber.get("input_key") == keys.ubershader and old_uber.get("status") == "ok"
-                     and state.intact(out, old_uber))
+                     and self.intact(old_uber, "ubershader"))
         self.uber_kept = uber_kept  # the record keeps the last build's templates for it (it is not composed)
         self.kept = set(kept)  # what the explanation of this build leaves out (inputs.py)
         todo = {h: p for h, p in scene.permutations.items() if h not in kept}
@@ -169,7 +186,7 @@ class _Build:
         for h in sorted(scene.permutations):
             if h in kept:
                 entries.append(kept[h])
-                res.unchanged += state.files(kept[h])
+                res.unchanged += self.files(kept[h])
             elif h in self.built:
                 entries.append(self.built[h])
             else:  # it did not compose
@@ -177,7 +194,7 @@ class _Build:
                                             _failure_head(scene, h, self.users.get(h, []))))
         if uber_kept:
             uber = old_uber
-            res.unchanged += state.files(uber)
+            res.unchanged += self.files(uber)
         else:
             made = compiled.ubershader if remote else self.entries.ubershader(self.ctx, uber_unit, compiled.results,
                                                                               res.costs)
@@ -189,6 +206,7 @@ class _Build:
             "tools": self.tools,
             "languages": list(self.ctx.languages),
             "platforms": list(self.ctx.platforms),
+            **({"artifacts": "packs"} if self.pack_only else {}),
             "conventions": conventions(self.ctx.platforms),
             "permutations": entries,
             "ubershader": uber,
@@ -209,6 +227,8 @@ class _Build:
             made = self.entries.make(self.ctx, pairs, part, self.res.costs)
         for h, m in made.items():
             replay(self.writer, m.files)
+            if self.pack_only:
+                self.writer.spool.settle(m.entry, h, self.ctx.platforms)
             self.built[h] = self._settle(m.entry, m.errors, self.old.get(h),
                                          _failure_head(self.scene, h, self.users.get(h, [])))
             if m.text is not None:
@@ -232,7 +252,10 @@ class _Build:
         write_textures(out, self.scene, res.manifest, self.writer.count, previous, self.base)
         if self.pack:  # written before the manifest that names them (content-named: the old ones stay until after it)
             from .pack import write_packs
-            res.manifest["packs"] = write_packs(out, res.manifest, self.writer.count)
+            res.manifest["packs"] = write_packs(out, res.manifest, self.writer.count,
+                                                self._fetch if self.pack_only else None)
+            if self.pack_only:
+                self.writer.spool.close()
         check_manifest(res.manifest)  # before it replaces the last one (SHADERMATRIX_CHECK_MANIFEST: the tests)
         if res.manifest == previous and (out / "manifest.json").is_file():  # nothing changed: not even re-encoded
             self.writer.count(False)
@@ -240,7 +263,7 @@ class _Build:
         else:
             text = encode_manifest(res.manifest, self.texts)  # json.dumps(indent=2), the entries' texts made already
             self.writer.put("manifest.json", text)
-        collect_garbage(out, res.manifest)  # the new manifest is in place: drop what it no longer names
+        collect_garbage(out, _loose(res.manifest) if self.pack_only else res.manifest)  # what it no longer names
         from .pack import collect_packs
         from .tables import collect_tables
         collect_packs(out, res.manifest)
@@ -260,7 +283,8 @@ class _Build:
             entry.pop("failed_sources", None)
             return entry
         failed = entry.get("failed_sources", {})
-        stale = old is not None and old.get("status") in ("ok", "stale") and state.intact(self.out, old)
+        stale = old is not None and old.get("status") in ("ok", "stale") and not self.pack_only \
+            and state.intact(self.out, old)  # --pack-only: the packs hold what builds, no stale outputs
         kept = "its last good outputs stay, marked stale" if stale else "it has no outputs yet"
         head, key = what
         self.res.failures.append("\n  ".join([f"{head} — fix the errors below ({kept})", *([key] if key else []),
@@ -275,7 +299,43 @@ class _Build:
         if made is None:
             return {}
         replay(self.writer, made.files)
+        if self.pack_only:
+            self.writer.spool.settle(made.entry, "ubershader", self.ctx.platforms)
         return self._settle(made.entry, made.errors, old, _uber_failure_head(self.scene))
+
+
+    def intact(self, entry: dict, name: str) -> bool:
+        """Whether the last build's `entry` (unit `name`) may be kept: its files are there with their sha256 (state.py);
+        with --pack-only, or the last build's packs hold all of it (spool.Packed)."""
+        return state.intact(self.out, entry) or (self.packed is not None and self.packed.intact(entry, name))
+
+    def files(self, entry: dict) -> int:
+        """The files of a kept entry that stay in the tree (none with --pack-only)."""
+        return 0 if self.pack_only else state.files(entry)
+
+    def _fetch(self, rel: str) -> bytes:
+        """An artifact for the packs of a --pack-only build: from this build's spool, the last build's packs, or a
+        loose file an earlier build left."""
+        data = self.writer.spool.get(rel)
+        if data is None:
+            data = self.packed.fetch(rel)
+        if data is None and (self.out / rel).is_file():
+            data = (self.out / rel).read_bytes()
+        if data is None:
+            from .pack import PackError
+            raise PackError(f"{self.out / rel}: in neither this build nor the last build's packs — build again "
+                            "(without --pack-only once if it persists)")
+        return data
+
+
+def _loose(manifest: dict) -> dict:
+    """What a --pack-only manifest names as files of the tree, for collect_garbage: its tables, textures and the
+    failing units' sources, not the entries' artifacts (the packs hold them; loose ones an earlier build left go)."""
+    def bare(e: dict) -> dict:
+        return {"hash": e.get("hash"), "failed_sources": e.get("failed_sources", {})}
+    return {**manifest, "permutations": [bare(e) for e in manifest["permutations"]],
+            "removed": [bare(e) for e in manifest.get("removed", [])], "ubershader": bare(manifest.get("ubershader") or {}),
+            "depth_shaders": {k: bare(e) for k, e in (manifest.get("depth_shaders") or {}).items()}}
 
 
 def _failure_head(scene: Scene, h: str, objs: list[dict]) -> tuple[str, str]:

@@ -19,7 +19,6 @@ from ..io import content_key
 from ..lang import SourceError
 from ..lang.errors import UserError
 from ..spec.where import KeyProblem
-from . import state
 from .platforms import PLATFORM_TABLE
 from .write import validate_dialects
 
@@ -80,15 +79,16 @@ def _write_units(build, units: dict) -> dict:
     from ..toolchain import compile_many
     from ..toolchain.jobs import source_jobs
 
-    ctx, res, out = build.ctx, build.res, build.out
+    ctx, res = build.ctx, build.res
     before = (build.previous.get("depth_shaders") or {})
     entries, todo = {}, {}
     for name, c in units.items():
         key = content_key(build.base, "depth unit", name, [s.text for s in [*c.sources, *c.dialects]])
         old = before.get(name)
-        if old is not None and old.get("input_key") == key and old.get("status") == "ok" and state.intact(out, old):
+        if old is not None and old.get("input_key") == key and old.get("status") == "ok" \
+                and build.intact(old, old["hash"]):
             entries[name] = old
-            res.unchanged += state.files(old)
+            res.unchanged += build.files(old)
         else:
             entries[name] = {"key": c.key, "hash": c.hash, "input_key": key, "languages": {},
                              "interface": c.interface.as_dict()}
@@ -105,6 +105,8 @@ def _write_units(build, units: dict) -> dict:
         errs = build.writer.unit(name, c.sources, results, entry)
         if not errs:
             errs = build.writer.platforms(name, c, entry, checked, "fp32")
+        if build.writer.spool is not None:  # build --pack-only: what its packs hold of the unit (spool.py)
+            build.writer.spool.settle(entry, entry["hash"], ctx.platforms)
         entry["status"] = "failed" if errs else "ok"
         if errs:
             entry["errors"] = errs

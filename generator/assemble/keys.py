@@ -76,7 +76,8 @@ def scene_keys(base: str, scene: Scene, lib: Library, keep_removed: bool, pack: 
     tables = content_key(base, scene.name, sorted((k, list(v)) for k, v in scene.light_sets.items()),
                          [[o["name"], o["material"], o["light_set"], o["permutation"]] for o in scene.objects],
                          sorted(repr(m) for m in scene.materials.values()),
-                         sorted(repr(x) for x in scene.lights.values()), keep_removed, *(["pack"] if pack else []))
+                         sorted(repr(x) for x in scene.lights.values()), keep_removed,
+                         *(["pack"] if pack is True else [f"pack-{pack}"] if pack else []))  # "only": --pack-only
     return Keys(keys, uber, tables, bricks)
 
 

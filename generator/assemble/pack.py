@@ -259,9 +259,15 @@ def pack_meta(platform: str, language: str, blob: str, generator: str, tools: di
 
 def _packed(entry: dict, name: str, platform: str):
     """(permutation name, stage, input key, blob kind, path, sha256) of an ok manifest entry on `platform`."""
+    return rows_of(entry, name, platform, ok_only=True)
+
+
+def rows_of(entry: dict, name: str, platform: str, ok_only: bool = False):
+    """What the pack of `platform` holds of a manifest entry, as _packed gives it; ok_only: only of an ok entry
+    (the pack's rule); else of an entry whatever its status (build --pack-only keeps them as it writes them)."""
     from .platforms import PLATFORM_TABLE
     p = PLATFORM_TABLE[platform]
-    if entry.get("status") != "ok":
+    if ok_only and entry.get("status") != "ok":
         return
     if name == "ubershader":  # built as SPIR-V only: in the pack of the platform that ships it (vulkan's)
         if p.ubershader:
@@ -274,9 +280,10 @@ def _packed(entry: dict, name: str, platform: str):
         yield name, stage, entry["input_key"], kind, item[kind]["path"], item[kind]["sha256"]
 
 
-def write_packs(out: Path, manifest: dict, count=None) -> list[dict]:
+def write_packs(out: Path, manifest: dict, count=None, fetch=None) -> list[dict]:
     """Write one pack per platform of `manifest` (its ok permutations and depth units; the ubershader in vulkan's) into
-    out/packs; returns the manifest's ``packs`` list. count(changed): the build's file counter."""
+    out/packs; returns the manifest's ``packs`` list. count(changed): the build's file counter. fetch(rel): an
+    artifact's bytes where the tree does not hold it (build --pack-only: spool.py), or None: read from the tree."""
     from .platforms import PLATFORM_TABLE
     out = Path(out)
     listed = []
@@ -286,7 +293,7 @@ def write_packs(out: Path, manifest: dict, count=None) -> list[dict]:
         rows += list(_packed(manifest.get("ubershader") or {}, "ubershader", platform))
         entries, kinds = [], set()
         for name, stage, input_key, kind, rel, sha in rows:
-            data = (out / rel).read_bytes()
+            data = (out / rel).read_bytes() if fetch is None else fetch(rel)
             if hashlib.sha256(data).hexdigest() != sha:
                 raise PackError(f"{out / rel}: its sha256 is not the manifest's — rebuild without --pack first")
             entries.append((name, stage, input_key, data))

@@ -28,7 +28,8 @@ def record(out: Path, manifest: dict, text: bytes, keys: Keys, kept: int, templa
     ok = all(e.get("status") == "ok" for e in manifest["permutations"]) and \
         (manifest.get("ubershader") or {}).get("status", "ok") == "ok"
     entries = [*manifest["permutations"], *manifest.get("removed", []), manifest.get("ubershader") or {},
-               *(manifest.get("depth_shaders") or {}).values()]
+               *(manifest.get("depth_shaders") or {}).values()] if manifest.get("artifacts") != "packs" else []
+    # (build --pack-only: the entries' artifacts are in the packs, listed below)
     state = {"manifest_sha256": sha256(text), "complete": ok, "keys": keys.permutations, "ubershader": keys.ubershader,
              "scene": keys.scene,
              "files": {rel: (out / rel).stat().st_size for e in entries for rel, _ in items(e)}

@@ -19,6 +19,8 @@ from .platforms import LANGUAGE_TREE, PLATFORM_TABLE, write_platforms
 class Writer:
     """Writes into `out` for one build, counting into its BuildResult `res` (written, unchanged, aliased, costs)."""
 
+    spool = None  # build --pack-only: the spool.Spool that takes the artifacts instead of the output tree
+
     def __init__(self, out: Path, ctx: BuildContext, res):
         self.out, self.ctx, self.res = out, ctx, res
         self._done: set[str] = set()  # SPIR-V files this build has written or found in place
@@ -33,6 +35,9 @@ class Writer:
             self.res.unchanged += 1
 
     def put(self, rel: str, data: bytes) -> None:
+        if self.spool is not None and artifact(rel):
+            self.spool.stash(rel, data)
+            return
         self.count(atomic_write(f"{self.out}/{rel}", data, self._dirs))
 
     def put_shared(self, rel: str, data: bytes) -> None:
@@ -41,7 +46,10 @@ class Writer:
             self.res.aliased += 1
         else:
             self._done.add(rel)
-            self.put(rel, data)
+            if self.spool is not None:
+                self.spool.stash(rel, data, shared=True)
+            else:
+                self.put(rel, data)
 
     def unit(self, name: str, sources, results, entry: dict) -> list[str]:
         """Write a unit's sources and SPIR-V into `entry` only when every one compiled; else write the failing
@@ -87,6 +95,15 @@ class Writer:
         if cost is None:
             cost = self.res.costs[sha] = cost_dict(spirv, self.ctx.store)
         return cost
+
+
+def artifact(rel: str) -> bool:
+    """Whether `rel` is an artifact of a unit (a source, a SPIR-V module, a platform's file), which build
+    --pack-only leaves to the packs: not the manifest, the tables and textures, or a failing unit's sources."""
+    return rel.split("/", 1)[0] in _TREES and ".failed." not in rel
+
+
+_TREES = {LANGUAGE_TREE, *(p.name for p in PLATFORM_TABLE.values() if p.own_files)}
 
 
 def validate_dialects(pairs, store, gate=None) -> dict[str, list[str]]:

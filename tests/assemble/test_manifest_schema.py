@@ -62,8 +62,8 @@ def _state_scene() -> str:
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory) -> dict[str, dict]:
-    """Manifests of builds that between them write every field: the scenes of scenes/ (the example with packs and on
-    one platform), masked shadow casters, every surface state with tables, a glTF file, textures with samplers, a
+    """Manifests of builds that between them write every field: the scenes of scenes/ (the example with packs, with
+    packs only and on one platform), masked shadow casters, every surface state with tables, a glTF file, textures with samplers, a
     removed permutation, a stale and a failed one, a scene with no object."""
     tmp = tmp_path_factory.mktemp("manifests")
     out: dict[str, dict] = {}
@@ -71,6 +71,7 @@ def built(tmp_path_factory) -> dict[str, dict]:
     out["textured.toml"] = _build(REPO / "scenes" / "textured.toml", "--out", tmp / "textured.toml")
     out["depth_mask"] = _build(REPO / "tests" / "scenes" / "depth_mask.toml", "--out", tmp / "depth_mask")
     out["vulkan"] = _build(EXAMPLE, "--out", tmp / "vulkan", "--platform", "vulkan")
+    out["pack_only"] = _build(EXAMPLE, "--out", tmp / "pack_only", "--pack-only")  # "artifacts": "packs"
     (tmp / "state.toml").write_text(_state_scene())
     out["state"] = _build(tmp / "state.toml", "--out", tmp / "state", "--pack")
     from tests.scene.test_gltf import sample_doc

@@ -4,7 +4,9 @@ from __future__ import annotations
 import json
 import signal
 import sys
+from dataclasses import replace
 from pathlib import Path
+from types import SimpleNamespace
 
 from ...lang.errors import UsageError, UserError
 
@@ -39,6 +41,11 @@ def add_arguments(p) -> None:
                    help="also write one shader pack per platform, DIR/packs/<platform>.<key16>.smpack (an index and "
                         "the platform's artifacts; format: generator/assemble/pack.py), listed under the manifest's "
                         "\"packs\"")
+    p.add_argument("--pack-only", action="store_true",
+                   help="the packs (as --pack) and the manifest without the loose artifacts: no source, SPIR-V or "
+                        "platform file per permutation (10,000 permutations are ~90,000 files otherwise); the "
+                        "manifest says \"artifacts\": \"packs\" and still lists every artifact's path and sha256, "
+                        "its bytes in the pack of its platform")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no per-permutation lines and no progress bar: the summary line and errors only")
     p.add_argument("--explain", action="store_true",
@@ -95,6 +102,60 @@ def _interrupter(gate):
     return interrupted
 
 
+def _request(args, platforms):
+    """What this invocation asks for that decides the outputs (assemble/noop.Request), or None where a no-op
+    must be decided by the full path: --explain (it says why), --validate-ir (it checks the IR), a glTF scene."""
+    import os
+    import time
+
+    from ...assemble.noop import Request
+    from ...backends import LANGUAGES
+    if args.explain or args.validate_ir or not str(args.scene).lower().endswith(".toml"):
+        return None
+    absolute = [os.path.abspath(d) for d in args.bricks or ()]
+    target = None
+    if args.depfile:
+        from ...assemble.depfile import shown
+        target = str(args.stamp) if args.stamp is not None else shown(Path(args.out) / "manifest.json")
+    return Request(os.path.abspath(args.scene), tuple(absolute), tuple(platforms), tuple(LANGUAGES),
+                   bool(args.keep_removed), "only" if args.pack_only else "pack" if args.pack else "",
+                   os.path.abspath(args.depfile) if args.depfile else None, target,
+                   os.getcwd() if args.depfile else None, started=time.time_ns())
+
+
+def _known_noop(args, request, started: float) -> bool:
+    """Whether the last build's record says this one has nothing to do (assemble/noop.py); then say so, as the
+    full path would, replay its warnings and replace the stamp."""
+    import time
+
+    from ...assemble import BuildResult
+    from ...assemble.depfile import touch
+    from ...assemble.noop import check
+    from ...assemble.outputs import locked
+    from ...io import Store, default_cache_dir
+    out, root = Path(args.out), args.cache_dir or default_cache_dir()
+    if args.no_cache or root is None or not (out / "manifest.json").is_file():  # the record is in the cache
+        return False
+    with locked(out):
+        hit = check(out, request, Store(root))
+        if hit is None:
+            return False
+        if args.stamp is not None:
+            touch(args.stamp)
+    for w in hit["warnings"]:
+        print(f"warning: {w}", file=sys.stderr)
+    seconds = time.perf_counter() - started
+    if args.json:
+        scene = SimpleNamespace(name=hit["scene"], permutations=range(hit["permutations"]))
+        res = BuildResult(out, unchanged=hit["unchanged"], kept=hit["permutations"], up_to_date=True)
+        res.manifest = {"packs": [{"path": p} for p in hit["packs"]]}
+        print(json.dumps(summary(scene, res, args.out, seconds, args.pack or args.pack_only), indent=2))
+        return True
+    print(f"{hit['scene']}: {hit['permutations']} permutations up to date: 0 composed, 0 compiled; "
+          f"0 files written, {hit['unchanged']} unchanged → {args.out}/manifest.json ({seconds:.2f} s)")
+    return True
+
+
 def run(args) -> int:
     from ...library.bricks import load_library
     from ...assemble import BuildContext, build
@@ -107,6 +168,9 @@ def run(args) -> int:
         raise UsageError("--no-cache and --cache-dir contradict each other — give one")
     if args.jobs is not None and args.jobs < 1:
         raise UsageError(f"-j {args.jobs}: give at least one job")
+    if args.pack_only and args.keep_removed:
+        raise UsageError("--pack-only and --keep-removed: the packs hold only what this build builds, so removed "
+                         "permutations could keep no outputs — give one")
     if args.executor and not args.executor.startswith("dask://"):
         raise UsageError(f"--executor {args.executor}: write dask://HOST:PORT")
     from ...assemble.platforms import PLATFORMS, parse_platforms
@@ -114,6 +178,9 @@ def run(args) -> int:
         platforms = parse_platforms(args.platform) if args.platform is not None else list(PLATFORMS)
     except ValueError as e:
         raise UsageError(f"--platform: {e}") from None
+    request = _request(args, platforms)
+    if request is not None and _known_noop(args, request, started):  # nothing loaded: assemble/noop.py
+        return 0
     try:
         lib = load_library(args.bricks or (), strict=False)  # a broken brick fails the build once a scene reaches it
         scene = load_scene(args.scene, lib)
@@ -121,12 +188,14 @@ def run(args) -> int:
         if args.json:  # a script reading stdout gets its answer too
             print(json.dumps({"ok": False, "failures": [str(e)]}, indent=2))
         raise
-    for e in lib.errors:  # what the scene reaches has loaded (resolving it raises a broken brick's error)
-        print(f"warning: {e} (no permutation of this scene uses the brick; `shadermatrix bricks --check` checks "
-              "every brick)", file=sys.stderr)
+    warnings = [f"{e} (no permutation of this scene uses the brick; `shadermatrix bricks --check` checks every brick)"
+                for e in lib.errors]  # what the scene reaches has loaded (resolving it raises a broken brick's error)
     from ...spec.resolve import fp16_warnings
-    for w in fp16_warnings(scene.permutations.values(), lib):  # bricks marked "fp16": "unsafe: ..."
+    warnings += fp16_warnings(scene.permutations.values(), lib)  # bricks marked "fp16": "unsafe: ..."
+    for w in warnings:
         print(f"warning: {w}", file=sys.stderr)
+    if request is not None:
+        request = replace(request, warnings=tuple(warnings))
     if args.validate_ir:
         from ...link.checked import ir_violations
         found = ir_violations([p for _, p in sorted(scene.permutations.items())], lib)
@@ -148,8 +217,8 @@ def run(args) -> int:
                        jobs=args.jobs, executor=executor)
     handlers = {sig: signal.signal(sig, _interrupter(ctx.gate)) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        res = build(scene, Path(args.out), ctx, depfile=args.depfile, keep_removed=args.keep_removed, pack=args.pack,
-                    stamp=args.stamp)
+        res = build(scene, Path(args.out), ctx, depfile=args.depfile, keep_removed=args.keep_removed,
+                    pack="only" if args.pack_only else args.pack, stamp=args.stamp, request=request)
     finally:
         if executor is not None:
             executor.close()
@@ -158,7 +227,7 @@ def run(args) -> int:
     seconds = time.perf_counter() - started
     why = _explained(scene, res) if args.explain else None
     if args.json:
-        print(json.dumps({**summary(scene, res, args.out, seconds, args.pack),
+        print(json.dumps({**summary(scene, res, args.out, seconds, args.pack or args.pack_only),
                           **({"explain": why.as_dict()} if why is not None else {})}, indent=2))
         for f in res.failures:
             print(f"error: {f}", file=sys.stderr)
@@ -190,7 +259,7 @@ def run(args) -> int:
           f"({c.jobs - c.distinct} merged), {c.cached} from the cache, {c.compiled} compiled; "
           f"{res.written} files written, {res.unchanged} unchanged, {res.aliased} SPIR-V shared → "
           f"{args.out}/manifest.json ({seconds:.1f} s)")
-    for p in res.manifest.get("packs", []) if args.pack else []:
+    for p in res.manifest.get("packs", []) if args.pack or args.pack_only else []:
         print(f"  pack {p['path']}: {p['entries']} entries, {p['size']} bytes")
     for f in res.failures:
         print(f"error: {f}", file=sys.stderr)
