@@ -76,9 +76,8 @@ def compile_permutations(ctx: BuildContext, permutations: dict, extra=(), on_don
     out = Compiled(costs=costs if costs is not None else {})
     items = sorted(permutations.items())
     if entries is not None and in_workers(ctx, len(items)):
-        from .parallel import compile_in_workers
-        compile_in_workers(ctx, items, list(extra), on_done, stats, ctx.jobs or os.cpu_count() or 1, out, entries,
-                           ubershader)
+        from .parallel import Plan, compile_in_workers
+        compile_in_workers(ctx, Plan(items, list(extra), entries, ubershader), on_done, stats, out)
     else:
         _here(ctx, items, list(extra), on_done, stats, out)
     return out

@@ -135,35 +135,59 @@ def _portable(e: UserError) -> UserError:
     return (EnvironmentMissing if isinstance(e, EnvironmentMissing) else UserError)(str(e))
 
 
-def compile_in_workers(ctx: BuildContext, items: list, extra: list, on_done, stats: CompileStats, workers: int,
-                       out: Compiled, entries: Entries, ubershader: bool = False) -> None:
-    """loop.compile_permutations in `workers` processes, or on the Dask cluster of ctx.executor (cluster.py), into
-    `out` (items: sorted (hash, Permutation) pairs; entries: what makes their manifest entries)."""
-    from tqdm import tqdm
+@dataclass
+class Plan:
+    """What compile_in_workers builds: the permutations (sorted (hash, Permutation) pairs), CompileJobs compiled
+    with them (the ubershader's, when it was composed in this process), what makes their manifest entries, and
+    whether a task composes and compiles the ubershader."""
 
-    seen: set[str] = set()  # the cache keys of every job
-    fresh: set[str] = set()  # those some worker compiled (the others came from the cache)
+    items: list
+    extra: list
+    entries: Entries
+    ubershader: bool = False
 
-    def take(value: Chunk) -> tuple:
+
+class _Tally:
+    """What the chunks brought back, gathered into `out` and `stats` as they come."""
+
+    def __init__(self, out: Compiled, stats: CompileStats):
+        self.out, self.stats = out, stats
+        self.seen: set[str] = set()  # the cache keys of every job
+        self.fresh: set[str] = set()  # those some worker compiled (the others came from the cache)
+
+    def take(self, value: Chunk) -> tuple:
+        out = self.out
         out.add(value.composed, value.errors)
         out.templates.update(value.templates)
         out.results.update(value.results)
         if value.ubershader is not None:
             out.ubershader = value.ubershader
-        stats.jobs += len(value.keys)
-        seen.update(value.keys.values())
-        fresh.update(value.fresh)
+        self.stats.jobs += len(value.keys)
+        self.seen.update(value.keys.values())
+        self.fresh.update(value.fresh)
         return value.results, value.made
 
-    if not items and not ubershader and not extra:
+    def finish(self) -> None:
+        # counted once per distinct shader, whichever worker got it first: the same counts for any N and any timing
+        # (when every shader compiles: in-process, a failing one is compiled, and counted, again per chunk)
+        self.stats.distinct += len(self.seen)
+        self.stats.compiled += len(self.seen & self.fresh)
+        self.stats.cached += len(self.seen - self.fresh)
+
+
+def compile_in_workers(ctx: BuildContext, plan: Plan, on_done, stats: CompileStats, out: Compiled) -> None:
+    """loop.compile_permutations in ctx.jobs worker processes (default: the core count), or on the Dask cluster
+    of ctx.executor (cluster.py), into `out`."""
+    from tqdm import tqdm
+
+    if not plan.items and not plan.ubershader and not plan.extra:
         return
+    tally, local = _Tally(out, stats), ctx.executor is None
     # without a cache (--no-cache), the local workers share a private one for this build alone, so that a shader is
     # compiled once whichever chunks have it (the in-process build's memo); named like the toolchain's temp dirs, a
     # killed build's is removed by the next
-    local = ctx.executor is None
     private = None if ctx.store is not None or not local else tempfile.mkdtemp(
         prefix=f"shadermatrix-{os.getpid()}-build-")
-    payload = pack(ctx, entries)
     # What comes back is kept to the end of the build (the entries, their texts and files: ~190 KB and some
     # thousand objects a permutation), none of it cyclic garbage, and the cyclic collector would walk all of it
     # again and again as it grows: measured, ~1 ms of this process's CPU per permutation of 1,000. Reference
@@ -171,26 +195,22 @@ def compile_in_workers(ctx: BuildContext, items: list, extra: list, on_done, sta
     collecting = gc.isenabled()
     gc.disable()
     try:
-        if local:
-            pool = Workers(workers, _start, (payload, dict(os.environ), str(ctx.store.root) if ctx.store else private),
-                           _task, _PRELOAD)
-        else:
-            from .cluster import Cluster
-            pool = Cluster(ctx.executor, payload, ctx.platforms, cached=ctx.store is not None)
-        with pool, tqdm(total=len(items), disable=not ctx.progress, unit="permutation", leave=False) as bar:
-            size = chunk_size(len(items), workers if local else pool.threads())
-            chunks = [[h for h, _ in items[k:k + size]] for k in range(0, len(items), size)]
+        pool = _pool(ctx, pack(ctx, plan.entries), private)
+        with pool, tqdm(total=len(plan.items), disable=not ctx.progress, unit="permutation", leave=False) as bar:
+            workers = (ctx.jobs or os.cpu_count() or 1) if local else pool.threads()
+            size = chunk_size(len(plan.items), workers)
+            chunks = [[h for h, _ in plan.items[k:k + size]] for k in range(0, len(plan.items), size)]
             # the ubershader first (composed there, or its large shaders one task each: they spread over the workers)
-            first = [(None, [])] if ubershader else [([], [job]) for job in extra]
+            first = [(None, [])] if plan.ubershader else [([], [job]) for job in plan.extra]
             done: dict[int, Chunk] = {}  # chunks back before an earlier one: written when it is
             following = 0  # the next chunk to write
             for k, value in pool.unordered(first + [(chunk, []) for chunk in chunks]):
                 if k < len(first):
-                    take(value)
+                    tally.take(value)
                     continue
                 done[k - len(first)] = value
                 while following in done:  # written in chunk order, each as soon as it and those before are back
-                    part, made = take(done.pop(following))
+                    part, made = tally.take(done.pop(following))
                     chunk = chunks[following]
                     if on_done is not None:
                         on_done([(h, out.composed[h]) for h in chunk if h in out.composed], part, made)
@@ -201,8 +221,13 @@ def compile_in_workers(ctx: BuildContext, items: list, extra: list, on_done, sta
             gc.enable()
         if private is not None:
             shutil.rmtree(private, ignore_errors=True)
-    # counted once per distinct shader, whichever worker got it first: the same counts for any N and any timing
-    # (when every shader compiles: in-process, a failing one is compiled, and counted, again per chunk)
-    stats.distinct += len(seen)
-    stats.compiled += len(seen & fresh)
-    stats.cached += len(seen - fresh)
+    tally.finish()
+
+
+def _pool(ctx: BuildContext, payload: bytes, private: str | None):
+    """The build's workers: ctx.jobs local processes (workers.Workers), or its Dask cluster's (cluster.Cluster)."""
+    if ctx.executor is not None:
+        from .cluster import Cluster
+        return Cluster(ctx.executor, payload, ctx.platforms, cached=ctx.store is not None)
+    root = str(ctx.store.root) if ctx.store is not None else private
+    return Workers(ctx.jobs or os.cpu_count() or 1, _start, (payload, dict(os.environ), root), _task, _PRELOAD)

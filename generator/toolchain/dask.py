@@ -38,6 +38,20 @@ def _on_worker(jobs, optimize: bool, validate: bool, versions: dict):
         raise WorkerMismatch(f"dask worker {socket.gethostname()}: {e}") from None
 
 
+def _reachable(address: str) -> None:
+    """Refuse at once a tcp:// address nothing listens on (distributed's Client retries a refused connection until
+    its timeout: 10 s before saying what one connection says)."""
+    import socket
+    host, _, port = address.removeprefix("tcp://").rpartition(":")
+    if not address.startswith("tcp://") or not port.isdigit():
+        return  # another transport, or a form the Client reports on itself
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=10).close()
+    except OSError as e:
+        raise UserError(f"no Dask scheduler at {address}: {e.strerror or e} — start one (`dask scheduler`) or check "
+                        "the address") from None
+
+
 class DaskExecutor:
     """Runs compile_many's tool work on the cluster at `address` (tcp://host:port or host:port)."""
 
@@ -46,6 +60,7 @@ class DaskExecutor:
         address = address[len(SCHEME):] if address.startswith(SCHEME) else address
         if "://" not in address:
             address = f"tcp://{address}"
+        _reachable(address)
         try:
             self.client = Client(address, timeout="10s", set_as_default=False)
         except OSError as e:

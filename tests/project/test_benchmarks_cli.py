@@ -41,6 +41,8 @@ def test_docs_name_every_script_and_only_options_they_take():
 @pytest.mark.parametrize("args", [
     ("scenegen.py", "0", "x.toml"),
     ("build.py", "--n", "0"),
+    ("scale.py", "--permutations", "0"),
+    ("scale.py", "--plan", "10000,lots"),
     ("hybrid.py", "--size", "big"),
     ("hybrid.py", "--frames", "-3"),
     ("runtime_vs_error.py", "--samples", "0"),

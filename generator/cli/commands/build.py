@@ -33,7 +33,8 @@ def add_arguments(p) -> None:
                    help="worker processes composing, compiling and analysing (default: the core count; from 64 "
                         "permutations, else N tool processes); the output is the same for any N")
     p.add_argument("--executor", metavar="dask://HOST:PORT",
-                   help="compile on a Dask distributed cluster (its workers need the pinned tools: docs/guide/build.md)")
+                   help="compose, compile and analyse on a Dask distributed cluster, this process writing (its workers "
+                        "need this shadermatrix and the pinned tools, one thread each: docs/guide/build.md)")
     p.add_argument("--keep-removed", action="store_true",
                    help="keep the outputs of permutations that left the scene, listed under the manifest's "
                         "\"removed\" (default: they are deleted)")
