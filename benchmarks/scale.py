@@ -1,6 +1,7 @@
 """The build toward 100,000 permutations: planning, a cold build, its no-op, and packs only.
 
-    .venv/bin/python benchmarks/scale.py [--permutations 10000] [--plan 10000,100000] [--report-only]
+    .venv/bin/python benchmarks/scale.py [--permutations 10000] [--plan 10000,100000] [--work DIR [--reuse]]
+                                         [--report-only]
 
 One run, on this machine (benchmarks/scenegen.py makes each scene: N distinct permutations, one object each):
 
@@ -15,6 +16,10 @@ One run, on this machine (benchmarks/scenegen.py makes each scene: N distinct pe
 - the same scene with --pack-only into another directory (the compile cache warm from the cold build, so its
   time is composing, analysing and writing): wall time, files in the tree, its no-op as above.
 
+--work DIR builds in DIR (kept) instead of a temporary directory; with --reuse, a DIR holding the trees of an
+earlier run of the same --permutations is measured again without building (the plan and the no-ops: on a
+quieter machine, say), its builds' figures taken from the scale.json that run wrote.
+
 The CPU and memory figures are the processes' own (getrusage), so that other work on a shared machine changes
 them less than it changes wall times. Writes benchmarks/results/scale.md and scale.json; the model there extends
 the per-permutation figures to 100,000 permutations.
@@ -25,6 +30,7 @@ written, the scene not loaded; the same for --pack-only.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import re
@@ -127,8 +133,13 @@ def main() -> int:
     ap.add_argument("--permutations", type=positive, default=10_000, help="the built scene's permutations")
     ap.add_argument("--plan", default="10000,100000", type=_sizes,
                     help="comma-separated scene sizes to plan (matrix --no-compile), default 10000,100000")
+    ap.add_argument("--work", metavar="DIR", type=Path, help="build in DIR and keep it (default: a temporary directory)")
+    ap.add_argument("--reuse", action="store_true",
+                    help="with --work: measure the trees an earlier run left there again, without building")
     ap.add_argument("--report-only", action="store_true", help="rewrite scale.md from the recorded scale.json")
     args = ap.parse_args()
+    if args.reuse and args.work is None:
+        ap.error("--reuse needs --work DIR")
     if args.report_only:
         report(json.loads((RESULTS / "scale.json").read_text()))
         return 0
@@ -136,18 +147,36 @@ def main() -> int:
     from generator.toolchain import tool_versions
     res: dict = {"generator": f"shadermatrix {__version__}", "tools": tool_versions(), "cores": os.cpu_count() or 1,
                  "permutations": args.permutations, "plan": {}}
-    with tempfile.TemporaryDirectory(prefix="shadermatrix-scale-") as tmp:
-        tmp = Path(tmp)
+    with contextlib.ExitStack() as stack:
+        if args.work is None:
+            tmp = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="shadermatrix-scale-")))
+        else:
+            tmp = args.work.resolve()
+            tmp.mkdir(parents=True, exist_ok=True)
         for n in args.plan:
             scene = generate(n, tmp / f"plan_{n}.toml")
             res["plan"][str(n)] = plan(scene) | {"scene_bytes": scene.stat().st_size}
             scene.unlink()
-        scene = generate(args.permutations, tmp / f"generated_{args.permutations}.toml")
         cache = tmp / "cache"
-        res["cold"] = cold(scene, tmp / "loose", cache)
-        res["noop"] = noop(scene, tmp / "loose", cache)
-        shutil.rmtree(tmp / "loose")
-        res["pack_only"] = cold(scene, tmp / "packs", cache, "--pack-only")
+        if args.reuse:
+            earlier = json.loads((RESULTS / "scale.json").read_text())
+            scene = tmp / f"generated_{args.permutations}.toml"
+            if earlier.get("permutations") != args.permutations or not scene.is_file() or not (tmp / "packs").is_dir():
+                raise SystemExit(f"--reuse: {tmp} holds no run of {args.permutations} permutations recorded in "
+                                 "scale.json — run without --reuse first")
+            res["cold"], res["pack_only"] = earlier["cold"], earlier["pack_only"]
+            res["reused"] = True
+        else:
+            scene = generate(args.permutations, tmp / f"generated_{args.permutations}.toml")
+            shutil.rmtree(tmp / "loose", ignore_errors=True)
+            shutil.rmtree(tmp / "packs", ignore_errors=True)
+            shutil.rmtree(cache, ignore_errors=True)
+            res["cold"] = cold(scene, tmp / "loose", cache)
+            res["pack_only"] = cold(scene, tmp / "packs", cache, "--pack-only")
+        if (tmp / "loose").is_dir():
+            res["noop"] = noop(scene, tmp / "loose", cache)
+        else:
+            res["noop"] = json.loads((RESULTS / "scale.json").read_text())["noop"]
         res["pack_only_noop"] = noop(scene, tmp / "packs", cache, "--pack-only")
     (RESULTS / "scale.json").write_text(json.dumps(res, indent=2) + "\n")
     report(res)
