@@ -45,7 +45,7 @@ MODEL = (100_000, ((8, 8), (32, 8)))  # permutations; Dask workers × cores each
 LOCAL_MODEL = (16, 64)  # cores of one machine, -j
 
 _MEASURED = """
-import functools, importlib, json, sys, time
+import functools, importlib, json, os, sys, time
 SPENT = {{}}
 
 def timed(label, modname, owner, name):  # the main thread's CPU in it, where the checkout has it
@@ -70,6 +70,8 @@ from generator.cli import main
 rc = main({argv!r})
 SPENT["main thread"] = time.thread_time()
 print(f"building-process-cpu {{time.process_time()}}", file=sys.stderr)
+t = os.times()
+print(f"building-process-user-system {{t.user}} {{t.system}}", file=sys.stderr)
 print(f"building-process-phases {{json.dumps(SPENT)}}", file=sys.stderr)
 sys.exit(rc)
 """
@@ -145,10 +147,12 @@ def measured(repo: Path, *args) -> tuple[float, float, str]:
     if r.returncode != 0:
         raise SystemExit(f"{' '.join(map(str, args))} failed:\n{r.stderr[-2000:]}")
     cpu = float(re.search(r"building-process-cpu (\S+)", r.stderr)[1])
+    user, system = (float(x) for x in re.search(r"building-process-user-system (\S+) (\S+)", r.stderr).groups())
     phases = json.loads(re.search(r"building-process-phases (.+)", r.stderr)[1])
     main_thread = phases.pop("main thread")
     phases["the rest of the main thread (the chunks' loop, settling, start-up)"] = main_thread - sum(phases.values())
     phases["its other threads (the Dask client: receiving the chunks)"] = cpu - main_thread
+    phases["of all the above, the kernel's (system CPU: creating the files, most of it)"] = system
     return wall, cpu, r.stdout, phases
 
 
@@ -219,6 +223,8 @@ def per_permutation(res: dict) -> dict:
         out["packs_only_building_marginal_ms"] = (p["building_cpu_s"] - q["building_cpu_s"]) / extra * 1e3
         out["packs_only_building_total_ms"] = p["building_cpu_s"] / p["permutations"] * 1e3
         out["packs_only_files_per_permutation"] = p["files"] / p["permutations"]
+        out["packs_only_phases_marginal_ms"] = {k: (v - q["phases_s"].get(k, 0.0)) / extra * 1e3
+                                                for k, v in p["phases_s"].items()}
     return out
 
 
@@ -308,12 +314,16 @@ def report(res: dict) -> None:
     md.append("| building process's fixed CPU (start-up, bricks, Dask client) | "
               + " | ".join(f"{r['per_permutation']['building_fixed_s']:.1f} s" for _, r in cols) + " | |")
     md.append(f"| files written per permutation | {pa['files_per_permutation']:.1f} |" + " |" * len(cols))
+    phased = [(f"{label}, loose", r["per_permutation"]["building_phases_marginal_ms"]) for label, r in cols]
+    phased += [(f"{label}, --pack-only", r["per_permutation"]["packs_only_phases_marginal_ms"]) for label, r in cols
+               if "packs_only_phases_marginal_ms" in r["per_permutation"]]
     md += ["", "Where the building process's marginal CPU goes (per permutation; the main thread's CPU in each step, "
-           "the rest of the process is the Dask client's thread):", "",
-           "| step | " + " | ".join(label for label, _ in cols) + " |", "|---|" + "---|" * len(cols)]
+           "the rest of the process is the Dask client's thread; the last row, the kernel's part of them all, is "
+           "mostly creating the loose files, whose cost depends on the file system: on this machine's /tmp, "
+           "crowded with recently deleted files, ~15 to ~400 µs for one empty file):", "",
+           "| step | " + " | ".join(label for label, _ in phased) + " |", "|---|" + "---|" * len(phased)]
     for step in pa["building_phases_marginal_ms"]:
-        md.append(f"| {step} | " + " | ".join(f"{r['per_permutation']['building_phases_marginal_ms'].get(step, 0):.2f} ms"
-                                             for _, r in cols) + " |")
+        md.append(f"| {step} | " + " | ".join(f"{ph.get(step, 0):.2f} ms" for _, ph in phased) + " |")
     md += ["", "Wall time here (two cores, shared with the workers and their tools, so not the cluster's):", "",
            "| build | " + " | ".join(label for label, _ in cols) + " |", "|---|" + "---|" * len(cols)]
     for key, text in (("small", f"Dask, {res['small']:,} permutations"), ("n", f"Dask, {res['n']:,} permutations")):

@@ -35,9 +35,9 @@ class Made:
     errors: list[str]
     files: list[tuple[str, bytes | None, bool]]
     # a permutation that built: its entry as the manifest's text holds it, cut where its sampler descriptors are
-    # (split_text), and those descriptors, in order
+    # (split_text), and those descriptors, in order, each with its text (_hole)
     text: list[str] | None = None
-    holes: list[dict] | None = None
+    holes: list[tuple] | None = None
 
 
 @dataclass
@@ -113,6 +113,7 @@ class Entries:
 
 _HOLE = "\0shadermatrix: a sampler descriptor\0"
 _PLACE = "\0shadermatrix: the permutations\0"
+_STATE = "sampler_state"
 
 
 def _indented(entry: dict) -> str:
@@ -120,9 +121,9 @@ def _indented(entry: dict) -> str:
     return json.dumps(entry, indent=2).replace("\n", "\n    ")
 
 
-def split_text(entry: dict) -> tuple[list[str], list[dict]]:
+def split_text(entry: dict) -> tuple[list[str], list[tuple]]:
     """(The entry's text (_indented) cut where each sampler descriptor of its platforms' reflections stands, those
-    descriptors in the text's order). The build sets a light or table sampler's ``sampler_state`` in them once the
+    descriptors in the text's order, each with its text as it is when made: _hole). The build sets a light or table sampler's ``sampler_state`` in them once the
     scene's samplers are numbered (texture_outputs.py), after the entry was made: they are encoded then, the rest
     of the entry here."""
     from .texture_outputs import _sampler_descriptors  # what texture_outputs may change: the same rows
@@ -144,14 +145,40 @@ def split_text(entry: dict) -> tuple[list[str], list[dict]]:
     text = _indented({**entry, "platforms": platforms} if holes else entry)
     parts = text.split(json.dumps(_HOLE))
     assert len(parts) == len(holes) + 1
-    return parts, holes
+    return parts, [_hole(d, before) for d, before in zip(holes, parts)]
 
 
-def _joined(parts: list[str], holes: list[dict]) -> str:
+def _hole(d: dict, before: str) -> tuple[dict, str | None, int]:
+    """(A sampler descriptor, its text where it stands as it is now, how many keys it has now). The build adds
+    ``sampler_state`` to it later, after the others (texture_outputs.py): its text is then this one with that
+    key spliced in (_descriptor), not encoded again by json's indented encoder, which is Python (~12 descriptors a
+    permutation). None: one that has a state already, encoded whole at the end."""
+    if not d or _STATE in d:
+        return d, None, len(d)
+    return d, _encode(d, before[before.rfind("\n") + 1:]), len(d)
+
+
+def _encode(d, indent: str) -> str:
+    return json.dumps(d, indent=2).replace("\n", "\n" + indent)
+
+
+def _descriptor(hole: tuple[dict, str | None, int], indent: str) -> str:
+    d, text, n = hole
+    if text is not None:
+        if len(d) == n:  # no state given
+            return text
+        if len(d) == n + 1 and next(reversed(d)) == _STATE:  # the one key the build adds, after the others
+            close = text.rindex("\n")  # the descriptor's closing brace, on a line of its own
+            return (f"{text[:close]},\n{indent}  {json.dumps(_STATE)}: {_encode(d[_STATE], indent + '  ')}"
+                    f"{text[close:]}")
+    return _encode(d, indent)
+
+
+def _joined(parts: list[str], holes: list[tuple]) -> str:
     out = [parts[0]]
-    for d, after in zip(holes, parts[1:]):
+    for hole, after in zip(holes, parts[1:]):
         indent = out[-1][out[-1].rfind("\n") + 1:]  # where the descriptor stands: its line's indentation
-        out += [json.dumps(d, indent=2).replace("\n", "\n" + indent), after]
+        out += [_descriptor(hole, indent), after]
     return "".join(out)
 
 

@@ -74,8 +74,8 @@ def _task(hashes: list | None, extra: list) -> Chunk:
 
 @dataclass
 class Chunk:
-    """What a task sends back (every value picklable): its permutations composed (without their sources: the
-    tables read the rest), their compose errors, the entries made (hash -> entries.Made), the compile results
+    """What a task sends back (every value picklable): its permutations composed (what the tables read of them:
+    _bare), their compose errors, the entries made (hash -> entries.Made), the compile results
     (without SPIR-V, which is in the entries' files; extra's whole, which the building process writes), the cache
     key of every job, the cache keys compiled here, the templates composed with and the ubershader's entry."""
 
@@ -104,7 +104,7 @@ def run_chunk(ctx: BuildContext, entries: Entries, hashes: list | None, extra: l
         raise _portable(e) from None
     mine = {j.key for j in extra}
     templates = {t for c in composed.values() for t in c.templates}
-    return Chunk({h: replace(c, sources=[], dialects=[]) for h, c in composed.items()}, errors, made,
+    return Chunk({h: _bare(c) for h, c in composed.items()}, errors, made,
                  {k: r if k in mine else _slim(r) for k, r in results.items()},
                  {k: r.cache_key for k, r in results.items()}, stats.fresh, templates)
 
@@ -124,6 +124,14 @@ def _ubershader(ctx: BuildContext, entries: Entries, memo: dict | None) -> Chunk
         raise _portable(e) from None
     return Chunk({}, {}, {}, {k: _slim(r) for k, r in results.items()}, {k: r.cache_key for k, r in results.items()},
                  stats.fresh, set(unit[0].templates) if isinstance(unit, tuple) else set(), made)
+
+
+def _bare(c):
+    """A Composed as the building process reads it once its entry is made: its material slots, its interface's
+    parameters (reflection.scene_tables) and its templates. The rest (the sources, the interface's blocks and
+    textures, the light slots: the entry holds them) would be a third of what it unpickles per permutation."""
+    iface = replace(c.interface, stage_entries={}, shading_inputs=[], surface=[], blocks=[], textures=[], outputs=[])
+    return replace(c, sources=[], dialects=[], lights=[], interface=iface)
 
 
 def _slim(r):

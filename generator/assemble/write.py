@@ -24,7 +24,7 @@ class Writer:
     def __init__(self, out: Path, ctx: BuildContext, res):
         self.out, self.ctx, self.res = out, ctx, res
         self._done: set[str] = set()  # SPIR-V files this build has written or found in place
-        self._dirs: set[str] = set()  # the directories it has made or found (io.atomic_write)
+        self._dirs: dict[str, set[str]] = {}  # the directories it has made or found, their names (io.atomic_write)
         # the platforms' binary steps (d3d12's DXC, where a dxc is on PATH), asked for only when a platform is built
         self._steps = {p: step for p in ctx.platforms if (step := PLATFORM_TABLE[p].binary_step()) is not None}
 

@@ -21,30 +21,38 @@ def sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def atomic_write(path: Path, data: bytes, dirs: set | None = None) -> bool:
+def atomic_write(path: Path, data: bytes, dirs: dict | None = None) -> bool:
     """Write `data` to `path` atomically; returns False (and touches nothing) when unchanged.
 
     Atomic against the process dying at any instant (Ctrl-C, SIGTERM, kill -9): a reader sees the old
     file or the new one, never a part. Not fsync'ed: a power cut may leave a recent file empty, which
     the next build notices (a size or sha256 that is not the recorded one) and rebuilds; fsync per file
     cost more than the rest of writing a 1,000-permutation build (docs/design/build.md, "No fsync").
-    dirs: directories the caller knows exist (its set, filled in here), not made again: a build writes
-    thousands of files into a few directories. Plain os calls, no pathlib: a build's writing is mostly this
-    function, and the kernel's part (five calls for a new file) is all of it that is left.
+
+    dirs: what a writer that alone writes a tree (a build, under its lock) knows of it — {directory: the names
+    in it}, each directory made (or found) and listed once, the names written since added — so that a new
+    file is not first opened to compare (a build writes thousands of new files into a few directories). A
+    name listed is compared as always. Plain os calls, no pathlib: a build's writing is mostly this function,
+    and the kernel's part (four calls for a new file) is all of it that is left.
     """
     path = os.fspath(path)
-    try:
-        with open(path, "rb") as f:
-            if f.read() == data:
-                return False
-    except OSError:
-        pass
     parent, name = os.path.split(path)
     parent = parent or "."
-    if dirs is None or parent not in dirs:
+    names = None
+    if dirs is not None:
+        names = dirs.get(parent)
+        if names is None:
+            os.makedirs(parent, exist_ok=True)
+            names = dirs[parent] = set(os.listdir(parent))
+    if names is None or name in names:
+        try:
+            with open(path, "rb") as f:
+                if f.read() == data:
+                    return False
+        except OSError:
+            pass
+    if names is None:
         os.makedirs(parent, exist_ok=True)
-        if dirs is not None:
-            dirs.add(parent)
     # Created with mode 0666 and O_EXCL: the kernel applies the umask, as for any file a program writes
     # (tempfile.mkstemp would give 0600). The random part: a killed process's leftover of the same pid
     # (containers reuse pids run after run) never stands in the way.
@@ -64,6 +72,8 @@ def atomic_write(path: Path, data: bytes, dirs: set | None = None) -> bool:
         except OSError:
             pass
         raise
+    if names is not None:
+        names.add(name)
     return True
 
 
