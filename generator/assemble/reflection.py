@@ -12,6 +12,7 @@ Each platform spells the Interface in its own binding model (platforms.py: each 
 from __future__ import annotations
 
 from ..link.values import light_values, material_values
+from ..scene.light_sets import light_indices
 from ..scene.load import Scene
 
 
@@ -38,7 +39,7 @@ def scene_tables(scene: Scene, interfaces: dict, previous: dict | None = None) -
         specs = {s.param: s.spec for s in c.material if s.spec is not None}
         materials.setdefault(m.name, {"brdf": m.brdf, "packing": m.packing,
                                       "params": material_values(scene, m.name, specs)})
-        for i, ln in enumerate(obj["lights"]):
+        for i, ln in light_indices(scene, obj):  # a dynamic set's light: its pair's loop reads it
             lspecs = iface.params.get(f"light{i}", {})
             L = scene.lights[ln]
             lights.setdefault(ln, {"type": L.type, "shadow": L.shadow, "params": light_values(scene, ln, lspecs)})

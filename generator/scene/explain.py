@@ -35,6 +35,7 @@ from ..library.bricks import Library
 from ..spec.constraints import CONSTRAINTS
 from ..spec.permutation import Permutation
 from ..spec.resolve import resolve
+from .light_sets import set_keys
 from .load import Scene
 
 
@@ -53,8 +54,7 @@ def _first_seen(values) -> list:
 
 def axes(scene: Scene) -> dict[str, list]:
     """The values each axis takes in the scene's declarations, in declaration order."""
-    configs = _first_seen(tuple((scene.lights[n].type, scene.lights[n].shadow) for n in members)
-                          for members in scene.light_sets.values())
+    configs = _first_seen(set_keys(scene, n) for n in scene.light_sets)  # dynamic sets: their model
     return {"brdf": _first_seen(m.brdf for m in scene.materials.values()),
             "packing": _first_seen(m.packing for m in scene.materials.values()),
             "surface": _first_seen(m.surface for m in scene.materials.values()),
@@ -67,7 +67,7 @@ def _surface_text(surface) -> str:
 
 
 def _lights_text(config) -> str:
-    return ",".join(f"{t}/{s}" for t, s in config) or "-"
+    return ",".join(k.canonical() for k in config) or "-"
 
 
 def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None,
@@ -80,8 +80,6 @@ def report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None = None,
 
 
 def _report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None, shaders: dict | None) -> dict:
-    from ..spec.permutation import LightKey
-
     ax = axes(scene)
     full = 1
     for values in ax.values():
@@ -123,7 +121,7 @@ def _report(scene: Scene, lib: Library, spirv: dict[str, tuple] | None, shaders:
     for axis, vals in ax.items():
         for v in vals:
             if axis in declared:
-                key = tuple(LightKey(t, s) for t, s in v) if axis == "lights" else v
+                key = v
                 mats, hs = declared[axis].get(v, []), drawn[axis].get(key, [])
             else:
                 mats, hs = [], list(scene.permutations)
@@ -158,9 +156,8 @@ def _by_value(scene: Scene) -> tuple[dict, dict]:
     for m in scene.materials.values():
         for axis, v in (("brdf", m.brdf), ("packing", m.packing), ("surface", m.surface)):
             declared[axis].setdefault(v, []).append(m.name)
-    for n, members in scene.light_sets.items():
-        config = tuple((scene.lights[x].type, scene.lights[x].shadow) for x in members)
-        declared["lights"].setdefault(config, []).append(n)
+    for n in scene.light_sets:
+        declared["lights"].setdefault(set_keys(scene, n), []).append(n)
     for h, p in scene.permutations.items():
         for axis, v in (("brdf", p.brdf), ("packing", p.packing), ("surface", p.surface), ("lights", p.lights)):
             drawn[axis].setdefault(v, []).append(h)

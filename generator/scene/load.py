@@ -8,7 +8,9 @@ Schema (docs/guide/scenes.md, every key):
                        textures = { TEXTURE = "path.png" }, samplers = { TEXTURE = { filter, … } }
                        (the images and samplers of the packing's textures: scene/textures.py)
     [lights.NAME]      type = light brick, shadow = spec (default "none"), params = {...}
-    [light_sets]       NAME = [light names, in order]
+    [light_sets]       NAME = [light names, in order]  (static: the key lists them)
+    [light_sets.NAME]  dynamic = true, lights = [names], max = N (default 256), model = ["type/shadow", …]
+                       (dynamic: the key carries the model; scene/light_sets.py)
     [[objects]]        name, material = NAME, lights = light set NAME
 Only (material × light set) pairs that some object uses become permutations.
 """
@@ -28,6 +30,7 @@ from ..spec.permutation import PRECISIONS, LightKey, Permutation, SpecError, can
 from ..spec.resolve import Resolved, check_packing, light_params, resolve
 from ..spec.surface import DEFAULT as DEFAULT_SURFACE, Surface
 from ..spec.where import Origin, Where
+from .light_sets import MAX_LIGHTS_PER_SET, DynamicSet, read_light_sets  # noqa: F401 (the cap, read here too)
 from .locate import Locator
 from .textures import declared, toml_bindings
 
@@ -70,6 +73,8 @@ class Scene:
     head_at: tuple[int, int] = (1, 1)
     notes: list[str] = field(default_factory=list)  # what an importer accepted or did not apply (scene/gltf.py)
     extra: dict = field(default_factory=dict)  # an importer's own data: glTF's extensions and pygltflib document
+    # light set name -> DynamicSet (scene/light_sets.py): the sets whose lights a loop reads from buffers
+    dynamic_sets: dict[str, DynamicSet] = field(default_factory=dict)
 
 
 def read_toml(path: Path, what: str, syntax_hint: str, limit: int = MAX_INPUT_BYTES) -> tuple[dict, "Locator"]:
@@ -94,7 +99,6 @@ def read_toml(path: Path, what: str, syntax_hint: str, limit: int = MAX_INPUT_BY
 # and reading one takes about 0.6 s per MB
 MAX_SCENE_BYTES = 64 << 20
 SCENE_SUFFIXES = (".toml", ".gltf", ".glb")  # what a SCENE argument may be: TOML, or glTF 2.0 (scene/gltf.py)
-MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed SPIR-V's 255 function arguments
 
 
 def load_scene(path, lib: Library) -> Scene:
@@ -182,19 +186,7 @@ def _load_toml(path: Path, lib: Library) -> Scene:
         _check_params(loc, f"lights.{name}", params, specs, f"light '{ltype}' with shadow '{shadow}'")
         scene.lights[name] = Light(name, ltype, shadow, params)
 
-    for name, members in _table(loc, data, "light_sets").items():
-        where = loc.find("light_sets", name)
-        if not isinstance(members, list) or not all(isinstance(x, str) for x in members):
-            raise loc.error(where, f"light set '{name}' must be a list of light names", 'write outdoor = ["sun"]')
-        if len(members) > MAX_LIGHTS_PER_SET:
-            raise loc.error(where, f"light set '{name}' has {len(members)} lights, more than the {MAX_LIGHTS_PER_SET} "
-                            "a specialized shader takes (its lights are unrolled: every light adds arguments, "
-                            "and SPIR-V allows a function 255)", f"split it into sets of at most {MAX_LIGHTS_PER_SET}")
-        for x in members:
-            if x not in scene.lights:
-                raise loc.error(where, f"light set '{name}' names unknown light '{x}'",
-                                f"lights: {', '.join(scene.lights) or 'none defined'}")
-        scene.light_sets[name] = members
+    read_light_sets(loc, data, scene, lib)  # static lists and dynamic tables (scene/light_sets.py)
 
     objects = data.get("objects", [])
     if not isinstance(objects, list):
@@ -222,8 +214,14 @@ def _load_toml(path: Path, lib: Library) -> Scene:
             raise loc.error(loc.find("objects", *(["lights"] if "lights" in obj else []), nth=i),
                             f"object '{oname}' needs lights = a light set name", 'write lights = "outdoor"')
         m = scene.materials[mat]
-        keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in names)
-        origin = Origin(parts[mat] + tuple((f"light{k}", parts[f"light:{n}"]) for k, n in enumerate(names)))
+        dyn = scene.dynamic_sets.get(lset)
+        if dyn is None:
+            keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in names)
+            origin = Origin(parts[mat] + tuple((f"light{k}", parts[f"light:{n}"]) for k, n in enumerate(names)))
+        else:  # the set's model: one loop per pair, whatever the number of lights
+            keys = dyn.model
+            set_at = at("light_sets", lset, "model" if "model" in data["light_sets"][lset] else "lights")
+            origin = Origin(parts[mat] + tuple((f"light{k}", set_at) for k in range(len(keys))))
         perm = Permutation(m.brdf, keys, m.packing, output, precision, m.surface, origin)
         h = hashes.get(perm)
         if h is None:  # the first object of a permutation: where messages about it will point

@@ -53,8 +53,13 @@ SCENE_SCHEMA = {
         "lights": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["type"],
             "properties": {"type": NAME, "shadow": SPEC, "params": PARAMS}}},
-        "light_sets": {"type": "object", "propertyNames": NAME,
-                       "additionalProperties": {"type": "array", "items": NAME, "maxItems": 4096}},
+        # a static set is a list of light names; a dynamic one a table (scene/light_sets.py): the keywords of
+        # one type are ignored by the other, so one schema says both
+        "light_sets": {"type": "object", "propertyNames": NAME, "additionalProperties": {
+            "type": ["array", "object"], "items": NAME, "maxItems": 4096,
+            "additionalProperties": False, "required": ["dynamic"],
+            "properties": {"dynamic": {"type": "boolean"}, "lights": {"type": "array", "items": NAME, "maxItems": 1 << 16},
+                           "max": {"type": "integer"}, "model": {"type": "array", "items": SPEC, "maxItems": 256}}}},
         "objects": {"type": "array", "items": {
             "type": "object", "additionalProperties": False, "required": ["material", "lights"],
             "properties": {"name": NAME, "material": NAME, "lights": NAME}}},
@@ -62,7 +67,7 @@ SCENE_SCHEMA = {
 }
 
 _TYPES = {"object": "a table", "array": "an array", "string": "a string", "number": "a number",
-          "boolean": "true or false"}
+          "integer": "a whole number", "boolean": "true or false"}
 _EXAMPLES = {"scene": "[scene] name = \"courtyard\"", "materials": "[materials.NAME] brdf = \"lambert\"",
              "lights": "[lights.NAME] type = \"point\"", "light_sets": "[light_sets] NAME = [\"sun\"]",
              "objects": "[[objects]] material = \"NAME\" lights = \"SET\""}
@@ -93,6 +98,8 @@ def _where(path: list) -> str:
     head, keys, nth = _header(path)
     if head == "objects":
         return f"object {nth + 1} ([[objects]])"
+    if head == "light_sets" and keys:
+        return f"light set '{keys[0]}'"
     return f"[{head}]" if head else "the scene"
 
 
@@ -180,7 +187,8 @@ def _located(e, loc):
         missing = next(k for k in e.validator_value if k not in e.instance)
         return loc.error(pos, f"{_where(path)} has no '{missing}'", f"add {missing} = …")
     if e.validator == "type":
-        want = _TYPES.get(e.validator_value, e.validator_value)
+        types = e.validator_value if isinstance(e.validator_value, list) else [e.validator_value]
+        want = " or ".join(_TYPES.get(t, t) for t in types)
         example = _EXAMPLES.get(str(path[0]) if path else "", "see docs/guide/scenes.md")
         return loc.error(pos, f"'{key}' must be {want}, not {_what(e.instance)}", f"write {example}"
                          if len(path) <= 1 else f"give {want}")

@@ -1,0 +1,164 @@
+"""A scene's light sets: a static set lists its lights (the key lists them, in order); a dynamic set is a table.
+
+    [light_sets]
+    outdoor = ["sun"]                 # static: every light is unrolled in the shader, at most MAX_LIGHTS_PER_SET
+
+    [light_sets.crowd]                # dynamic: one loop per type/shadow-filter pair over a storage buffer
+    dynamic = true
+    lights = ["lamp0", "lamp1"]       # the lights it holds (any number up to max)
+    max = 64                          # the capacity of its buffers (what an engine allocates); default 256
+    model = ["point/none"]            # optional: the pairs a light of it may be; default: its lights' pairs
+
+The permutation key of an object lit by a dynamic set carries the set's model (sorted dynamic LightKeys,
+`lights=*point/none,*spot/none`), not its lights: any number of lights of those pairs is one shader per material.
+Why a model may name pairs no light has yet: an engine adding lights at run time needs the shader that reads
+them. A shadow filter that samples a texture cannot be looped over yet (one shadow map per element needs texture
+arrays), so such a pair is refused here, at the set, before any shader is linked.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..library.bricks import Library
+from ..spec.permutation import LightKey, SpecError, canonical, parse_spec
+from .locate import Locator
+
+MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed SPIR-V's 255 function arguments
+DEFAULT_MAX = 256  # a dynamic set's buffer capacity when the scene gives none
+MAX_DYNAMIC = 1 << 16  # a dynamic set's largest capacity: what an engine allocates per pair must stay sane
+
+
+@dataclass(frozen=True)
+class DynamicSet:
+    """A dynamic light set: its model (the key's sorted dynamic LightKeys) and its buffers' capacity."""
+
+    name: str
+    model: tuple  # (LightKey(dynamic=True), ...) sorted by canonical text
+    max: int  # the capacity of each pair's buffer, in lights
+
+    def pair_of(self, light) -> int:
+        """The index in the model (the permutation's light index) of a scene Light."""
+        return self.model.index(LightKey(light.type, light.shadow, True))
+
+
+def set_keys(scene, name: str) -> tuple:
+    """The permutation key's lights for light set `name`: a static set's lights in order, a dynamic set's model."""
+    dyn = scene.dynamic_sets.get(name)
+    if dyn is not None:
+        return dyn.model
+    return tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in scene.light_sets[name])
+
+
+def light_indices(scene, obj) -> list[tuple[int, str]]:
+    """(permutation light index, light name) for every light of an object: a static set's lights are the key's
+    lights in order; a dynamic set's light is read by the loop of its type/filter pair."""
+    dyn = scene.dynamic_sets.get(obj["light_set"])
+    if dyn is None:
+        return list(enumerate(obj["lights"]))
+    return [(dyn.pair_of(scene.lights[n]), n) for n in obj["lights"]]
+
+
+def read_light_sets(loc: Locator, data: dict, scene, lib: Library) -> None:
+    """Fill scene.light_sets (name -> light names) and scene.dynamic_sets from [light_sets]; located errors."""
+    table = data.get("light_sets", {})
+    if not isinstance(table, dict):
+        raise loc.error(loc.top("light_sets"), "'light_sets' must be a table", "write [light_sets] NAME = [\"sun\"]")
+    for name, value in table.items():
+        where = loc.find("light_sets", name)
+        if isinstance(value, dict):
+            members = _dynamic(loc, name, value, scene, lib)
+        else:
+            members = value
+            if not isinstance(members, list) or not all(isinstance(x, str) for x in members):
+                raise loc.error(where, f"light set '{name}' must be a list of light names", 'write outdoor = ["sun"]')
+            if len(members) > MAX_LIGHTS_PER_SET:
+                raise loc.error(where, f"light set '{name}' has {len(members)} lights, more than the "
+                                f"{MAX_LIGHTS_PER_SET} a specialized shader takes (its lights are unrolled: every "
+                                "light adds arguments, and SPIR-V allows a function 255)",
+                                f"split it into sets of at most {MAX_LIGHTS_PER_SET}, or make it dynamic "
+                                f"([light_sets.{name}] dynamic = true, lights = [...])")
+            _known(loc, where, name, members, scene)
+        scene.light_sets[name] = list(members)
+
+
+def _known(loc: Locator, where, name: str, members: list, scene) -> None:
+    for x in members:
+        if x not in scene.lights:
+            raise loc.error(where, f"light set '{name}' names unknown light '{x}'",
+                            f"lights: {', '.join(scene.lights) or 'none defined'}")
+
+
+def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library) -> list:
+    """A dynamic set's lights; records its DynamicSet in scene.dynamic_sets."""
+    def at(key):
+        return loc.find("light_sets", name, key)
+    if t.get("dynamic") is not True:
+        raise loc.error(at("dynamic") if "dynamic" in t else loc.find("light_sets", name),
+                        f"light set '{name}' is a table, which only a dynamic set is",
+                        f"add dynamic = true, or write a static set as a list: {name} = [\"sun\"]")
+    members = t.get("lights", [])
+    _known(loc, at("lights"), name, members, scene)
+    if len(set(members)) != len(members):
+        twice = next(x for x in members if members.count(x) > 1)
+        raise loc.error(at("lights"), f"light set '{name}' holds light '{twice}' twice", "list each light once")
+    if "model" in t:
+        model = tuple(_model_entry(loc, at("model"), name, e, lib) for e in t["model"])
+        if len(set(model)) != len(model):
+            raise loc.error(at("model"), f"light set '{name}': its model names a pair twice", "name each pair once")
+    else:
+        model = tuple(dict.fromkeys(LightKey(scene.lights[n].type, scene.lights[n].shadow, True) for n in members))
+        if not model:
+            raise loc.error(loc.find("light_sets", name), f"dynamic light set '{name}' has no lights and no model",
+                            'give the pairs its lights may be: model = ["point/none"]')
+    model = tuple(sorted(model, key=LightKey.canonical))
+    for n in members:
+        light = scene.lights[n]
+        if LightKey(light.type, light.shadow, True) not in model:
+            raise loc.error(at("lights"), f"light '{n}' ({light.type}/{light.shadow}) is not in the model of dynamic "
+                            f"light set '{name}' ({', '.join(k.canonical()[1:] for k in model)})",
+                            f"add \"{light.type}/{light.shadow}\" to its model, or move '{n}' to another set")
+    where = at("model") if "model" in t else at("lights")
+    for k in model:
+        sampled = _texture_of(lib, k)
+        if sampled:
+            raise loc.error(where, f"light set '{name}': lights in a buffer cannot have a shadow map yet "
+                            f"({k.light}/{k.shadow} samples '{sampled}')", "use shadow none, or a static set")
+    cap = t.get("max", DEFAULT_MAX)
+    if not 1 <= cap <= MAX_DYNAMIC:
+        raise loc.error(at("max"), f"light set '{name}': max is {cap}, not between 1 and {MAX_DYNAMIC}",
+                        f"give the capacity its buffers are allocated for, e.g. max = {DEFAULT_MAX}")
+    if cap < len(members):
+        raise loc.error(at("max"), f"light set '{name}' holds {len(members)} lights, more than its max = {cap}",
+                        f"raise max to at least {len(members)}")
+    scene.dynamic_sets[name] = DynamicSet(name, model, cap)
+    return members
+
+
+def _model_entry(loc: Locator, where, name: str, entry: str, lib: Library) -> LightKey:
+    """One `type/shadow` pair of a model, checked against the library (a malformed entry is a located error)."""
+    ltype, slash, shadow = entry.partition("/")
+    if not slash or not ltype or not shadow:
+        raise loc.error(where, f"light set '{name}': model entry {entry!r} is not TYPE/SHADOW",
+                        'write e.g. model = ["point/none", "spot/none"]')
+    if lib.get("light", ltype) is None:
+        raise loc.error(where, f"light set '{name}': model entry {entry!r} names unknown light type '{ltype}'",
+                        f"type is one of {', '.join(b.id for b in lib.of_kind('light'))}")
+    try:
+        nodes = parse_spec(shadow, lib, ("shadow",))
+    except SpecError as e:
+        raise loc.error(where, f"light set '{name}': model entry {entry!r}: {e.message}", e.hint) from None
+    if len(nodes) != 1:
+        raise loc.error(where, f"light set '{name}': model entry {entry!r} names {len(nodes)} shadow filters",
+                        "a pair is one light type and one shadow filter")
+    return LightKey(ltype, canonical(nodes), True)
+
+
+def _texture_of(lib: Library, k: LightKey) -> str:
+    """The first texture a pair's light brick or shadow filter samples ('' when none)."""
+    light = lib.get("light", k.light)
+    if light is not None and light.textures:
+        return next(iter(light.textures))
+    for n in parse_spec(k.shadow, lib, ("shadow",)):
+        if n.textures:
+            return next(iter(n.textures))
+    return ""
