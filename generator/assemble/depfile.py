@@ -86,7 +86,7 @@ def inputs(scene, lib, out: Path, templates) -> list[str]:
     from ..backends import template_file
     from .texture_outputs import image_files
     bricks = sorted(_bricks(scene, lib), key=lambda b: (b.kind, b.id))
-    files = [scene.path, *image_files(scene), *(b.path for b in bricks), *_table_sources(bricks),
+    files = [scene.path, *scene.extra.get("inputs", ()), *image_files(scene), *(b.path for b in bricks), *_table_sources(bricks),
              *(template_file(t) for t in sorted(templates)), *brick_dirs(lib), Path(out) / VERSIONS]
     return sorted({shown(f) for f in files})
 

@@ -42,13 +42,15 @@ import numpy as np
 from ..library.bricks import Library
 from ..spec.permutation import LightKey, Permutation
 from .gltf_extensions import ACCEPTED_EXTENSIONS, SHADING_EXTENSIONS, check_extensions
-from .gltf_lights import MAX_LIGHTS_PER_SET, SPOT_NO_RANGE, LightSets
+from .gltf_lights import LIGHTS, MAX_LIGHTS_PER_SET, SPOT_NO_RANGE, LightSets
 from .gltf_materials import BRDF, GltfMaterial, Materials, textures_need_uv
 from .gltf_meshes import MODES, generate_tangents, primitive_mesh
 from .gltf_names import clean, free_name, unique_names
 from .gltf_nodes import instances
 from .gltf_read import MAX_GLTF_BYTES, GltfError, Reader, open_gltf, pygltf_document
+from .gltf_sidecar import Sidecar
 from .jsonpos import origins, pointer
+from .light_sets import set_keys
 from .load import Scene
 
 __all__ = ["ACCEPTED_EXTENSIONS", "BRDF", "MAX_GLTF_BYTES", "MAX_LIGHTS_PER_SET", "SHADING_EXTENSIONS",
@@ -80,12 +82,18 @@ def load_gltf(path, lib: Library) -> Scene:
     if not scenes and rd.array("meshes"):
         notes.append("the file has no scenes: its meshes are not instanced, so no objects")
     set_names = unique_names([s.get("name") if isinstance(s.get("name"), str) else "" for s in scenes], "scene")
+    lights_file = Sidecar(path, lib)  # SCENE.lights.toml: shadows and a dynamic set (scene/gltf_sidecar.py)
     for si, s in enumerate(scenes):
         placed = instances(rd, si, s)
-        members = build.lights.of_scene(si, placed)
+        members = build.lights.of_scene(si, placed, limit=not lights_file.dynamic)
+        lights_file.apply_lights(scene, members)
         scene.light_sets[set_names[si]] = members
+        lights_file.apply_set(scene, set_names[si])
         for ni, world in placed:
             build.node(ni, world, set_names[si], members)
+    lights_file.check_names(scene)
+    if lights_file.found:
+        scene.extra["inputs"] = [lights_file.path]  # read by every command: a build's depfile lists it
     for h, origin in origins(rd.shown, text, build.asks, rd.glb).items():
         scene.permutations[h] = replace(scene.permutations[h], origin=origin)
         scene.where.setdefault(h, (origin.parts[0][1].line, origin.parts[0][1].col))
@@ -139,10 +147,19 @@ class _Objects:
             raise rd.err(f"{mptr}/primitives", "a mesh has at least one primitive", "remove the mesh or add one")
         nname = node.get("name") if isinstance(node.get("name"), str) and node.get("name") else \
             mesh.get("name") if isinstance(mesh.get("name"), str) and mesh.get("name") else f"node{ni}"
-        keys = tuple(LightKey(scene.lights[n].type, scene.lights[n].shadow) for n in members)
+        keys = set_keys(scene, lset)  # a dynamic set's model, or its lights
         at = _Placed(ni, world, mi, nname, len(prims) > 1, lset, members, keys)
         for pi, prim in enumerate(prims):
             self._primitive(at, pi, prim)
+
+    def _light_ptr(self, at: _Placed, k: int) -> str:
+        """Where light k of the key was asked for: a static set's light k, a dynamic set's first light of pair k."""
+        if at.light_set not in self.scene.dynamic_sets:
+            return self.lights.ptrs[at.lights[k]]
+        pair = at.keys[k]
+        first = next((n for n in at.lights if LightKey(self.scene.lights[n].type, self.scene.lights[n].shadow, True)
+                      == pair), None)
+        return self.lights.ptrs[first] if first else LIGHTS
 
     def _primitive(self, at: _Placed, pi: int, prim) -> None:
         rd, scene = self.rd, self.scene
@@ -171,7 +188,7 @@ class _Objects:
             scene.permutations.setdefault(h, perm)
             self.asks[h] = ((("brdf", m.source if mat_i is not None else pptr),)
                             + ((("vertex_color", f"{pptr}/attributes/COLOR_0"),) if m.surface.vertex_color else ())
-                            + tuple((f"light{k}", self.lights.ptrs[n]) for k, n in enumerate(at.lights)))
+                            + tuple((f"light{k}", self._light_ptr(at, k)) for k in range(len(at.keys))))
         scene.users.setdefault(h, []).append(oname)
         scene.objects.append({"name": oname, "material": m.name, "light_set": at.light_set, "lights": list(at.lights),
                               "permutation": h, "node": at.node, "mesh_index": at.mesh, "primitive": pi,

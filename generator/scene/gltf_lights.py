@@ -7,7 +7,8 @@ range or 1e6 when absent, inner_angle/outer_angle = innerConeAngle/outerConeAngl
 intensity (the bricks' "game intensity"; candela / lux are taken as is). Each glTF scene is one light set
 (its lights in node order, at most MAX_LIGHTS_PER_SET), and every mesh node of that scene uses it. A light
 is named from its definition, else its node, else `light<k>` (scene/gltf_names.py); an error about it is
-at its definition, `/extensions/KHR_lights_punctual/lights/<k>`.
+at its definition, `/extensions/KHR_lights_punctual/lights/<k>`. A lights file beside the scene
+(SCENE.lights.toml, scene/gltf_sidecar.py) then gives lights shadow filters and may make the sets dynamic.
 """
 from __future__ import annotations
 
@@ -38,8 +39,9 @@ class LightSets:
         self.names: set[str] = set()
         self.ptrs: dict[str, str] = {}  # light name -> the pointer of its KHR_lights_punctual definition
 
-    def of_scene(self, si: int, instances: list) -> list[str]:
-        """The names of the lights glTF scene si's node instances carry, in node order (its light set)."""
+    def of_scene(self, si: int, instances: list, limit: bool = True) -> list[str]:
+        """The names of the lights glTF scene si's node instances carry, in node order (its light set); limit:
+        at most MAX_LIGHTS_PER_SET (a static set; a dynamic one, by the lights file, holds up to its max)."""
         rd, klights = self.rd, self.defs
         nodes = rd.array("nodes")
         members = []
@@ -61,10 +63,11 @@ class LightSets:
             self.scene.lights[lname] = light(rd, self.lib, klights[k], f"{LIGHTS}/lights/{k}", lname, world)
             self.ptrs[lname] = f"{LIGHTS}/lights/{k}"
             members.append(lname)
-        if len(members) > MAX_LIGHTS_PER_SET:
+        if limit and len(members) > MAX_LIGHTS_PER_SET:
             raise rd.err(pointer("scenes", si), f"scene {si} has {len(members)} lights, more than the "
                          f"{MAX_LIGHTS_PER_SET} a specialized shader takes (its lights are unrolled)",
-                         f"split it into scenes of at most {MAX_LIGHTS_PER_SET} lights")
+                         f"split it into scenes of at most {MAX_LIGHTS_PER_SET} lights, or make its lights "
+                         "dynamic in SCENE.lights.toml ([light_set] dynamic = true)")
         return members
 
 

@@ -58,6 +58,11 @@ def light_indices(scene, obj) -> list[tuple[int, str]]:
     return [(dyn.pair_of(scene.lights[n]), n) for n in obj["lights"]]
 
 
+def dynamic_set(loc: Locator, name: str, t: dict, scene, lib: Library, header: tuple) -> None:
+    """Make light set `name` (its lights already in scene.light_sets) dynamic by table t, found at `header`."""
+    _dynamic(loc, name, t, scene, lib, header, scene.light_sets[name])
+
+
 def read_light_sets(loc: Locator, data: dict, scene, lib: Library) -> None:
     """Fill scene.light_sets (name -> light names) and scene.dynamic_sets from [light_sets]; located errors."""
     table = data.get("light_sets", {})
@@ -88,15 +93,20 @@ def _known(loc: Locator, where, name: str, members: list, scene) -> None:
                             f"lights: {', '.join(scene.lights) or 'none defined'}")
 
 
-def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library) -> list:
-    """A dynamic set's lights; records its DynamicSet in scene.dynamic_sets."""
+def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library, header: tuple = (), given=None) -> list:
+    """A dynamic set's lights; records its DynamicSet in scene.dynamic_sets. header: where its table is, the
+    keys before its own (a scene's ("light_sets", name), the default; a glTF sidecar's ("light_set",));
+    given: its lights when the table does not list them (a glTF scene's)."""
+    header = header or ("light_sets", name)
+
     def at(key):
-        return loc.find("light_sets", name, key)
+        return loc.find(*header, key)
     if t.get("dynamic") is not True:
-        raise loc.error(at("dynamic") if "dynamic" in t else loc.find("light_sets", name),
+        raise loc.error(at("dynamic") if "dynamic" in t else loc.find(*header),
                         f"light set '{name}' is a table, which only a dynamic set is",
                         f"add dynamic = true, or write a static set as a list: {name} = [\"sun\"]")
-    members = t.get("lights", [])
+    listed, t = t, {"lights": [], **t, **({"lights": given} if given is not None else {})}
+    members = t["lights"]
     _known(loc, at("lights"), name, members, scene)
     if len(set(members)) != len(members):
         twice = next(x for x in members if members.count(x) > 1)
@@ -108,14 +118,15 @@ def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library) -> list:
     else:
         model = tuple(dict.fromkeys(LightKey(scene.lights[n].type, scene.lights[n].shadow, True) for n in members))
         if not model:
-            raise loc.error(loc.find("light_sets", name), f"dynamic light set '{name}' has no lights and no model",
+            raise loc.error(loc.find(*header), f"dynamic light set '{name}' has no lights and no model",
                             'give the pairs its lights may be: model = ["point/none"]')
     model = tuple(sorted(model, key=LightKey.canonical))
     for n in members:
         light = scene.lights[n]
         if LightKey(light.type, light.shadow, True) not in model:
-            raise loc.error(at("lights"), f"light '{n}' ({light.type}/{light.shadow}) is not in the model of dynamic "
-                            f"light set '{name}' ({', '.join(k.canonical()[1:] for k in model)})",
+            raise loc.error(at("lights" if "lights" in listed else "model"),
+                            f"light '{n}' ({light.type}/{light.shadow}) is not in the model of dynamic light set "
+                            f"'{name}' ({', '.join(k.canonical()[1:] for k in model)})",
                             f"add \"{light.type}/{light.shadow}\" to its model, or move '{n}' to another set")
     where = at("model") if "model" in t else at("lights")
     for k in model:

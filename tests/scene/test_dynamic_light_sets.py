@@ -100,3 +100,47 @@ def test_a_static_set_past_32_lights_points_at_dynamic_sets(tmp_path):
     with pytest.raises(SourceError) as e:
         _load(tmp_path, _scene(33, f"[light_sets]\ncrowd = [{names}]\n"))
     assert "make it dynamic" in str(e.value)
+
+
+# ---------------------------------------------------------------- glTF: SCENE.lights.toml beside the scene
+
+def _gltf(tmp_path, sidecar: str | None):
+    from generator.library.bricks import load_library
+    from generator.scene.load import load_scene
+    from tests.scene.test_gltf import sample_doc
+    path = sample_doc(extra_lights=True).write_gltf(tmp_path / "model.gltf")
+    if sidecar is not None:
+        (tmp_path / "model.lights.toml").write_text(sidecar)
+    return load_scene(path, load_library(()))
+
+
+def test_a_gltf_lights_file_gives_shadows_and_a_dynamic_set(tmp_path):
+    static = _gltf(tmp_path, None)
+    assert [static.lights[n].shadow for n in ("sun", "bulb", "torch")] == ["none"] * 3 and not static.dynamic_sets
+    shadowed = _gltf(tmp_path, '[lights.sun]\nshadow = "pcf"\n')
+    assert shadowed.lights["sun"].shadow == "pcf" and "lights=directional/pcf," in next(
+        iter(shadowed.permutations.values())).canonical()
+    dyn = _gltf(tmp_path, '[light_set]\ndynamic = true\nmax = 16\nmodel = ["spot/none", "directional/none", '
+                          '"point_range/none", "point/none"]\n')
+    assert dyn.dynamic_sets["main"].max == 16
+    keys = {p.canonical().split(";")[1] for p in dyn.permutations.values()}
+    assert keys == {"lights=*directional/none,*point/none,*point_range/none,*spot/none"}
+    assert [str(p) for p in dyn.extra["inputs"]] == [str(tmp_path / "model.lights.toml")]
+
+
+@pytest.mark.parametrize("sidecar, line, words", [
+    ('[lights.sunn]\nshadow = "pcf"\n', 1, ["the glTF scene has no light 'sunn'", "did you mean 'sun'?"]),
+    ('[lights.sun]\nshadows = "pcf"\n', 2, ["unknown key 'shadows' in [lights.sun]", "did you mean 'shadow'?"]),
+    ('[light_set]\ndynamic = true\nmaxx = 4\n', 3, ["unknown key 'maxx' in [light_set]", "did you mean 'max'?"]),
+    ('[light_set]\ndynamic = true\nmodel = ["point/none"]\n', 3, ["light 'sun' (directional/none) is not in the model"]),
+    ('[lights.sun]\nshadow = "pcf"\n[light_set]\ndynamic = true\n', 3,
+     ["lights in a buffer cannot have a shadow map yet"]),
+    ('[light_set]\nmax = 4\n', 2, ["'max' is for a dynamic light set"]),
+    ('[light_set]\ndynamic = true\nmax = 2\n', 3, ["holds 3 lights, more than its max = 2"]),
+])
+def test_a_wrong_gltf_lights_file_is_one_located_error(tmp_path, sidecar, line, words):
+    with pytest.raises(SourceError) as e:
+        _gltf(tmp_path, sidecar)
+    msg = str(e.value)
+    assert msg.startswith(f"{tmp_path / 'model.lights.toml'}:{line}:") and " — " in msg, msg
+    assert all(w in msg for w in words), msg
