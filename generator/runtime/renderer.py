@@ -15,17 +15,19 @@ the objects stand in a row along x, 2.5 apart, in scene order, and the camera lo
 centre from above and in front (:func:`camera`, :func:`placement`).
 
 Shadows: for every light whose shadow filter samples a texture (shadow_map, pcf, pcf_hardware, vsm), a
-depth pass before the first frame draws every object from the light with the generated depth shaders
+depth pass before the first frame draws the objects of its light sets from the light (they alone cast its
+shadow, as they alone receive it) with the generated depth shaders
 (compose/depth.py), as the light's depth pass description says (runtime/shadow_pass.py, depth_pass: the
 manifest's ``lights.<name>.depth_pass``, here for the Vulkan platform and a ``shadow_size`` square map;
 runtime/depth_passes.py draws it): a masked material's objects through its mask unit (its coverage cuts
 holes in the shadow), every other one through the position-only vertex stage; for a brick texture named
 `shadow_moments` (vsm) the moments stage writes (d, d², 0, 1) into an RGBA32F target and the blur unit's two
-fullscreen passes box-filter it on the GPU. The light's matrix is fitted to the placed objects' bounds
+fullscreen passes box-filter it on the GPU. The light's matrix is fitted to its casters' placed bounds
 (shadow_pass.fit_shadow_matrix: a directional light's orthographic projection along its direction, a point
-light's perspective one from its position) and written into the light's shadow_matrix parameter of both
-paths (the specialized Lights blocks and the ubershader's LightEntry data); the depth map is bound as the
-light's shadow map (pcf: a `pcf_texel` the scene leaves unset is written as 1 / shadow_size, in both paths
+light's perspective one from its position, a spot's or uberlight's from its position along its axis covering its
+cone; casters the map cannot reach are a warning located at the light, in the report's shadow_warnings) and
+written into the light's shadow_matrix parameter of both paths (the specialized Lights blocks and the
+ubershader's LightEntry data); the depth map is bound as the light's shadow map (pcf: a `pcf_texel` the scene leaves unset is written as 1 / shadow_size, in both paths
 too), the blurred moments as its `shadow_moments`. A `texture2d_shadow`
 (pcf_hardware) reads the depth pass's D32_SFLOAT image itself through a comparison sampler
 (runtime/depth_images.py: linear, compareOp LESS_OR_EQUAL), where no map is drawn a lit 1×1 depth image
@@ -95,6 +97,8 @@ class Report:
     texture_notes: list[str] = field(default_factory=list)  # what the device clamped of a sampler state
     validation: bool = False  # whether the Khronos validation layer was on
     validation_messages: list[str] = field(default_factory=list)  # what the layer said during this render
+    # per shadowed light whose map misses casters it may light (shadow_pass.uncovered): a located warning
+    shadow_warnings: list[str] = field(default_factory=list)
 
     def as_dict(self) -> dict:
         from dataclasses import asdict
@@ -187,8 +191,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
     from .material_textures import BuildOutputs, MaterialTextures
     from .pipeline_state import COLOR_FORMATS, clear_color, color_attachment, render_state
-    from .shadow_pass import (VULKAN_CONVENTIONS, depth_pass, depth_plan, fit_shadow_matrix, pass_units,
-                              shadowed_lights)
+    from .shadow_pass import (VULKAN_CONVENTIONS, caster_points, casters as casters_of, depth_pass, depth_plan,
+                              fit_lights, light_where, pass_units, shadowed_lights)
 
     if mode not in MODES:
         raise UserError(f"unknown mode {mode!r} — use one of {', '.join(MODES)}")
@@ -231,13 +235,13 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     spv = {k: results[j.key].spirv for k, j in jobs.items()}
 
     # Shadowed lights (their filter samples a texture) and their matrices, fitted to the placed objects.
-    points = placed.points()
     light_vals = {ln: {k: L.params.get(k, sp.default) for k, sp in _light_specs(lib, L).items()}
                   for ln, L in scene.lights.items()}
     sampled = shadow_textures(resolved.values())  # a used light's filter is among them
     shadowed = list(shadowed_textures)
-    matrices = {ln: gx.column_major(fit_shadow_matrix(scene.lights[ln].type, light_vals[ln], points, ln))
-                for ln in shadowed}
+    # each light's casters (the objects of its light sets) and its matrix fitted to their bounds
+    cast_by = {ln: casters_of(scene, ln) for ln in shadowed}
+    matrices, shadow_warnings = fit_lights(scene, placed, light_vals, cast_by)
     for ln in shadowed:
         light_vals[ln]["shadow_matrix"] = matrices[ln]
     # pcf's tap spacing: one texel of the map this render makes, unless the scene says otherwise
@@ -256,7 +260,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             device = Device(validation=validation_requested())
     first_message = len(device.messages)
     owned = []
-    report = Report(mode, language, (W, H), placement=str(placed.source) if placed.source else "row")
+    report = Report(mode, language, (W, H), placement=str(placed.source) if placed.source else "row",
+                    shadow_warnings=shadow_warnings)
     try:
         cache = PipelineCacheFile(device, out / f"pipeline_cache.{language}.bin")
         report.cache_problem = cache.problem
@@ -349,7 +354,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for ln in shadowed:
                 desc = passes_of[ln]
                 m = np.asarray(desc["matrix"]["premultiply"]["vulkan"]) @ np.asarray(matrices[ln]).reshape(4, 4).T
-                drawn = passes.draw(desc, m, np.append(points.mean(0), 1.0), casters)
+                drawn = passes.draw(desc, m, np.append(caster_points(placed, cast_by[ln]).mean(0), 1.0),
+                                    [casters[i] for i in cast_by[ln]])
                 if drawn.depth is not None:
                     shadow_maps[ln] = drawn.depth
                 if drawn.moments is not None:
@@ -404,7 +410,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             if t.param == MOMENTS and light_name in moments:
                 return moments[light_name]
             if t.compare:  # a depth image for a comparison sampler: the depth pass's own, or a lit (1.0) one
-                return depth_compared(shadow_maps.get(light_name))
+                return depth_compared(shadow_maps.get(light_name), light_name)
             return shadow_maps[light_name] if light_name in shadow_maps else textures[t.param]
 
         def stand_in(t):
@@ -422,12 +428,13 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 owned.append(compared["sampler"])
             return compared["sampler"]
 
-        def depth_compared(dt):
+        def depth_compared(dt, light_name=None):
             """What a texture2d_shadow reads: depth target dt (its D32_SFLOAT image), or a lit 1×1 stand-in."""
             if dt is not None:
                 if dt.sampled != "depth":
-                    raise UserError(f"{device.name} cannot linearly filter {dt.depth_format} depth: no comparison "
-                                    "sampler for a texture2d_shadow (pcf_hardware) — use pcf")
+                    raise light_where(scene, light_name).error(
+                        f"light '{light_name}': {device.name} cannot linearly filter {dt.depth_format} depth: no "
+                        "comparison sampler for a texture2d_shadow (pcf_hardware)", 'use shadow = "pcf"')
                 return dt
             if "lit" not in compared:
                 compared["lit"] = DepthImage(device, np.ones((1, 1), np.float32))
@@ -482,7 +489,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             frame_export = FrameExport(scene.name, (W, H), attachment, clear, eye, gx.column_major(vp),
                                        *placed_meshes(placed.objects, key_of, cpu_meshes), draw_order=blended_last,
                                        lights={ln: {"shadow_matrix": matrices[ln], "pcf_texel": texels.get(ln),
-                                                    "size": passes_of[ln]["size"], "eye": points.mean(0)}
+                                                    "size": passes_of[ln]["size"],
+                                                    "eye": caster_points(placed, cast_by[ln]).mean(0),
+                                                    "casters": cast_by[ln]}
                                                for ln in shadowed})
         specialized: dict[str, object] = {}
         order = list(dict.fromkeys(h for h, _, _, _ in draws))  # first use

@@ -20,13 +20,40 @@ is then clip y = -1, as in Vulkan), and z' = 2z - w where the depth range is -1.
 glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), which makes it the identity instead). The colour pass keeps
 shadow_matrix itself. A y flip reverses the triangles' winding; the depth pass culls nothing.
 
+The casters: a shadowed light casts only onto and from the objects of its light sets, as the scene says: its
+depth pass draws the objects whose light set holds it (:func:`casters`), and its fit covers only their bounds
+(the manifest's ``matrix.fit.casters`` = "light_sets"; the frame export lists them per light). An object outside
+those sets neither receives the light (its permutation has no slot for it) nor casts its shadow.
+
 The fit (:func:`fit_shadow_matrix`, the method the renderer uses; an engine that fits to its own bounds
-the same way gets the same matrix): a directional light's orthographic projection along its direction
-around the centre of the bounds, x and y padded by FIT_MARGIN of their extent, depth spanning them; a
-point light's perspective projection from its position toward the bounds' centre, its field of view
-covering them up to ±FIT_MAX_HALF_ANGLE degrees, near and far fitted with 2 % slack. The bounds are the
-world-space corners of every object's axis-aligned bounding box in its own space, transformed by its
-model matrix (runtime/placement.py, Placement.points); `render` records the matrices it used in its report.
+the same way gets the same matrix), per light brick:
+
+- directional: an orthographic projection along its direction around the centre of the bounds, x and y padded
+  by FIT_MARGIN of their extent, depth spanning them;
+- point, point_range: a perspective projection from its position toward the bounds' centre, its field of view
+  covering them up to ±FIT_MAX_HALF_ANGLE degrees (one map, not a cube: cube maps need cube or array textures,
+  which the brick language does not have yet);
+- spot: a perspective projection from its position along its `direction`, square, its half-angle the cone's
+  (`outer_angle`: outside it the brick gives no light, so nothing there needs a shadow), the tangent widened by
+  FIT_PADDING so that the edge texels and pcf's taps around the cone's rim stay inside the map, at most
+  ±FIT_MAX_HALF_ANGLE;
+- uberlight: a perspective projection from its position along `direction`, its y axis the brick's `up` made
+  orthogonal to it; its half-width and half-height tangents those of the soft edge's outer superellipse
+  (width + width_edge, height + height_edge: the brick's light is 0 outside the rectangle that bounds it),
+  each widened by FIT_PADDING and at most tan(FIT_MAX_HALF_ANGLE); an `up` parallel to the axis (the brick's
+  unshaped light) takes the widest.
+
+Near and far of every perspective fit: from the bounds' depths along the view axis, far = the farthest × 1.02 +
+1e-3, near = max(the nearest × 0.98, far × 1e-3). The bounds are the world-space corners of every caster's
+axis-aligned bounding box in its own space, transformed by its model matrix (runtime/placement.py,
+Placement.points); `render` records the matrices it used in its report.
+
+The limit: a perspective map covers less than a half-space. Where a caster's bounds reach outside the map while
+the light may shine there (a point light among its casters, or casters beyond ±FIT_MAX_HALF_ANGLE of a spot's or
+uberlight's axis when its cone is wider), those parts are not shadowed correctly: :func:`uncovered` finds them,
+and `render` warns at the light's scene line (a warning, not a refusal: the map is right wherever it reaches,
+and a point light inside a room is common). What `render` cannot draw at all (a light type with no projection,
+an axis of no length) is a :class:`ShadowProblem`, located at the light's scene line by :func:`light_where`.
 """
 from __future__ import annotations
 
@@ -41,7 +68,10 @@ MOMENTS = "shadow_moments"  # the shadow brick texture that reads the (blurred) 
 PCF_TEXEL = "pcf_texel"  # a shadow parameter the renderer writes as 1 / size when the scene leaves it unset
 MOMENTS_BOX = 5  # the moments' prefilter: a box of this many texels a side
 FIT_MARGIN = 0.02
-FIT_MAX_HALF_ANGLE = 75.0
+FIT_MAX_HALF_ANGLE = 75.0  # the widest half-angle of a perspective map, in degrees: tan 75° = 3.7, so the map's
+# texels at the edge are 14 times the centre's (1 / cos² 75°) — wider would waste the map on its rim
+FIT_PADDING = 0.02  # the fraction a spot's or uberlight's cone tangents are widened by (5 texels of a 512 map)
+PERSPECTIVE = ("point", "point_range", "spot", "uberlight")
 IDENTITY = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
 # (depth_range, ndc_y, framebuffer_origin) of the platform the renderer draws (assemble/platforms.py, Vulkan)
 VULKAN_CONVENTIONS = ("0..1", "down", "top-left")
@@ -112,29 +142,185 @@ def moments_map(depth: np.ndarray, box: int = MOMENTS_BOX) -> np.ndarray:
     return out
 
 
+class ShadowProblem(Exception):
+    """What `render` cannot draw of a shadowed light, before it is located: the parameter that asks for it (None:
+    the light's type), what is wrong and what to do; the renderer raises it at the light's scene line
+    (:func:`light_where`)."""
+
+    def __init__(self, param: str | None, message: str, hint: str):
+        self.param, self.message, self.hint = param, message, hint
+        super().__init__(f"{message} — {hint}")
+
+
+def light_where(scene, name: str, param: str | None = None):
+    """The scene line that asks for light `name` (spec/where.Where): in a TOML scene its `params.<param>` key
+    (or its `type`), elsewhere (glTF) where its first object's permutation records it (the light's definition)."""
+    from ..spec.where import Where
+
+    path = getattr(scene, "path", None)
+    if path is not None and str(path).endswith(".toml") and scene.lights.get(name) is not None:
+        from ..scene.locate import Locator
+        try:
+            loc = Locator(str(path), path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError):
+            loc = None
+        if loc is not None:
+            keys = ("params", param) if param and param in scene.lights[name].params else ("type",)
+            return Where(str(path), *loc.find(f"lights.{name}", *keys))
+    for o in scene.objects:
+        perm = scene.permutations.get(o["permutation"])
+        if name in o["lights"] and perm is not None and perm.origin is not None:
+            return perm.origin.at(f"light{o['lights'].index(name)}")
+    return Where(str(path or scene.name))
+
+
+def casters(scene, name: str) -> list[int]:
+    """The indices (scene.objects' order, the manifest's and the export's) of the objects light `name` casts from and
+    onto: those whose light set holds it."""
+    return [i for i, o in enumerate(scene.objects) if name in o["lights"]]
+
+
+def _axis(values: dict, name: str, example: str = "[0.3, -0.9, 0.3]") -> np.ndarray:
+    d = np.asarray(values["direction"], np.float64).reshape(3)
+    if not np.linalg.norm(d) > 0.0:
+        raise ShadowProblem("direction", f"light '{name}': direction {list(values['direction'])} has no length, so "
+                            "its shadow map has no view", f"give the light a direction, e.g. {example}")
+    return d / np.linalg.norm(d)
+
+
+def _uber_frame(values: dict, axis: np.ndarray) -> np.ndarray | None:
+    """The uberlight brick's y axis (its `up` made orthogonal to the axis), or None where up is parallel to it."""
+    c = np.cross(np.asarray(values["up"], np.float64).reshape(3), axis)
+    if not np.dot(c, c) > 1e-30:
+        return None
+    x = c / np.linalg.norm(c)
+    return np.cross(axis, x)
+
+
+def _depth_range(view: np.ndarray, pts: np.ndarray) -> tuple[float, float]:
+    """(near, far) of a perspective fit from the view-space depths of pts (the point fit's rule: module docstring)."""
+    depth = -((view[:3, :3] @ pts.T).T + view[:3, 3])[:, 2]
+    far = max(float(depth.max()), 1e-3) * 1.02 + 1e-3
+    return max(float(depth.min()) * 0.98, far * 1e-3), far
+
+
+def cone_tangents(light_type: str, values: dict) -> tuple[float, float]:
+    """(tan x, tan y) of the half-angles a spot's or uberlight's map covers (before FIT_MAX_HALF_ANGLE's clamp):
+    the cone or the outer superellipse's rectangle, widened by FIT_PADDING; inf for an unshaped uberlight."""
+    pad = 1.0 + FIT_PADDING
+    if light_type == "spot":
+        t = np.tan(min(float(values["outer_angle"]), np.pi / 2 - 1e-9)) * pad
+        return t, t
+    axis = _axis(values, "")
+    if _uber_frame(values, axis) is None:
+        return np.inf, np.inf
+    return ((float(values["width"]) + float(values["width_edge"])) * pad,
+            (float(values["height"]) + float(values["height_edge"])) * pad)
+
+
+def _cone_matrix(light_type: str, values: dict, pts: np.ndarray, name: str) -> np.ndarray:
+    from .camera import _light_up, look_at, perspective
+
+    axis = _axis(values, name)
+    eye = np.asarray(values["position"], np.float64).reshape(3)
+    up = _uber_frame(values, axis) if light_type == "uberlight" else None
+    view = look_at(eye, eye + axis, _light_up(axis) if up is None else up)
+    limit = np.tan(np.radians(FIT_MAX_HALF_ANGLE))
+    tx, ty = (min(max(t, 1e-3), limit) for t in cone_tangents(light_type, values))
+    near, far = _depth_range(view, pts)
+    return perspective(2.0 * np.degrees(np.arctan(ty)), tx / ty, near, far) @ view
+
+
 def fit_shadow_matrix(light_type: str, values: dict, points, name: str = "") -> np.ndarray:
     """World → light clip space (row-major, float64) of a light of `light_type` with parameters `values`, fitted
-    to world `points` ((n, 3): the corners of every object's bounds). The module docstring states the method."""
-    from ..lang.errors import UserError
+    to world `points` ((n, 3): the corners of every caster's bounds). The module docstring states the method; a
+    light it has no projection for is a ShadowProblem."""
     from .camera import directional_shadow_matrix, point_shadow_matrix
 
+    pts = np.asarray(points, np.float64).reshape(-1, 3)
     if light_type == "directional":
-        if not np.linalg.norm(np.asarray(values["direction"], np.float64)) > 0.0:
-            raise UserError(f"light '{name}': direction {list(values['direction'])} has no length, so its "
-                            "shadow map has no view — give the direction to the light, e.g. [0.3, 0.9, 0.3]")
-        return directional_shadow_matrix(values["direction"], points, margin=FIT_MARGIN)
-    if light_type == "point":
-        return point_shadow_matrix(values["position"], points, max_half_angle_deg=FIT_MAX_HALF_ANGLE)
-    raise UserError(f"light '{name}': the renderer has no shadow projection for light type '{light_type}' "
-                    "— use shadow = \"none\" for it")
+        return directional_shadow_matrix(_axis(values, name, "[0.3, 0.9, 0.3]"), pts, margin=FIT_MARGIN)
+    if light_type in ("point", "point_range"):
+        return point_shadow_matrix(values["position"], pts, max_half_angle_deg=FIT_MAX_HALF_ANGLE)
+    if light_type in ("spot", "uberlight"):
+        return _cone_matrix(light_type, values, pts, name)
+    raise ShadowProblem(None, f"light '{name}': the renderer has no shadow projection for light type "
+                        f"'{light_type}' (it projects {', '.join(('directional',) + PERSPECTIVE)})",
+                        'use shadow = "none" for it')
+
+
+def uncovered(light_type: str, values: dict, matrix, points) -> np.ndarray:
+    """Which of `points` ((n, 3)) the light may shine on but its map (`matrix`, row-major) does not reach: outside
+    the clip volume's x, y or in front of the light's plane, and — for a spot or an uberlight — inside its cone
+    (outside it the light gives nothing, so no shadow is missed). A directional fit covers every point."""
+    pts = np.asarray(points, np.float64).reshape(-1, 3)
+    clip = np.c_[pts, np.ones(len(pts))] @ np.asarray(matrix, np.float64).reshape(4, 4).T
+    w = clip[:, 3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = ~((w > 0) & (np.abs(clip[:, 0]) <= w * (1 + 1e-9)) & (np.abs(clip[:, 1]) <= w * (1 + 1e-9)))
+    if light_type not in ("spot", "uberlight"):
+        return out if light_type in PERSPECTIVE else np.zeros(len(pts), bool)
+    axis = _axis(values, "")
+    rel = pts - np.asarray(values["position"], np.float64).reshape(3)
+    z = rel @ axis
+    tx, ty = cone_tangents(light_type, values)
+    if light_type == "spot":
+        side = np.linalg.norm(rel - z[:, None] * axis, axis=1)
+        lit = (z > 0) & (side <= tx * z)
+    else:
+        y = _uber_frame(values, axis)
+        lit = z > 0
+        if y is not None:
+            x = np.cross(y, axis)
+            lit &= (np.abs(rel @ x) <= tx * z) & (np.abs(rel @ y) <= ty * z)
+    return out & lit
+
+
+def caster_points(placed, indices: list[int]) -> np.ndarray:
+    """The corners of the bounds of placed objects `indices` (runtime/placement.Placement), (8 n, 3): a light's
+    casters' bounds, what its fit covers."""
+    return np.concatenate([placed.objects[i].corners() for i in indices]) if indices else np.zeros((1, 3))
+
+
+def fit_lights(scene, placed, values: dict, cast_by: dict[str, list[int]]) -> tuple[dict, list[str]]:
+    """({light: its shadow_matrix, column-major}, located warnings) of the shadowed lights `cast_by` ({light: its
+    casters' indices}) of `scene` placed as `placed`, their parameters `values`. A light the renderer cannot
+    project is a SourceError at its scene line; one whose map misses casters it may light is a warning there."""
+    from .camera import column_major
+
+    matrices, warnings = {}, []
+    for ln, idx in cast_by.items():
+        L = scene.lights[ln]
+        pts = caster_points(placed, idx)
+        try:
+            m = fit_shadow_matrix(L.type, values[ln], pts, ln)
+        except ShadowProblem as e:
+            raise light_where(scene, ln, e.param).error(e.message, e.hint) from None
+        matrices[ln] = column_major(m)
+        missed = [placed.objects[i].name for i in idx
+                  if uncovered(L.type, values[ln], m, placed.objects[i].corners()).any()]
+        if missed:
+            cone = "" if L.type in ("point", "point_range") else " inside its cone"
+            param = {"point": "position", "point_range": "position"}.get(L.type, "direction")
+            w = light_where(scene, ln, param)
+            warnings.append(f"{w.path}:{w.line}:{w.col}: warning: light '{ln}': its one shadow map covers "
+                            f"±{FIT_MAX_HALF_ANGLE:g}° about its axis, and the bounds of {', '.join(map(repr, missed))} "
+                            f"reach beyond{cone}: shadows there are not drawn correctly — keep the casters ahead of "
+                            "the light (a point light outside their bounds, a spot's cone narrower), or narrow its "
+                            "light sets (cube maps are not drawn yet)")
+    return matrices, warnings
 
 
 # The fit's parameters as the manifest states them (depth_pass.matrix.fit; the method: the module docstring).
 FIT = {"directional": {"projection": "orthographic", "margin": FIT_MARGIN},
-       "point": {"projection": "perspective", "max_half_angle_deg": FIT_MAX_HALF_ANGLE}}
-# What the fit covers: the world-space corners of every object's axis-aligned bounding box in its own space,
-# transformed by its model matrix (the renderer's: runtime/placement.py, Placement.points).
+       **{t: {"projection": "perspective", "max_half_angle_deg": FIT_MAX_HALF_ANGLE} for t in ("point", "point_range")},
+       **{t: {"projection": "perspective", "max_half_angle_deg": FIT_MAX_HALF_ANGLE, "padding": FIT_PADDING}
+          for t in ("spot", "uberlight")}}
+# What the fit covers: the world-space corners of each caster's axis-aligned bounding box in its own space,
+# transformed by its model matrix (the renderer's: runtime/placement.py, Placement.points) ...
 BOUNDS = "object_box_corners"
+# ... of the casters: the objects whose light set holds the light (casters), not every object of the scene
+CASTERS = "light_sets"
 
 
 def platform_premultiply(depth_range: str, ndc_y: str, framebuffer_origin: str) -> list[list[float]]:
@@ -175,6 +361,7 @@ def depth_pass(light, textures: dict[str, bool], values: dict, units: dict, bind
                    "to_map": {"uv": "clip.xy / clip.w * 0.5 + 0.5", "depth": "clip.z / clip.w"},
                    "premultiply": {p: platform_premultiply(*c) for p, c in sorted((platforms or {}).items())},
                    "fit": {"light_type": light.type, **FIT.get(light.type, {}), "bounds": BOUNDS,
+                           "casters": CASTERS,
                            "function": "generator.runtime.shadow_pass.fit_shadow_matrix"}}
     if PCF_TEXEL in values:
         d["texel"] = {"parameter": PCF_TEXEL, "value": values[PCF_TEXEL]}

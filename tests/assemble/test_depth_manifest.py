@@ -137,7 +137,8 @@ def test_the_matrix_convention_maps_the_brick_s_texel_on_every_platform(built):
     mat = m["lights"]["sun"]["depth_pass"]["matrix"]
     assert mat["parameter"] == "shadow_matrix" and mat["clip"] == "vulkan"
     assert mat["fit"] == {"light_type": "directional", "projection": "orthographic", "margin": 0.02,
-                          "bounds": "object_box_corners", "function": "generator.runtime.shadow_pass.fit_shadow_matrix"}
+                          "bounds": "object_box_corners", "casters": "light_sets",
+                          "function": "generator.runtime.shadow_pass.fit_shadow_matrix"}
     clip = np.array([0.3, -0.6, 0.25, 1.0])  # a point the brick reads at uv (0.65, 0.2), depth 0.25
     for p, pre in mat["premultiply"].items():
         c = PLATFORM_TABLE[p].conventions

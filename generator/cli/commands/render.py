@@ -54,6 +54,8 @@ def run(args) -> int:
         raise VulkanUnavailable(f"no Vulkan device to render on: {e} — install Mesa lavapipe (`make setup`)") from None
     if report.cache_problem:
         print(f"warning: {report.cache_problem}", file=sys.stderr)
+    for warning in report.shadow_warnings:  # located already: path:line:col: warning: ...
+        print(warning, file=sys.stderr)
     for note in report.texture_notes:
         print(f"note: {note}", file=sys.stderr)
     last = report.steady
