@@ -1,7 +1,7 @@
 /* The draws of the frame and the one command buffer that records them.
  *
- * Every object is drawn into each shadowed light's map (casters: the light's description names the unit; a
- * masked object's own unit), then the blur passes of a moments light, then the objects in the export's
+ * The objects of each shadowed light's sets (the export's casters) are drawn into its map (the light's description
+ * names the unit; a masked object's own unit), then the blur passes of a moments light, then the objects in the export's
  * draw_order into the colour target with their permutations; bindings.c writes each draw's descriptor sets. */
 #include "render.h"
 
@@ -124,6 +124,19 @@ static bool fullscreen(engine *e)
                           data, &e->fullscreen);
 }
 
+/* Whether object i is drawn into light fl's map: it is among the export's casters (every object where the export
+ * lists none). */
+static bool casts(const flight *fl, int i)
+{
+    const cJSON *c;
+    if (!fl->casters)
+        return true;
+    cJSON_ArrayForEach(c, fl->casters)
+        if ((int)c->valuedouble == i)
+            return true;
+    return false;
+}
+
 static bool build_items(engine *e)
 {
     const manifest *m = e->m;
@@ -146,7 +159,9 @@ static bool build_items(engine *e)
         const cJSON *masked = casters ? j_obj(src, casters, "masked", where) : NULL;
         if (!opaque || !masked)
             return false;
-        for (int i = 0; i < n; i++) {  /* every object casts, lit by the light or not */
+        for (int i = 0; i < n; i++) {  /* the objects of its light sets cast (the export's casters) */
+            if (!casts(lp->fl, i))
+                continue;
             const cJSON *c = j_opt(masked, m->objects[i].permutation);
             if (!c)
                 c = opaque;

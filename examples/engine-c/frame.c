@@ -161,6 +161,17 @@ static bool load_lights(frame *f)
                 return false;
             x->has_texel = true;
         }
+        const cJSON *casters = j_opt(l, "casters"), *c;
+        if (casters) {  /* the objects of its light sets (absent in an older export: every object casts) */
+            if (!cJSON_IsArray(casters))
+                return j_fail(src, at, "casters is not an array of object indices");
+            cJSON_ArrayForEach(c, casters)
+                if (!cJSON_IsNumber(c) || c->valuedouble != floor(c->valuedouble) || c->valuedouble < 0
+                    || c->valuedouble >= f->nobjects)
+                    return j_fail(src, at, "casters holds %s, not an index of the %d objects",
+                                  cJSON_IsNumber(c) ? "a number out of range" : "a non-number", f->nobjects);
+            x->casters = casters;
+        }
     }
     return true;
 }

@@ -109,6 +109,7 @@ typedef struct flight {
     double pcf_texel;
     int size[2];
     double eye[3];
+    const cJSON *casters;      /* the objects drawn into its map (indices, checked), or NULL: every object */
 } flight;
 
 typedef struct frame {

@@ -6,7 +6,7 @@ The tolerance: the renderer compiles its own GLSL while the engine loads the bui
 pack, so a float may round differently in the last place, which can move a channel by one step of 8 bits; two
 steps or more is a real difference (a wrong binding, block, matrix or state moves whole regions, as the tests
 below that edit one field show). Measured on lavapipe (Mesa 25), 128 × 80: every channel equal (largest difference
-0) on all five scenes.
+0) on all six scenes.
 """
 from __future__ import annotations
 
@@ -142,7 +142,9 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "gltf": lambda tmp: gltf_scene(tmp / "textured.gltf"),
           # masked casters (mask and mask_moments units) and a vsm light (moments, blur)
           "depth_mask": lambda tmp: REPO / "tests" / "scenes" / "depth_mask.toml",
-          "tables": lambda tmp: _written(tmp / "tables.toml", TABLES)}
+          "tables": lambda tmp: _written(tmp / "tables.toml", TABLES),
+          # a spot light's perspective map with pcf, and an object outside its light set that casts nothing
+          "spot_shadow": lambda tmp: REPO / "tests" / "scenes" / "spot_shadow.toml"}
 
 
 @pytest.fixture(scope="module")
@@ -226,11 +228,12 @@ def test_a_layout_unlike_the_shaders_is_a_validation_failure(engine, prepared, t
     assert not (tmp_path / "out.png").exists()
 
 
-@pytest.mark.parametrize("what", ["material", "shadow_matrix", "sampler"])
+@pytest.mark.parametrize("what", ["material", "shadow_matrix", "sampler", "casters"])
 def test_what_the_engine_reads_changes_the_picture(engine, prepared, tmp_path, what):
     """The comparison can fail: one value changed in what the engine reads — a Material upload (the ground's
-    rho_d), the sun's fitted matrix in the export, a sampler row — moves the picture past the tolerance."""
-    build, export, reference = prepared("example" if what != "sampler" else "textured")
+    rho_d), the sun's fitted matrix in the export, a sampler row, a light's casters (spot_shadow's box left out)
+    — moves the picture past the tolerance."""
+    build, export, reference = prepared({"sampler": "textured", "casters": "spot_shadow"}.get(what, "example"))
     if what == "material":
         def darker(m):
             u = _perm(m, "ground")["uploads"][0]
@@ -245,7 +248,11 @@ def test_what_the_engine_reads_changes_the_picture(engine, prepared, tmp_path, w
         shutil.copytree(export, tmp_path / "x")
         export = tmp_path / "x"
         doc = json.loads((export / "frame.json").read_text())
-        doc["lights"]["sun"]["shadow_matrix"][12] += 0.2  # the map shifted by a tenth of its width
+        if what == "casters":  # the floor alone: the box's shadow goes
+            assert doc["lights"]["spot"]["casters"] == [0, 1]
+            doc["lights"]["spot"]["casters"] = [0]
+        else:
+            doc["lights"]["sun"]["shadow_matrix"][12] += 0.2  # the map shifted by a tenth of its width
         (export / "frame.json").write_text(json.dumps(doc))
     r = run_engine(engine, build, export, tmp_path / "out.png")
     assert r.returncode == 0, r.stderr[-3000:]
@@ -278,6 +285,9 @@ BAD = {
     "a light's map of 1e300 texels": (
         lambda b, x: _json_edit(x / "frame.json", lambda d: d["lights"]["sun"].update(size=[1e300, 1e300])),
         "lights.sun: size 1e+300 x 1e+300 is not a map of 1 to 16384 texels a side"),
+    "a caster the export lacks": (
+        lambda b, x: _json_edit(x / "frame.json", lambda d: d["lights"]["sun"].update(casters=[0, 99])),
+        "lights.sun: casters holds a number out of range, not an index of the"),
     "an object the manifest lacks": (
         lambda b, x: _json_edit(x / "frame.json", lambda d: d["objects"][0].update(name="sofa")),
         "object sofa; the manifest's object 0 is bench"),
