@@ -8,14 +8,16 @@ hits no box first) the test intersects, in NumPy float64, the segment from the f
 casters' boxes (axis-aligned: their placed bounds), and compares with the render: lit (a channel above 2) or
 shadowed. Pixels within two shadow-map texels of the analytic shadow edge are left out: a floor point is far from
 the edge when every point of the floor whose map position lies 1 or 2 texels from its own (16 directions) has its
-shadow state. Of the rest at least 99 % must agree, for the spot (within its full-intensity cone) and for the same
-scene with a point light in its place (one ±75° map fitted to the casters). The outsider's would-be shadow stays
-lit; the frame export lists the light's casters. A spot whose direction has no length is refused at its scene
+shadow state. Of the rest at least 99 % must agree, for the spot (within its full-intensity cone), and for the same
+scene with a point light (one ±75° map fitted to the casters) or an uberlight (within its inner superellipse) in
+its place. The outsider's would-be shadow stays lit; the frame export lists the light's casters; a spot's and an
+uberlight's cone rims map just inside their maps. A spot whose direction has no length is refused at its scene
 line (path:line:col), and a point light among its casters' bounds is a warning located at the light.
 
 Measured on lavapipe (Mesa 25), 160 × 112, map 256²: the spot 100.00 % of 4,050 judged pixels agree (432 of them
-shadowed), the point light 100.00 % of 10,915 (368); the outsider's would-be shadow, 665 and 1,009 seen pixels, all
-lit — with every object casting (as before casters were per light set) none of it is, and 83 % agree. ~7 s.
+shadowed), the point light 100.00 % of 10,915 (368), the uberlight 100.00 % of 2,000 (365); the outsider's
+would-be shadow (665, 1,009, 473 seen pixels) all lit — with every object casting (as before casters were per
+light set) none of the spot's is, and 83 % agree. ~8 s.
 Rendered in-process on the validated `device` (tests/lavapipe.py).
 """
 from __future__ import annotations
@@ -57,6 +59,34 @@ def _copy(tmp_path: Path, name: str, edit) -> Path:
 def _as_point(line: str) -> str:
     return ('params = { position = [0.4, 4.0, 0.3], color = [16.0, 16.0, 16.0], shadow_bias = 0.002, '
             'pcf_taps = 1.0 }')
+
+
+UBER = {"width": 0.55, "height": 0.4, "width_edge": 0.1, "height_edge": 0.1, "roundness": 0.5, "up": [0.3, 0.0, 1.0]}
+
+
+def _as_uberlight(line: str) -> str:
+    shape = ", ".join(f"{k} = {v}" for k, v in UBER.items())
+    return (f"params = {{ position = [0.4, 4.0, 0.3], direction = [-0.1, -1.0, -0.05], color = [16.0, 16.0, 16.0], "
+            f"radius = 100.0, {shape}, shadow_bias = 0.002, pcf_taps = 1.0 }}")
+
+
+def _full_intensity(kind: str, params: dict, g) -> np.ndarray:
+    """Where the light shines on floor points g at full intensity (0.01 clear of where it starts to fade): a spot's
+    inner cone, an uberlight's inner superellipse (the bricks' own shapes, bricks/light), everywhere for a point."""
+    if kind == "point":
+        return np.ones(g.shape[:-1], bool)
+    axis = np.array(params["direction"], np.float64)
+    axis /= np.linalg.norm(axis)
+    v = g - np.array(params["position"], np.float64)
+    z = v @ axis
+    if kind == "spot":
+        return z / np.linalg.norm(v, axis=-1) > np.cos(params["inner_angle"] - 0.01)
+    x_axis = np.cross(np.array(params["up"], np.float64), axis)
+    x_axis /= np.linalg.norm(x_axis)
+    y_axis = np.cross(axis, x_axis)
+    e = 2.0 / params["roundness"]
+    rho = ((np.abs(v @ x_axis) / params["width"]) ** e + (np.abs(v @ y_axis) / params["height"]) ** e) ** (1.0 / e)
+    return (z > 0) & (rho < 0.97 * z)
 
 
 def _boxes(pl) -> dict:
@@ -129,7 +159,7 @@ def _render(scene_path, lib, device, out, export=None):
     return scene, np.asarray(Image.open(out / "frame_0000.png").convert("RGB")).astype(int), rep
 
 
-def _check(scene, img, rep, spot: bool):
+def _check(scene, img, rep, kind: str):
     """The ray test: (agreeing fraction, pixels compared, the outsider's would-be shadow's pixels and its lit part)."""
     from generator.runtime.placement import load_placement
 
@@ -138,12 +168,7 @@ def _check(scene, img, rep, spot: bool):
     L = scene.lights["spot"]
     light = np.array(L.params["position"], np.float64)
     seen, g = _floor_pixels(pl)
-    if spot:  # where the spot shines at full intensity (inside its inner cone, 0.01 rad clear of its rim)
-        axis = np.array(L.params["direction"], np.float64)
-        axis /= np.linalg.norm(axis)
-        v = g - light
-        cos = (v @ axis) / np.linalg.norm(v, axis=-1)
-        seen &= cos > np.cos(L.params["inner_angle"] - 0.01)
+    seen &= _full_intensity(kind, L.params, g)
     matrix = rep.shadow_maps["spot"]["shadow_matrix"]
     expected = _shadowed(g, light, boxes["box"])
     judged = seen & _far_from_edge(g, light, boxes["box"], matrix, SHADOW)
@@ -153,14 +178,14 @@ def _check(scene, img, rep, spot: bool):
     return agree, judged.sum(), expected[judged].sum(), would.sum(), (~shadowed[would]).mean() if would.any() else 0.0
 
 
-@pytest.mark.parametrize("kind", ["spot", "point"])
+@pytest.mark.parametrize("kind", ["spot", "point", "uberlight"])
 def test_the_shadow_falls_where_the_ray_test_says_and_only_casters_cast(device, lib, tmp_path, kind):
     path = SCENE
-    if kind == "point":
-        path = _copy(tmp_path, "point", _as_point)
-        path.write_text(path.read_text().replace('type = "spot"', 'type = "point"', 1))
+    if kind != "spot":
+        path = _copy(tmp_path, kind, _as_point if kind == "point" else _as_uberlight)
+        path.write_text(path.read_text().replace('type = "spot"', f'type = "{kind}"', 1))
     scene, img, rep = _render(path, lib, device, tmp_path / kind, export=tmp_path / "export")
-    agree, judged, in_shadow, would, lit = _check(scene, img, rep, kind == "spot")
+    agree, judged, in_shadow, would, lit = _check(scene, img, rep, kind)
     assert judged > 1500 and in_shadow > 100, (judged, in_shadow)
     assert agree >= AGREE, f"{kind}: {agree:.2%} of {judged} floor pixels agree with the ray test (≥ {AGREE:.0%} wanted)"
     assert would > 50, f"the outsider's would-be shadow covers {would} seen pixels: the check says little"
@@ -201,3 +226,32 @@ def test_a_point_light_among_its_casters_is_a_warning_at_its_line(lib, tmp_path)
     assert len(warnings) == 1 and warnings[0].startswith(f"{path}:{row}:12: warning: light 'spot'"), warnings
     assert "'floor'" in warnings[0] and "'outsider'" not in warnings[0]
     assert point_at("above", [0.4, 4.0, 0.3])[1] == [], "a point light above its casters: one map holds them"
+
+
+@pytest.mark.parametrize("kind", ["spot", "uberlight"])
+def test_a_cone_s_rim_lies_just_inside_its_map(kind):
+    """The spot's cone (outer_angle) and the uberlight's outer superellipse's rectangle map to 1 / (1 + padding) of
+    the map's half-side; a cone wider than ±75° is clamped there (no GPU needed)."""
+    from generator.runtime.shadow_pass import FIT_PADDING, fit_shadow_matrix
+
+    pos, axis = np.array([0.4, 4.0, 0.3]), np.array([0.0, -1.0, 0.0])
+    casters = np.array([[-3.0, 0.0, -3.0], [3.0, 1.0, 3.0]])
+    if kind == "spot":
+        values = {"position": pos, "direction": axis, "outer_angle": 0.5}
+        rim = [pos + axis + np.tan(0.5) * np.array([1.0, 0.0, 0.0])]
+    else:
+        values = {"position": pos, "direction": axis, **UBER}
+        x = np.cross(UBER["up"], axis)
+        x /= np.linalg.norm(x)
+        y = np.cross(axis, x)
+        rim = [pos + axis + (UBER["width"] + UBER["width_edge"]) * x, pos + axis + (UBER["height"] + UBER["height_edge"]) * y]
+    m = fit_shadow_matrix(kind, values, casters)
+    for p in rim:
+        c = m @ np.append(p, 1.0)
+        assert abs(np.abs(c[:2] / c[3]).max() - 1.0 / (1.0 + FIT_PADDING)) < 1e-9, c[:2] / c[3]
+    z = np.c_[casters, np.ones(2)] @ m.T
+    assert (z[:, 2] / z[:, 3] > 0).all() and (z[:, 2] / z[:, 3] < 1).all(), "near and far hold the casters"
+    if kind == "spot":
+        wide = fit_shadow_matrix(kind, {**values, "outer_angle": 1.5}, casters)
+        edge = wide @ np.append(pos + axis + np.tan(np.radians(75.0)) * np.array([1.0, 0.0, 0.0]), 1.0)
+        assert abs(abs(edge[0] / edge[3]) - 1.0) < 1e-9, "clamped at ±75°"
