@@ -250,7 +250,8 @@ class DepthPasses:
 
     def draw(self, desc: dict, view_proj, eye, casters: list[Caster]) -> Drawn:
         """Draw one light's pass as `desc` (shadow_pass.depth_pass) says, every caster with Frame.view_proj =
-        `view_proj` (row-major: the light's matrix premultiplied for Vulkan, the identity)."""
+        `view_proj` (row-major: the light's matrix premultiplied for Vulkan, the identity). A device that cannot draw
+        the description's kind is a shadow_pass.ShadowProblem (the renderer locates it at the light's line)."""
         from .graphics import frame_bytes
 
         size, dep = desc["size"], desc["depth"]
@@ -259,7 +260,11 @@ class DepthPasses:
                              f"the description asks for {dep}")
         moments = desc["kind"] == "moments"
         if moments:
-            target = self._own(FloatTarget(self.device, size[0], size[1], depth=True))
+            try:
+                target = self._own(FloatTarget(self.device, size[0], size[1], depth=True))
+            except VulkanUnavailable as e:  # the device, for this light's filter: the caller locates it at the light
+                from .shadow_pass import ShadowProblem
+                raise ShadowProblem(None, str(e), 'use shadow = "pcf"') from None
         else:
             target = self._own(DepthTarget(self.device, size[0], size[1]))
         frame = self._buffer(frame_bytes(view_proj, eye))

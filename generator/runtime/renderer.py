@@ -191,8 +191,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
     from .material_textures import BuildOutputs, MaterialTextures
     from .pipeline_state import COLOR_FORMATS, clear_color, color_attachment, render_state
-    from .shadow_pass import (VULKAN_CONVENTIONS, caster_points, casters as casters_of, depth_pass, depth_plan,
-                              fit_lights, light_where, pass_units, shadowed_lights)
+    from .shadow_pass import (VULKAN_CONVENTIONS, ShadowProblem, caster_points, casters as casters_of, depth_pass,
+                              depth_plan, fit_lights, light_where, pass_units, shadowed_lights)
 
     if mode not in MODES:
         raise UserError(f"unknown mode {mode!r} — use one of {', '.join(MODES)}")
@@ -354,8 +354,11 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for ln in shadowed:
                 desc = passes_of[ln]
                 m = np.asarray(desc["matrix"]["premultiply"]["vulkan"]) @ np.asarray(matrices[ln]).reshape(4, 4).T
-                drawn = passes.draw(desc, m, np.append(caster_points(placed, cast_by[ln]).mean(0), 1.0),
-                                    [casters[i] for i in cast_by[ln]])
+                try:
+                    drawn = passes.draw(desc, m, np.append(caster_points(placed, cast_by[ln]).mean(0), 1.0),
+                                        [casters[i] for i in cast_by[ln]])
+                except ShadowProblem as e:  # what the device cannot draw for this light's filter
+                    raise light_where(scene, ln).error(f"light '{ln}': {e.message}", e.hint) from None
                 if drawn.depth is not None:
                     shadow_maps[ln] = drawn.depth
                 if drawn.moments is not None:
