@@ -210,7 +210,7 @@ class _Build:
             "conventions": conventions(self.ctx.platforms),
             "permutations": entries,
             "ubershader": uber,
-            **material_states(scene, scene_tables(scene, compiled.composed, self.previous)),
+            **material_states(scene, scene_tables(scene, compiled.composed, self.previous, self.ctx.platforms)),
         }
         from .depth import write_depth_passes  # the shadowed lights' depth passes: their shaders, their descriptions
         write_depth_passes(self)

@@ -11,12 +11,12 @@ Each platform spells the Interface in its own binding model (platforms.py: each 
 """
 from __future__ import annotations
 
-from ..link.values import light_values, material_values
+from ..link.values import light_buffer_block, light_values, material_values
 from ..scene.light_sets import light_indices
 from ..scene.load import Scene
 
 
-def scene_tables(scene: Scene, interfaces: dict, previous: dict | None = None) -> dict:
+def scene_tables(scene: Scene, interfaces: dict, previous: dict | None = None, platforms=()) -> dict:
     """Named materials, lights, light sets and objects, with every value an engine uploads.
 
     `interfaces`: permutation hash -> Composed (with .interface, .material, .lights slots). `previous`: the
@@ -43,8 +43,52 @@ def scene_tables(scene: Scene, interfaces: dict, previous: dict | None = None) -
             lspecs = iface.params.get(f"light{i}", {})
             L = scene.lights[ln]
             lights.setdefault(ln, {"type": L.type, "shadow": L.shadow, "params": light_values(scene, ln, lspecs)})
+    dynamic = dynamic_tables(scene, interfaces, previous, platforms)
     return {"materials": dict(sorted(materials.items())), "lights": dict(sorted(lights.items())),
             "light_sets": {k: list(v) for k, v in sorted(scene.light_sets.items())},
+            **({"dynamic_light_sets": dynamic} if dynamic else {}),
             "objects": [{"name": o["name"], "material": o["material"], "light_set": o["light_set"],
                          "permutation": o["permutation"]} for o in scene.objects]}
 
+
+
+FILL = ("per pair, the set's lights of that type and shadow filter, in the set's order: element k at k x stride, "
+        "each parameter at its offset (little-endian float32; a vector parameter fills its components), zeros "
+        "elsewhere; bind the first count x stride bytes of a buffer of max x stride: the shader's light count is "
+        "the bound range / stride (no light: bind a range below the stride, e.g. 4 bytes)")
+
+
+def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platforms) -> dict:
+    """Per dynamic light set: its capacity and, per pair of its model, the storage buffer an engine fills.
+
+    The block, its layout and its bindings are those of every permutation the set lights (a dynamic set's
+    permutations have its model as their lights, so the builder places the buffers alike: link.link_permutation);
+    read from the first composed one, or from the last build's manifest when none was composed this time."""
+    from .platforms import PLATFORM_TABLE
+    old = (previous or {}).get("dynamic_light_sets", {})
+    out = {}
+    for name, dyn in sorted(scene.dynamic_sets.items()):
+        c = next((interfaces[o["permutation"]] for o in scene.objects
+                  if o["light_set"] == name and o["permutation"] in interfaces), None)
+        if c is None:
+            if name in old:
+                out[name] = old[name]
+            continue
+        members = scene.light_sets[name]
+        pairs = []
+        for i, pair in enumerate(dyn.model):
+            block = c.interface.block(light_buffer_block(i))
+            stride = block.members[0]["array_stride"]
+            bindings = {}
+            for p in platforms:
+                rows = PLATFORM_TABLE[p].reflection(c.interface)
+                bindings[p] = next({k: v for k, v in row.items() if k not in ("name", "stages", "visibility")}
+                                   for rows_ in rows.values() if isinstance(rows_, list) for row in rows_
+                                   if isinstance(row, dict) and row.get("name") == block.name)
+            pairs.append({"pair": pair.canonical(), "light_index": i, "block": block.name, "set": block.set,
+                          "binding": block.binding, "bindings": bindings, "stride": stride,
+                          "layout": [{k: v for k, v in sl.as_dict().items() if k in ("name", "type", "offset", "size")}
+                                     for sl in block.slots],
+                          "lights": [n for n in members if dyn.pair_of(scene.lights[n]) == i]})
+        out[name] = {"max": dyn.max, "pairs": pairs, "fill": FILL}
+    return out

@@ -1,8 +1,8 @@
 """Scene values laid out by an Interface: named parameter values and ready-to-upload blocks.
 
 `uploads(scene, h, c)` gives, per (material, light set) drawn with permutation `h`, the
-Material and Lights blocks as float32 bytes (hex), laid out by `c`'s Interface; the
-manifest writes them and the renderer uploads them. `light_entry` and `entry_bytes` lay out the
+Material and Lights blocks as float32 bytes (hex), laid out by `c`'s Interface, and for a dynamic light
+set each pair's storage buffer (`light_buffers`); the manifest writes them and the renderer uploads them. `light_entry` and `entry_bytes` lay out the
 ubershader's LightEntry / MaterialEntry storage buffers (link/uber.py).
 """
 from __future__ import annotations
@@ -37,6 +37,9 @@ def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None) -> list[
         mat = c.interface.block("Material")
         if mat is not None:
             item["Material"] = pack(c.material, values, mat.members[-1]["size"] // 16).hex()
+        dyn = scene.dynamic_sets.get(obj["light_set"])
+        if dyn is not None:
+            item["light_buffers"] = {b: data.hex() for b, data in light_buffers(scene, obj["lights"], dyn, c).items()}
         lb = c.interface.block("Lights")
         if lb is not None:
             lvals = {}
@@ -48,6 +51,28 @@ def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None) -> list[
     for item in out:
         item["objects"] = [o["name"] for o in mine
                            if (o["material"], o["light_set"]) == (item["material"], item["light_set"])]
+    return out
+
+
+def light_buffer_block(i: int) -> str:
+    """The storage block of the key's dynamic light i (link.link_permutation names it)."""
+    return f"LightBuffer{i}"
+
+
+def light_buffers(scene: Scene, names: list[str], dyn, c) -> dict[str, bytes]:
+    """Per pair of a dynamic set's model, its storage block's name and bytes: the lights `names` of that pair, in
+    their order, each element laid out as the block's parameters say (a static set's values, so both draw alike)."""
+    out = {}
+    for i, pair in enumerate(dyn.model):
+        block = c.interface.block(light_buffer_block(i))
+        stride = block.members[0]["array_stride"]
+        specs = c.interface.params.get(f"light{i}", {})
+        data = b""
+        for ln in names:
+            if dyn.pair_of(scene.lights[ln]) == i:
+                v = light_values(scene, ln, specs)
+                data += pack(block.slots, {s.name: _element(v[s.param], s) for s in block.slots}, stride // 16)
+        out[block.name] = data
     return out
 
 

@@ -33,6 +33,12 @@ too), the blurred moments as its `shadow_moments`. A `texture2d_shadow`
 (runtime/depth_images.py: linear, compareOp LESS_OR_EQUAL), where no map is drawn a lit 1×1 depth image
 (depth 1.0); a device that cannot linearly filter D32_SFLOAT is refused for it.
 
+Dynamic light sets (scene/light_sets.py): the specialized pipeline of an object lit by one reads each pair of the
+set's model from its own storage buffer, filled with that pair's lights in the set's order (link/values.py
+light_buffers: the bytes the manifest's uploads hold, the values a static set would upload) and bound whole, so
+the loop's count is the buffer's length; a pair with no light gets a 4-byte buffer (a count of 0). The
+ubershader reads the set's lights from its LightEntry buffer as for a static set.
+
 Material textures are the build's (runtime/material_textures.py): every texture a material binds, the scene's
 image or the generated one, is the KTX2 artifact the build's manifest lists for it (``materials.<m>.textures``),
 sha256-checked and uploaded with its whole mip chain, read through the sampler the manifest spells for Vulkan
@@ -459,6 +465,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                                                                   matrices, texels), U)
             if c.interface.block("Material"):
                 spec[(1, 0)] = buf(bytes.fromhex(up["Material"]), U)
+            for name, data in up.get("light_buffers", {}).items():  # a dynamic set: each pair's lights (link/values.py)
+                blk = c.interface.block(name)  # no light of the pair: a range below the stride, a count of 0
+                spec[(blk.set, blk.binding)] = buf(bytes.fromhex(data) or bytes(4), S)
             for t in c.interface.textures:
                 if t.group == "light":
                     res, smp = light_texture(t, obj["lights"][t.light]), sampler_of(t)
