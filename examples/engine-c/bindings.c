@@ -123,8 +123,9 @@ static bool write_item_sets(engine *e, draw_item *it)
             w->dstSet = it->sets[s];
             w->dstBinding = b->binding;
             w->descriptorCount = 1;
-            if (b->kind == BIND_BLOCK) {
-                w->descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+            if (b->kind == BIND_BLOCK || b->kind == BIND_STORAGE) {
+                w->descriptorType = b->kind == BIND_BLOCK ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                          : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
                 buffers[i] = (VkDescriptorBufferInfo){VK_NULL_HANDLE, 0, VK_WHOLE_SIZE};
                 if (!block_buffer(e, it, &p->blocks[b->ref], &buffers[i].buffer))
                     return false;
@@ -156,7 +157,7 @@ static bool write_item_sets(engine *e, draw_item *it)
 /* One pool for the frame, sized by counting every draw's bindings. */
 bool write_sets(engine *e)
 {
-    uint32_t sets = 0, counts[3] = {0, 0, 0};
+    uint32_t sets = 0, counts[4] = {0, 0, 0, 0};
     for (int d = 0; d < e->ndraws; d++) {
         const program_layout *l = &e->draws[d].pipe->layout;
         for (int s = 0; s < l->nsets; s++) {
@@ -165,11 +166,11 @@ bool write_sets(engine *e)
                 counts[l->bindings[s][i].kind]++;
         }
     }
-    VkDescriptorPoolSize sizes[3];
+    VkDescriptorPoolSize sizes[4];
     uint32_t n = 0;
-    const VkDescriptorType types[3] = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
-                                       VK_DESCRIPTOR_TYPE_SAMPLER};
-    for (int k = 0; k < 3; k++)
+    const VkDescriptorType types[4] = {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
+                                       VK_DESCRIPTOR_TYPE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    for (int k = 0; k < 4; k++)
         if (counts[k])
             sizes[n++] = (VkDescriptorPoolSize){types[k], counts[k]};
     if (!sets)

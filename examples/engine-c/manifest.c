@@ -21,8 +21,10 @@ static bool stage_bit(const char *stage, VkShaderStageFlags *bit)
     return true;
 }
 
-/* Adds one stage's uniform blocks to p->blocks, merging a block both stages read (same set, binding, name). */
-static bool add_blocks(const manifest *m, program *p, const cJSON *list, VkShaderStageFlags bit, const char *where)
+/* Adds one stage's uniform (or, storage: storage) blocks to p->blocks, merging a block both stages read (same
+ * set, binding, name). */
+static bool add_blocks(const manifest *m, program *p, const cJSON *list, VkShaderStageFlags bit, const char *where,
+                       bool storage)
 {
     const json_src *src = &m->src;
     int i = 0;
@@ -33,13 +35,15 @@ static bool add_blocks(const manifest *m, program *p, const cJSON *list, VkShade
         block_ref r = {0};
         r.json = b;
         if (!(r.name = j_str(src, b, "name", at)) || !j_int(src, b, "set", at, 0, 31, &r.set)
-            || !j_int(src, b, "binding", at, 0, 1023, &r.binding) || !j_int(src, b, "size", at, 1, 65536, &r.size))
+            || !j_int(src, b, "binding", at, 0, 1023, &r.binding)
+            || !j_int(src, b, "size", at, storage ? 0 : 1, 65536, &r.size))
             return false;
         const char *kind = j_str(src, b, "kind", at);
         if (!kind)
             return false;
-        if (strcmp(kind, "uniform") != 0)
-            return j_fail(src, at, "block %s is a %s block; this engine fills uniform blocks only", r.name, kind);
+        r.storage = storage;
+        if (strcmp(kind, storage ? "storage" : "uniform") != 0)
+            return j_fail(src, at, "block %s is a %s block in %s", r.name, kind, where);
         int k;
         for (k = 0; k < p->nblocks; k++)
             if (p->blocks[k].set == r.set && p->blocks[k].binding == r.binding)
@@ -124,12 +128,12 @@ bool program_parse(const manifest *m, const cJSON *entry, const char *name, bool
             return false;
         char list[300];
         snprintf(list, sizeof list, "%s.uniform_blocks", at);
-        if (!add_blocks(m, p, blocks, bit, list))
+        if (!add_blocks(m, p, blocks, bit, list, false))
             return false;
-        const cJSON *storage = j_opt(st, "storage_blocks");
-        if (cJSON_GetArraySize(storage) > 0)
-            return j_fail(src, at, "%d storage blocks; this engine fills uniform blocks only",
-                          cJSON_GetArraySize(storage));
+        const cJSON *storage = j_opt(st, "storage_blocks");  /* a dynamic light set's buffers (resources.c) */
+        snprintf(list, sizeof list, "%s.storage_blocks", at);
+        if (storage && !add_blocks(m, p, storage, bit, list, true))
+            return false;
         const cJSON *textures = j_opt(st, "textures");
         snprintf(list, sizeof list, "%s.textures", at);
         if (textures && !add_textures(m, p, textures, bit, list))
@@ -339,11 +343,14 @@ bool manifest_load(const char *build_dir, manifest *m)
         return false;
     if (!(m->materials = j_obj(src, m->root, "materials", "manifest"))
         || !(m->lights = j_obj(src, m->root, "lights", "manifest"))
-        || !(m->light_sets = j_obj(src, m->root, "light_sets", "manifest"))
-        || !(m->samplers = j_arr(src, m->root, "samplers", "manifest")))
+        || !(m->light_sets = j_obj(src, m->root, "light_sets", "manifest")))
+        return false;
+    /* samplers is there only when something samples a texture (a scene of lights without maps has none) */
+    if (j_opt(m->root, "samplers") && !(m->samplers = j_arr(src, m->root, "samplers", "manifest")))
         return false;
     m->depth_shaders = j_opt(m->root, "depth_shaders");
     m->tables = j_opt(m->root, "tables");
+    m->dynamic_light_sets = j_opt(m->root, "dynamic_light_sets");
     return load_permutations(m) && load_objects(m);
 }
 

@@ -1,5 +1,6 @@
 /* What the draws read: meshes, textures from the KTX2 files, samplers from the manifest's rows, and the
- * uniform blocks. Each is made once and shared by every draw that reads the same thing. */
+ * uniform blocks and a dynamic light set's storage buffers. Each is made once and shared by every draw that reads
+ * the same thing. */
 #include "render.h"
 
 #include <stdio.h>
@@ -331,8 +332,109 @@ static bool blur_block(engine *e, const draw_item *it, const block_ref *b, unsig
     return true;
 }
 
+/* A dynamic light set's storage buffer `b` (LightBuffer<i>), filled as the manifest's dynamic_light_sets says:
+ * the pair whose block it is lists its lights in order; element k (stride bytes) holds lights[k]'s parameters
+ * (the manifest's lights.<name>.params) at the layout's offsets, as float32. Bound whole: the shader's light
+ * count is its size / stride; a pair with no light gets 4 bytes (a count of 0; a buffer cannot be empty). */
+static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkBuffer *out)
+{
+    const json_src *src = &e->m->src;
+    if (it->object < 0)
+        return fail("%s: storage block %s read by a pass that draws no object", it->pipe->prog->name, b->name);
+    const mobject *o = &e->m->objects[it->object];
+    char where[200];
+    snprintf(where, sizeof where, "dynamic_light_sets[%s]", o->light_set);
+    const cJSON *set = j_opt(e->m->dynamic_light_sets, o->light_set), *pair = NULL, *x;
+    if (!set)
+        return j_fail(src, where, "%s reads storage block %s, and light set %s is not a dynamic one",
+                      it->pipe->prog->name, b->name, o->light_set);
+    const cJSON *pairs = j_arr(src, set, "pairs", where);
+    cJSON_ArrayForEach(x, pairs) {
+        const cJSON *name = j_opt(x, "block");
+        if (cJSON_IsString(name) && strcmp(name->valuestring, b->name) == 0)
+            pair = x;
+    }
+    if (!pair)
+        return j_fail(src, where, "no pair's block is %s", b->name);
+    for (int i = 0; i < e->nblocks; i++)
+        if (e->blocks[i].key == pair && strcmp(e->blocks[i].name, b->name) == 0) {
+            *out = e->blocks[i].buffer.buffer;
+            return true;
+        }
+    int stride, cap;
+    const cJSON *layout = j_arr(src, pair, "layout", where), *lights = j_arr(src, pair, "lights", where);
+    if (!layout || !lights || !j_int(src, pair, "stride", where, 16, 1 << 16, &stride)
+        || !j_int(src, set, "max", where, 1, 1 << 16, &cap))
+        return false;
+    int count = cJSON_GetArraySize(lights);
+    if (count > cap)
+        return j_fail(src, where, "%d lights, more than its max %d", count, cap);
+    size_t size = count ? (size_t)count * (size_t)stride : 4;
+    unsigned char *data = calloc(size, 1);
+    if (!data)
+        return fail("out of memory");
+    bool ok = true;
+    int k = 0;
+    const cJSON *ln;
+    cJSON_ArrayForEach(ln, lights) {
+        const cJSON *light = cJSON_IsString(ln) ? j_opt(e->m->lights, ln->valuestring) : NULL;
+        const cJSON *params = j_opt(light, "params"), *slot;
+        if (!params) {
+            ok = j_fail(src, where, "light %d of %s is not in lights", k, b->name);
+            break;
+        }
+        cJSON_ArrayForEach(slot, layout) {
+            const cJSON *name = j_opt(slot, "name");
+            int offset, bytes;
+            if (!cJSON_IsString(name) || !j_int(src, slot, "offset", where, 0, stride - 4, &offset)
+                || !j_int(src, slot, "size", where, 4, stride, &bytes) || offset + bytes > stride || offset % 4) {
+                ok = ok && j_fail(src, where, "a layout entry of %s this engine cannot place", b->name);
+                break;
+            }
+            const cJSON *v = j_opt(params, name->valuestring);
+            int n = bytes / 4;
+            double values[16] = {0};
+            if (cJSON_IsNumber(v))
+                for (int c = 0; c < n && c < 16; c++)
+                    values[c] = v->valuedouble;  /* a scalar fills a vector's components, as the generator packs */
+            else if (cJSON_IsArray(v) && cJSON_GetArraySize(v) == n && n <= 16)
+                for (int c = 0; c < n; c++)
+                    values[c] = cJSON_GetArrayItem(v, c)->valuedouble;
+            else {
+                ok = j_fail(src, where, "light %s has no %d-float value %s", ln->valuestring, n, name->valuestring);
+                break;
+            }
+            for (int c = 0; c < n; c++) {
+                float f = (float)values[c];
+                memcpy(data + (size_t)k * (size_t)stride + (size_t)offset + 4 * (size_t)c, &f, 4);
+            }
+        }
+        if (!ok)
+            break;
+        k++;
+    }
+    if (ok && e->nblocks == e->capblocks) {
+        int more_cap = e->capblocks ? 2 * e->capblocks : 32;
+        block_entry *more = realloc(e->blocks, (size_t)more_cap * sizeof *more);
+        ok = more ? (e->blocks = more, e->capblocks = more_cap, true) : fail("out of memory");
+    }
+    block_entry *entry = ok ? &e->blocks[e->nblocks] : NULL;
+    ok = ok && gpu_buffer_new(e->g, (VkDeviceSize)size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, data, &entry->buffer);
+    free(data);
+    if (!ok)
+        return false;
+    entry->name = b->name;
+    entry->key = pair;
+    entry->layout = layout;
+    e->nblocks++;
+    *out = entry->buffer.buffer;
+    return true;
+}
+
 bool block_buffer(engine *e, const draw_item *it, const block_ref *b, VkBuffer *out)
 {
+    if (b->storage)
+        return light_buffer(e, it, b, out);
     const void *key;
     bool object = strcmp(b->name, "Object") == 0, upload = !strcmp(b->name, "Material") || !strcmp(b->name, "Lights");
     if (strcmp(b->name, "Frame") == 0)

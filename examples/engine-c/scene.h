@@ -21,7 +21,8 @@
 /* A uniform block a program reads (interface.<stage>.uniform_blocks), with the stages that read it. */
 typedef struct block_ref {
     const char *name;          /* Frame, Object, Material, Lights: what the engine puts there is by name */
-    int set, binding, size;
+    int set, binding, size;    /* size 0: a storage block (LightBuffer<i>), its bytes what the engine fills */
+    bool storage;              /* interface.<stage>.storage_blocks: a dynamic light set's buffer */
     VkShaderStageFlags stages;
     const cJSON *json;         /* its members and parameters (offsets of each value) */
 } block_ref;
@@ -73,6 +74,7 @@ typedef struct manifest {
     json_src src;
     const cJSON *conv;         /* conventions.platforms.vulkan */
     const cJSON *materials, *lights, *light_sets, *samplers, *depth_shaders, *tables;
+    const cJSON *dynamic_light_sets;  /* optional: per dynamic light set, its pairs' buffers (how to fill them) */
     const char *pack_path, *pack_sha256, *pack_key;
     program *perms;
     int nperms;

@@ -27,13 +27,15 @@ static const VkDescriptorType TYPES[] = {
     [BIND_BLOCK] = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
     [BIND_IMAGE] = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
     [BIND_SAMPLER] = VK_DESCRIPTOR_TYPE_SAMPLER,
+    [BIND_STORAGE] = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
 };
 
 bool layout_create(gpu *g, const program *p, program_layout *l)
 {
     memset(l, 0, sizeof *l);
     for (int i = 0; i < p->nblocks; i++)
-        if (!put_binding(l, p, p->blocks[i].set, p->blocks[i].binding, BIND_BLOCK, i, p->blocks[i].stages))
+        if (!put_binding(l, p, p->blocks[i].set, p->blocks[i].binding,
+                         p->blocks[i].storage ? BIND_STORAGE : BIND_BLOCK, i, p->blocks[i].stages))
             return false;
     for (int i = 0; i < p->ntextures; i++) {
         const texture_ref *t = &p->textures[i];

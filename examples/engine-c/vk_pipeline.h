@@ -16,7 +16,7 @@
 #define MAX_SETS 8
 #define MAX_SET_BINDINGS 64
 
-typedef enum binding_kind { BIND_BLOCK, BIND_IMAGE, BIND_SAMPLER } binding_kind;
+typedef enum binding_kind { BIND_BLOCK, BIND_IMAGE, BIND_SAMPLER, BIND_STORAGE } binding_kind;
 
 typedef struct set_binding {
     uint32_t binding;

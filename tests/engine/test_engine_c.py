@@ -6,7 +6,7 @@ The tolerance: the renderer compiles its own GLSL while the engine loads the bui
 pack, so a float may round differently in the last place, which can move a channel by one step of 8 bits; two
 steps or more is a real difference (a wrong binding, block, matrix or state moves whole regions, as the tests
 below that edit one field show). Measured on lavapipe (Mesa 25), 128 × 80: every channel equal (largest difference
-0) on all six scenes.
+0) on all seven scenes (the dynamic light set's too).
 """
 from __future__ import annotations
 
@@ -144,7 +144,9 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "depth_mask": lambda tmp: REPO / "tests" / "scenes" / "depth_mask.toml",
           "tables": lambda tmp: _written(tmp / "tables.toml", TABLES),
           # a spot light's perspective map with pcf, and an object outside its light set that casts nothing
-          "spot_shadow": lambda tmp: REPO / "tests" / "scenes" / "spot_shadow.toml"}
+          "spot_shadow": lambda tmp: REPO / "tests" / "scenes" / "spot_shadow.toml",
+          # a dynamic light set: 16 points and 2 spots in two storage buffers (manifest dynamic_light_sets)
+          "dynamic": lambda tmp: REPO / "tests" / "scenes" / "dynamic_lights.toml"}
 
 
 @pytest.fixture(scope="module")
@@ -228,12 +230,13 @@ def test_a_layout_unlike_the_shaders_is_a_validation_failure(engine, prepared, t
     assert not (tmp_path / "out.png").exists()
 
 
-@pytest.mark.parametrize("what", ["material", "shadow_matrix", "sampler", "casters"])
+@pytest.mark.parametrize("what", ["material", "shadow_matrix", "sampler", "casters", "light_buffer"])
 def test_what_the_engine_reads_changes_the_picture(engine, prepared, tmp_path, what):
     """The comparison can fail: one value changed in what the engine reads — a Material upload (the ground's
-    rho_d), the sun's fitted matrix in the export, a sampler row, a light's casters (spot_shadow's box left out)
-    — moves the picture past the tolerance."""
-    build, export, reference = prepared({"sampler": "textured", "casters": "spot_shadow"}.get(what, "example"))
+    rho_d), the sun's fitted matrix in the export, a sampler row, a light's casters (spot_shadow's box left out),
+    a dynamic set's lights (half of its points left out of their buffer) — moves the picture past the tolerance."""
+    build, export, reference = prepared({"sampler": "textured", "casters": "spot_shadow",
+                                         "light_buffer": "dynamic"}.get(what, "example"))
     if what == "material":
         def darker(m):
             u = _perm(m, "ground")["uploads"][0]
@@ -244,6 +247,12 @@ def test_what_the_engine_reads_changes_the_picture(engine, prepared, tmp_path, w
             for row in m["samplers"]:
                 row["platforms"]["vulkan"].update(magFilter="VK_FILTER_NEAREST", minFilter="VK_FILTER_NEAREST")
         build = _edited(build, tmp_path / "b", nearest)
+    elif what == "light_buffer":
+        def fewer(m):
+            pair = m["dynamic_light_sets"]["crowd"]["pairs"][0]
+            assert pair["pair"] == "*point/none" and len(pair["lights"]) == 16
+            del pair["lights"][8:]  # the engine's buffer, and so the shader's count, is 8 lights
+        build = _edited(build, tmp_path / "b", fewer)
     else:
         shutil.copytree(export, tmp_path / "x")
         export = tmp_path / "x"
