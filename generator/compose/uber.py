@@ -4,7 +4,7 @@ from __future__ import annotations
 import hashlib
 
 from ..library.bricks import Library
-from ..link.uber import Uber, link_ubershader
+from ..link.uber import ALPHA_MODE_FUNCTION, Uber, link_ubershader
 from ..spec.permutation import Permutation
 from ..backends import LANGUAGES, language
 from ..backends.base import Emitted
@@ -57,7 +57,10 @@ def compose_ubershader(perms: list[Permutation], lib: Library, languages=LANGUAG
             templates.update(used)
             ctx = {"provenance": _provenance("ubershader", f"{len(perms)} permutations", h, bricks, used),
                    "inputs": iface.surface, "textures": iface.textures, "shade": shade,
-                   "call_args": _call_args(u, lang.material_index), "iface": iface, **lang.context()}
+                   "call_args": _call_args(u, lang.material_index), "iface": iface, **lang.context(),
+                   "double_sided": u.double_sided, "material_index": lang.material_index,
+                   # the main's discard reads the entry's alpha mode (link/uber.py ALPHA_MODE_FUNCTION)
+                   "alpha_mode": ALPHA_MODE_FUNCTION if "mask" in u.alpha_modes else ""}
             sources.append(_render(lib, tname, target, ctx, emitted if stage == "fragment" else Emitted(""),
                                    f"ubershader.{'frag' if stage == 'fragment' else 'vert'}.{lang.name}"))
     return Composed(key, h, sources, bricks, templates, iface), u

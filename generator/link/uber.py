@@ -7,11 +7,22 @@ stands in for computes the same code; `coverage()` proves every axis value reach
 
 Data (documented in docs/design/link.md, "The ubershader's data"; the manifest lists the tables):
 - `material_buffer`: MaterialEntry { ids: ivec4; data: vec4[M] } per material. ids.x is the
-  material *variant* — a (BRDF, packing, output) combination of the table `variants`; ids.y,
-  ids.z and ids.w are reserved (0).
-  `data` holds exactly the variant's specialized Material block (the same bytes as the
-  specialized permutation's `uploads`, less the surface state's vec4s at its end), M the
-  largest of them.
+  material *variant* — a (BRDF, packing, output) combination of the table `variants`; ids.y the
+  material's alpha mode (ALPHA_IDS: 0 opaque, 1 mask, 2 blend); ids.z and ids.w are reserved (0).
+  `data` holds the bricks' part of the variant's specialized Material block (the same bytes as the
+  specialized permutation's `uploads`, less the surface state's vec4s at its end), M the largest
+  of them; where a permutation is masked or blended, data[surface_at] (= that M, and M grows by
+  one) holds (base_alpha, alpha_cutoff, 0, 0), the surface state's values at one place for every
+  variant (a specialized block packs them after its bricks' part, where each variant's ends).
+- Surface state (spec/surface.py), as the specialized shader does it: a variant used by a masked
+  or blended permutation computes the same coverage (base_alpha · the packing's base colour
+  texture's A) after its output brick and returns it as alpha (BLEND) or 1 / 0 against the cutoff
+  (MASK), and the fragment main discards alpha below 0.5 where ids.y says mask (it reads ids.y
+  through `surface_alpha_mode(material)`); with a double-sided permutation the main reverses N, T
+  and B on back faces, which reach it only where the pipeline culls nothing (a single-sided
+  object's pipeline culls them). Blending, culling and depth writes are pipeline state: an object
+  is drawn with the ubershader under its permutation's render_state (runtime/pipeline_state.py),
+  one pipeline per distinct state. Vertex colours and emission are not in the ubershader.
 - `light_buffer`: LightEntry { ids: ivec4; data: vec4[K] } per light, looped over with a
   runtime count. ids.x indexes `light_types`, ids.y `shadows`, ids.z the shadow map the
   light's filter samples (0 … shadow_maps-1). data[0 …) holds the light brick's parameters,
@@ -28,13 +39,15 @@ from ..library.inputs import SURFACE
 from ..spec.permutation import Permutation
 from ..spec.resolve import Resolved, resolve
 from ..spec.where import KeyProblem, within
-from .glue import _Binder, brdf_glue, has_tangent, read_slot, shading_tangent
+from .glue import _Binder, _sample, brdf_glue, coverage_texture, has_tangent, read_slot, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, layout
 from .irgen import Builder
 from .program import Program
 from .glue import UV_LOCAL  # the ubershader's variants share the specialized glue's uv local
 
 IVEC4 = vector("int", 4)
+ALPHA_IDS = {"opaque": 0, "mask": 1, "blend": 2}  # MaterialEntry.ids.y: the material's alpha mode
+ALPHA_MODE_FUNCTION = "surface_alpha_mode"  # int (int material): ids.y of its entry, for the fragment main
 
 
 @dataclass
@@ -68,6 +81,9 @@ class Uber:
     signature: list[tuple[str, Type]] = field(default_factory=list)
     surface: list[str] = field(default_factory=list)
     reads: list[str] = field(default_factory=list)
+    surface_at: int | None = None  # the vec4 of MaterialEntry.data holding (base_alpha, alpha_cutoff, 0, 0)
+    alpha_modes: list[str] = field(default_factory=list)  # the permutations' alpha modes, in ALPHA_IDS order
+    double_sided: bool = False  # a permutation is double-sided: the main reverses N, T, B on back faces
 
     def interface(self, kernel: bool = False) -> Interface:
         """The ubershader's Interface: its buffers, the Draw block, textures, inputs and outputs."""
@@ -92,7 +108,11 @@ class Uber:
         return {"variants": [{"id": k, "brdf": v.brdf, "packing": v.packing, "output": v.output,
                               "parameters": [s.as_dict() for s in v.slots]} for k, v in enumerate(self.variants)],
                 "light_types": self.light_types, "shadows": self.shadows, "shadow_maps": self.shadow_maps,
-                "material_entry": {"ids": "ivec4 (variant, 0, 0, 0)", "data_vec4s": self.material_vec4s},
+                "render_state": "an object's permutation's render_state (cull, blend, depth write): one pipeline per "
+                                "distinct state; its material's alpha mode in the entry's ids.y",
+                "material_entry": {"ids": "ivec4 (variant, alpha mode, 0, 0)", "data_vec4s": self.material_vec4s,
+                                   "alpha_modes": dict(ALPHA_IDS),
+                                   **({"surface_at": self.surface_at} if self.surface_at is not None else {})},
                 "light_entry": {"ids": "ivec4 (light type, shadow, shadow map, 0)", "data_vec4s": self.light_vec4s,
                                 "shadow_parameters_at": self.light_split}}
 
@@ -130,12 +150,18 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     shadows: list[str] = []
     lights, shadow_of = {}, {}  # light type -> its LightPart's params; shadow spec -> the filter's node, params
     shadowed = 0
+    alpha_variants: set[int] = set()  # the variants a masked or blended permutation uses
+    modes, double_sided = {"opaque"}, False
     for r in [p if isinstance(p, Resolved) else resolve(p, lib) for p in perms]:
         p = r.perm
         if (p.brdf, p.packing, p.output) not in [v.key for v in variants]:
             probe = resolve(Permutation(p.brdf, (), p.packing, p.output, p.precision, origin=p.origin), lib)
             variants.append(Variant(p.brdf, p.packing, p.output, link_permutation(probe, lib).material))
             resolved.append(probe)
+        if p.surface.alpha != "opaque":
+            alpha_variants.add([v.key for v in variants].index((p.brdf, p.packing, p.output)))
+        modes.add(p.surface.alpha)
+        double_sided = double_sided or p.surface.double_sided
         for lk, lt in zip(p.lights, r.lights):
             if lk.light not in light_types:
                 light_types.append(lk.light)
@@ -147,6 +173,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     prog, b = Program(lib_memo=lib.memo), Builder()
     bind = _Binder(b)
     M = max([1] + [max([1] + [s.index + s.width for s in v.slots]) for v in variants])
+    surface_at = M if alpha_variants else None
+    M += surface_at is not None
     lnodes = {t: lights[t][0] for t in light_types}
     snodes = {s: shadow_of[s][0] for s in shadows}
     A = max([1] + [_vec4s(lights[t][1]) for t in light_types])
@@ -229,12 +257,18 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         stmts.append(b.decl("color", b.construct(VEC4, b.const(0.0))))
         outs = [[b.assign(b.var("color", VEC4), bind.call(prog, on, "output", "o_", "material", None, {},
                                                           {**material_args(k), "color": b.var("Lo", VEC3)}))]
+                + (_surface_alpha(b, bind, me, mat_data, surface_at, packings[k], bool(uvs[k]))
+                   if k in alpha_variants else [])
                 for k, on in enumerate(outputs)]
         stmts.append(_switch(b, b.copy(variant), outs))
         stmts.append(b.ret(b.var("color", VEC4)))
         return stmts
 
     stmts = body()
+    if "mask" in modes and not kernel:  # the fragment main discards by the entry's alpha mode
+        prog.add(b.function(ALPHA_MODE_FUNCTION, [("material", INT)], INT, lambda: [b.ret(ir.Swizzle(
+            INT, b.here(), ir.Member(IVEC4, b.here(), ir.Index(MaterialEntry, b.here(), ir.Var(
+                mbuf.ty, b.here(), mbuf.name, "global"), b.var("material", INT, "param")), "ids"), "y"))]))
     leftover = [n for n in bind.params]
     if leftover:
         with within(resolved[0].origin, resolved[0].key):  # where the scene asks for its first material
@@ -262,7 +296,29 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         tex.set = 0 if tex.group == "light" else 1
         tex.binding = nxt[tex.group]
         nxt[tex.group] += 2
-    return Uber(prog, variants, light_types, shadows, shadowed, M, A, K, layouts, bind.textures, sig, surface, reads)
+    return Uber(prog, variants, light_types, shadows, shadowed, M, A, K, layouts, bind.textures, sig, surface, reads,
+                surface_at, [m for m in ALPHA_IDS if m in modes], double_sided)
+
+
+def _surface_alpha(b: Builder, bind: _Binder, me: ir.Expr, mat_data: Type, at: int, packing, filtered_uv: bool
+                   ) -> list[ir.Stmt]:
+    """`if (me.ids.y != 0) color.a = coverage or 1 / 0 against the cutoff`: the specialized glue's surface_output
+    (link/glue.py coverage, coverage_alpha) with base_alpha and alpha_cutoff read from data[at] (x, y). The base
+    colour texture is sampled at uv_t where the variant's packing has a uv filler (what its other samples read)."""
+    mode = ir.Swizzle(INT, b.here(), ir.Member(IVEC4, b.here(), b.copy(me), "ids"), "y")
+    cov = read_slot(b, me, mat_data, Slot("m_base_alpha", "base_alpha", FLOAT, at, component=0))
+    cutoff = read_slot(b, me, mat_data, Slot("m_alpha_cutoff", "alpha_cutoff", FLOAT, at, component=1))
+    tex = coverage_texture(packing)
+    if tex:
+        bind.uv = b.var(UV_LOCAL, SURFACE["uv"]) if filtered_uv else None
+        cov = b.arith("*", cov, ir.Swizzle(FLOAT, b.here(), _sample(b, bind, f"t_{tex}", tex, True), "w"))
+        bind.uv = None
+    masked = ir.Select(FLOAT, b.here(), b.compare(">=", b.var("coverage", FLOAT), cutoff), b.const(1.0), b.const(0.0))
+    alpha = ir.Select(FLOAT, b.here(), b.compare("==", b.copy(mode), ir.Const(INT, b.here(), ALPHA_IDS["mask"])),
+                      masked, b.var("coverage", FLOAT))
+    rgb = ir.Swizzle(VEC3, b.here(), b.var("color", VEC4), "xyz")
+    return [b.if_(b.compare("!=", mode, ir.Const(INT, b.here(), ALPHA_IDS["opaque"])),
+                  [b.decl("coverage", cov), b.assign(b.var("color", VEC4), b.construct(VEC4, rgb, alpha))])]
 
 
 def _texture_types(node) -> dict[str, Type]:

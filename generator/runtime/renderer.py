@@ -47,17 +47,21 @@ and a masked material's depth pass bind the same image and sampler. Only the ren
 here: a brick's baked table (reference/tables.py; read through the sampler its row of the build's ``tables``
 names), the lit stand-ins of unused shadow slots, and a grey image
 for an ubershader texture the drawn material does not bind (its variant never samples it). The surface state of a permutation
-(spec/surface.py) is honoured by its specialized pipeline: alpha MASK discards in the shader, BLEND
-pipelines blend source-over without writing depth and are drawn after the opaque ones (not sorted by depth),
-single-sided surfaces cull their back faces, all as the manifest's render_state says (the given build's entry,
-else runtime/pipeline_state.py, the function the build writes it with); the ubershader implements none of it
-(it stands in for the BRDF, packing and output only). Pipelines are created through
+(spec/surface.py) is honoured by its specialized pipeline and by the ubershader alike: alpha MASK discards in
+the shader, BLEND pipelines blend source-over without writing depth and are drawn after the opaque ones, back to
+front (:func:`draw_order`: by the view depth of each one's bounding-box centre, ties in scene order; the frame
+export's draw_order), single-sided surfaces cull their back faces, all as the manifest's render_state says (the
+given build's entry, else runtime/pipeline_state.py, the function the build writes it with). The ubershader reads
+a material's alpha mode and coverage values from its MaterialEntry (link/uber.py) and is drawn with the object's
+render state: one ubershader pipeline per distinct (cull, blend, depth) state, and per variant with
+uber_ids="specialization". Vertex colours and emission are the specialized shaders' only. Pipelines are created through
 a persisted pipeline cache (runtime/pipeline_cache.py), and when the render opens its own device,
 Mesa's shader disk cache lives in out/shader_cache and the driver's hit and miss counts go into the
 report (runtime/shader_cache.py).
 """
 from __future__ import annotations
 
+import json
 import threading
 import time
 from dataclasses import dataclass, field
@@ -187,7 +191,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..toolchain import CompileJob, compile_many
     from . import graphics as gx
     from .device import Device, validation_requested
-    from ..link.uber import SPEC_VARIANT
+    from ..link.uber import ALPHA_IDS, SPEC_VARIANT
     from ..spec.resolve import resolve
     from .pipeline_cache import PipelineCacheFile
     from .depth_images import ComparisonSampler, DepthImage
@@ -314,7 +318,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             owned.append(b)
             return b
 
-        def make_pipeline(tag, iface, variant=None):
+        def make_pipeline(tag, iface, variant=None, state=None):
             t0 = time.perf_counter()
             frag, spec = spv[(tag, "frag")], None
             if variant is not None:
@@ -324,7 +328,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     spec = {SPEC_VARIANT: variant}
             p = gx.GraphicsPipeline(device, target, spv[(tag, "vert")], frag, iface.vertex_inputs,
                                     gx.layouts_from_interface(iface), cache=cache, specialization=spec,
-                                    render_state=states.get(tag))  # the ubershader: none (docs/design/runtime.md)
+                                    render_state=state or states.get(tag))  # the ubershader: the drawn object's
             owned.append(p)  # released whatever happens next (list.append is atomic: the worker may call this)
             report.pipeline_create_ms.append((time.perf_counter() - t0) * 1e3)
             report.pipelines_created += 1
@@ -386,10 +390,14 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                       if x["material"] == name)
             data = np.zeros((u.material_vec4s, 4), np.float32)
             block = np.frombuffer(bytes.fromhex(up.get("Material", "")), np.float32).reshape(-1, 4)
-            n = min(len(block), len(data))  # the surface state's values come last, and the ubershader has none
-            data[:n] = block[:n]
             k = variant[(p.brdf, p.packing, p.output)]
-            mat_ids.append((k, 0, 0, 0))
+            n = max([0] + [s.index + s.width for s in u.variants[k].slots])  # the bricks' part: the surface's
+            data[:n] = block[:n]  # values come after it, and the ubershader reads them from data[surface_at]
+            if u.surface_at is not None:
+                at = {s.param: s for s in composed[obj["permutation"]].material if s.light is None}
+                data[u.surface_at, :2] = [block[at[x].index, at[x].component] if x in at else 0.0
+                                          for x in ("base_alpha", "alpha_cutoff")]
+            mat_ids.append((k, ALPHA_IDS[p.surface.alpha], 0, 0))
             mat_rows.append(data)
         material_buffer = buf(entry_bytes(np.array(mat_ids), np.stack(mat_rows)), S)
         light_buffers, slot_lights = {}, {}
@@ -492,8 +500,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             draws.append((h, spec, ub, mesh_of[i]))
         report.textures, report.texture_notes = mtex.report(), list(mtex.notes)
 
-        # blended surfaces after the opaque ones, in scene order otherwise (no sorting by depth: docs/design/runtime.md)
-        blended_last = sorted(range(len(draws)), key=lambda i: perms[draws[i][0]].surface.alpha == "blend")
+        # blended surfaces after the opaque ones, back to front (draw_order), in scene order otherwise
+        blended_last = draw_order(placed, vp, [perms[d[0]].surface.alpha == "blend" for d in draws])
         draws = [draws[i] for i in blended_last]
         frame_export = None
         if export is not None:  # written once the frames are drawn: a failed render leaves the last export alone
@@ -508,12 +516,17 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         specialized: dict[str, object] = {}
         order = list(dict.fromkeys(h for h, _, _, _ in draws))  # first use
         start = time.perf_counter()
+        # the ubershader's pipelines: one per (variant, when it is a specialization constant) and distinct render
+        # state of the objects drawn (few: cull back or none, blended or not), each object's its permutation's
         uber_pipes = {}
-        if mode != "specialized":
-            for k in (sorted({m[0] for m in mat_ids}) if spec_ids else [None]):
-                uber_pipes[k] = make_pipeline("ubershader", uber.interface, k)
-        uber_of = {h: (variant[(perms[h].brdf, perms[h].packing, perms[h].output)] if spec_ids else None)
+        state_key = {h: json.dumps({k: states[h][k] for k in ("blend", "cull", "depth")}, sort_keys=True)
+                     for h in perms}  # what a pipeline holds (a mask's alpha mode and cutoff are the shader's)
+        uber_of = {h: (variant[(perms[h].brdf, perms[h].packing, perms[h].output)] if spec_ids else None, state_key[h])
                    for h in perms}
+        if mode != "specialized":
+            for h in order:
+                if uber_of[h] not in uber_pipes:
+                    uber_pipes[uber_of[h]] = make_pipeline("ubershader", uber.interface, uber_of[h][0], states[h])
         worker = None
         if mode == "specialized":
             for h in order:
@@ -575,9 +588,22 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 report.shader_cache_hits, report.shader_cache_misses = stats
         report.validation = bool(device.validation)
         report.validation_messages = [str(m) for m in device.messages[first_message:]]
-    import json
     atomic_write(out / "report.json", (json.dumps(report.as_dict(), indent=2) + "\n").encode())
     return report
+
+
+def draw_order(placed, view_proj, blended: list[bool]) -> list[int]:
+    """The objects' draw order: the opaque (and masked) ones first, in scene order, then the blended ones back to
+    front — by the view depth of their world-space bounding box's centre (its distance along the camera's forward:
+    the clip-space w of view_proj × centre, for the renderer's perspective cameras), farthest first, ties in scene
+    order. Source-over blending then composes a nearer surface over a farther one wherever their boxes'
+    centres are ordered as the surfaces are (not for interpenetrating surfaces: no per-fragment sorting)."""
+    def depth(i):
+        corners = placed.objects[i].corners()
+        centre = 0.5 * (corners.min(0) + corners.max(0))
+        return float((np.asarray(view_proj, np.float64) @ np.append(centre, 1.0))[3])
+    opaque = [i for i, b in enumerate(blended) if not b]
+    return opaque + sorted((i for i, b in enumerate(blended) if b), key=lambda i: -depth(i))
 
 
 def _light_specs(lib, light) -> dict:
