@@ -105,3 +105,25 @@ def test_a_light_outside_the_sets_model_is_refused_at_the_set(lib, device, tmp_p
     line = text.splitlines().index("lights = [\"l0\", \"l1\", \"l2\"]") + 1
     assert msg.startswith(f"{tmp_path / 'bad' / 's.toml'}:{line}:"), msg
     assert "light 'l0' (point/none) is not in the model of dynamic light set 'all' (spot/none)" in msg
+
+
+def test_a_gltf_scene_made_dynamic_by_its_lights_file_draws_as_its_static_import(lib, device, tmp_path):
+    from PIL import Image
+
+    from generator.assemble.render_inputs import scene_textures
+    from generator.runtime.renderer import render_scene
+    from generator.scene.load import load_scene
+    from tests.scene.test_gltf import sample_doc
+    path = sample_doc(extra_lights=True).write_gltf(tmp_path / "model.gltf")
+    images = {}
+    for name, sidecar in (("static", None), ("dynamic", "[light_set]\ndynamic = true\nmax = 8\n")):
+        if sidecar is not None:
+            (tmp_path / "model.lights.toml").write_text(sidecar)
+        scene = load_scene(path, lib)
+        assert bool(scene.dynamic_sets) == (sidecar is not None)
+        out = tmp_path / name
+        render_scene(scene, lib, "specialized", 1, out, (W, H), device=device, build=scene_textures(scene, out))
+        images[name] = np.asarray(Image.open(out / "frame_0000.png").convert("RGBA")).astype(int)
+    # the model's loops run in the order of its sorted pairs (directional, point_range, spot): the import's order
+    assert images["static"][..., :3].max() > 40
+    _agree(images["dynamic"], images["static"], "glTF lights as a dynamic set")
