@@ -71,6 +71,8 @@ def built(tmp_path_factory) -> dict[str, dict]:
     out["textured.toml"] = _build(REPO / "scenes" / "textured.toml", "--out", tmp / "textured.toml")
     out["depth_mask"] = _build(REPO / "tests" / "scenes" / "depth_mask.toml", "--out", tmp / "depth_mask")
     out["dynamic"] = _build(REPO / "tests" / "scenes" / "dynamic_lights.toml", "--out", tmp / "dynamic")  # light buffers
+    out["spot_shadow"] = _build(REPO / "tests" / "scenes" / "spot_shadow.toml", "--out", tmp / "spot",
+                                "--platform", "vulkan")  # a perspective shadow fit (its padding)
     out["vulkan"] = _build(EXAMPLE, "--out", tmp / "vulkan", "--platform", "vulkan")
     out["pack_only"] = _build(EXAMPLE, "--out", tmp / "pack_only", "--pack-only")  # "artifacts": "packs"
     (tmp / "state.toml").write_text(_state_scene())
