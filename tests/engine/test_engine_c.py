@@ -146,7 +146,9 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           # a spot light's perspective map with pcf, and an object outside its light set that casts nothing
           "spot_shadow": lambda tmp: REPO / "tests" / "scenes" / "spot_shadow.toml",
           # a dynamic light set: 16 points and 2 spots in two storage buffers (manifest dynamic_light_sets)
-          "dynamic": lambda tmp: REPO / "tests" / "scenes" / "dynamic_lights.toml"}
+          "dynamic": lambda tmp: REPO / "tests" / "scenes" / "dynamic_lights.toml",
+          # a masked, two blended (drawn back to front, as the export's draw_order says) and a double-sided object
+          "surface_state": lambda tmp: REPO / "tests" / "scenes" / "surface_state.toml"}
 
 
 @pytest.fixture(scope="module")
