@@ -35,7 +35,7 @@ count the 32-bit components they move.
 """
 from __future__ import annotations
 
-from .spirv import GLSL_STD_450, Instruction, Module
+from .spirv import GLSL_STD_450, OPCODES, Instruction, Module
 
 ALU_OPS = {
     "SNegate", "FNegate", "IAdd", "FAdd", "ISub", "FSub", "IMul", "FMul", "UDiv", "SDiv", "FDiv", "UMod",
@@ -92,34 +92,48 @@ def ext_name(mod: Module, ins: Instruction) -> str | None:
     """The GLSL.std.450 instruction name of an OpExtInst, None for other sets."""
     if mod.ext_imports.get(ins.words[2]) != "GLSL.std.450":
         return None
-    return GLSL_STD_450.get(ins.words[3], f"GLSL.std.450#{ins.words[3]}")
+    name = GLSL_STD_450.get(ins.words[3])
+    return name if name is not None else f"GLSL.std.450#{ins.words[3]}"
 
 
-def _ext(mod: Module, ins: Instruction, n_res: int) -> tuple[str, dict]:
-    """Class and scalar counts of a GLSL.std.450 instruction."""
-    name = ext_name(mod, ins)
+# The rule _ext() takes for a GLSL.std.450 name whose figures depend on its operand or are fixed.
+_E_LENGTH, _E_REFRACT, _E_CROSS, _E_REFLECT, _E_FACEFORWARD, _E_DETERMINANT, _E_INVERSE = range(1, 8)
+_EXT_RULE = {**dict.fromkeys(("Length", "Distance", "Normalize"), _E_LENGTH), "Refract": _E_REFRACT,
+             "Cross": _E_CROSS, "Reflect": _E_REFLECT, "FaceForward": _E_FACEFORWARD,
+             "Determinant": _E_DETERMINANT, "MatrixInverse": _E_INVERSE}
+# The other names: their figures follow from the result's components n alone, (class, a, t) for
+# a * max(n, 1) ALU operations and t * n transcendental ones.
+_EXT_BY_RESULT = {n: ("transcendental", 0, 1) if n in TRANSCENDENTAL_EXT else ("alu", EXT_PER_COMPONENT.get(n, 1), 0)
+                  for n in GLSL_STD_450.values() if n not in _EXT_RULE}
+# by instruction number, for count_rows
+_EXT_NUMBER_BY_RESULT = {number: (name, *_EXT_BY_RESULT[name])
+                         for number, name in GLSL_STD_450.items() if name in _EXT_BY_RESULT}
+
+
+def _ext(mod: Module, ins: Instruction, name: str, n_res: int) -> tuple[str, int, int]:
+    """Class, ALU and transcendental counts of a GLSL.std.450 instruction."""
+    rule = _EXT_RULE.get(name)
+    if rule is None:  # one of _EXT_BY_RESULT, or an instruction number without a name
+        cls, a, t = _EXT_BY_RESULT.get(name, ("alu", 1, 0))
+        return cls, a * max(n_res, 1), t * n_res
     args = ins.words[4:]
+    if rule == _E_CROSS:
+        return "alu", 9, 0
+    if rule == _E_DETERMINANT:
+        return "alu", DETERMINANT.get(_matrix_shape(mod, args[0])[0], 40), 0
+    if rule == _E_INVERSE:
+        return "alu", INVERSE.get(_matrix_shape(mod, args[0])[0], 120), 0
     n = _operand_components(mod, args[0]) if args else n_res
-    if name in TRANSCENDENTAL_EXT:
-        return "transcendental", {"transcendental": n_res}
-    if name in ("Length", "Distance", "Normalize"):
+    if rule == _E_LENGTH:
         if n == 1:
-            return "alu", {"alu": 2 if name == "Distance" else 1}
+            return "alu", 2 if name == "Distance" else 1, 0
         alu = 2 * n - 1 if name == "Length" else 3 * n - 1
-        return "transcendental", {"alu": alu, "transcendental": 1}
-    if name == "Refract":
-        return "transcendental", {"alu": 6 * n + 6, "transcendental": 1}
-    if name == "Cross":
-        return "alu", {"alu": 9}
-    if name == "Reflect":
-        return "alu", {"alu": 4 * n}
-    if name == "FaceForward":
-        return "alu", {"alu": 3 * n}
-    if name == "Determinant":
-        return "alu", {"alu": DETERMINANT.get(_matrix_shape(mod, args[0])[0], 40)}
-    if name == "MatrixInverse":
-        return "alu", {"alu": INVERSE.get(_matrix_shape(mod, args[0])[0], 120)}
-    return "alu", {"alu": EXT_PER_COMPONENT.get(name, 1) * max(n_res, 1)}
+        return "transcendental", alu, 1
+    if rule == _E_REFRACT:
+        return "transcendental", 6 * n + 6, 1
+    if rule == _E_REFLECT:
+        return "alu", 4 * n, 0
+    return "alu", 3 * n, 0  # FaceForward
 
 
 def _alu_scalars(mod: Module, ins: Instruction, n_res: int) -> int:
@@ -140,38 +154,110 @@ def _alu_scalars(mod: Module, ins: Instruction, n_res: int) -> int:
     return n_res
 
 
+# Which rule of counts() an instruction name takes (the sets above are disjoint); "other" when absent.
+_ALU, _ALU_SHAPED, _EXT, _TEXTURE, _BRANCH, _LOAD, _STORE = range(1, 8)
+_RULE = {**dict.fromkeys(ALU_OPS, _ALU),
+         **dict.fromkeys(("Dot", "Any", "All", "MatrixTimesVector", "VectorTimesMatrix", "MatrixTimesMatrix"),
+                         _ALU_SHAPED),
+         "ExtInst": _EXT, **dict.fromkeys(TEXTURE_OPS, _TEXTURE), "BranchConditional": _BRANCH, "Switch": _BRANCH,
+         **dict.fromkeys(LOAD_OPS, _LOAD), **dict.fromkeys(STORE_OPS, _STORE)}
+_STORED_VALUE = {"Store": 1, "AtomicStore": 3, "ImageWrite": 2}   # operand word holding the value stored
+
+
+def _fixed(name: str) -> tuple | None:
+    """counts() of an instruction whose figures are its name's alone (others, textures), else None."""
+    rule = _RULE.get(name)
+    if rule is None:
+        return "other", "Op" + name, 0, 0, 0, 0
+    return ("texture", "Op" + name, 0, 0, 0, 0) if rule == _TEXTURE else None
+
+
+# counts() of the instructions whose figures are their name's alone, by name (structure declarations left out)
+FIXED_COUNTS = {n: f for n in OPCODES.values() if (f := _fixed(n)) is not None and n not in NOT_EXECUTED}
+_RULE_KEY = {n: (rule, "Op" + n) for n, rule in _RULE.items() if rule != _TEXTURE}
+
+
+def counts(mod: Module, ins: Instruction) -> tuple[str, str, int, int, int, int]:
+    """(class, histogram key, ALU, transcendental, load and store scalar counts) of one instruction inside
+    a function: the figures of :func:`classify` as plain numbers (the cost analysis sums them for every
+    instruction, without a dict for each)."""
+    name = ins.name
+    fixed = FIXED_COUNTS.get(name)
+    if fixed is not None:
+        return fixed
+    rk = _RULE_KEY.get(name)
+    if rk is None:  # an opcode without a name ("Op<number>")
+        return _fixed(name)
+    rule, key = rk
+    type_id = ins.type_id
+    if rule == _ALU:
+        return "alu", key, mod.type_components[type_id] if type_id else 0, 0, 0, 0
+    if rule == _ALU_SHAPED:
+        return "alu", key, _alu_scalars(mod, ins, mod.type_components[type_id] if type_id else 0), 0, 0, 0
+    if rule == _EXT:
+        ext = ext_name(mod, ins)
+        if ext is None:
+            return "other", key, 0, 0, 0, 0
+        cls, alu, transcendental = _ext(mod, ins, ext, mod.type_components[type_id] if type_id else 0)
+        return cls, ext, alu, transcendental, 0, 0
+    if rule == _BRANCH:
+        return ("other" if mod.is_constant(ins.words[0]) else "branch"), key, 0, 0, 0, 0
+    if rule == _LOAD:
+        if name == "Load" and is_handle(mod, type_id):
+            return "other", "OpLoad(handle)", 0, 0, 0, 0
+        if name.startswith("CopyMemory"):
+            width = mod.width(pointee(mod, ins.words[0]))
+            return "load", key, 0, 0, width, width
+        width = mod.width(type_id)
+        return "load", key, 0, 0, width, (0 if name in ("Load", "AtomicLoad") else width)
+    return "store", key, 0, 0, 0, mod.width(mod.value_types.get(ins.words[_STORED_VALUE[name]], 0))
+
+
+_ALU_KEYS = {n: key for n, (rule, key) in _RULE_KEY.items() if rule == _ALU}
+
+
+def count_rows(mod: Module, body: list[Instruction]) -> list[tuple[str, str, int, int, int, int]]:
+    """:func:`counts` of each instruction, in order; the commonest kinds (an instruction whose figures are its
+    name's, a component-wise ALU operation, a GLSL.std.450 one whose figures follow from its result) without
+    a call each."""
+    fixed, alu, components = FIXED_COUNTS, _ALU_KEYS, mod.type_components
+    by_result = _EXT_NUMBER_BY_RESULT
+    glsl = {i for i, name in mod.ext_imports.items() if name == "GLSL.std.450"}
+    rows = []
+    for ins in body:
+        name = ins.name
+        row = fixed.get(name)
+        if row is None:
+            key = alu.get(name)
+            if key is not None:
+                type_id = ins.type_id
+                row = "alu", key, components[type_id] if type_id else 0, 0, 0, 0
+            elif name == "ExtInst" and ins.words[2] in glsl and (ext := by_result.get(ins.words[3])) is not None:
+                type_id = ins.type_id
+                n = components[type_id] if type_id else 0
+                ext_key, cls, a, t = ext
+                row = cls, ext_key, a * (n if n > 1 else 1), t * n, 0, 0
+            else:
+                row = counts(mod, ins)
+        rows.append(row)
+    return rows
+
+
+_SCALAR_CLASSES = ("alu", "transcendental", "load", "store")
+
+
 def classify(mod: Module, ins: Instruction) -> tuple[str, str, dict]:
-    """(class, histogram key, scalar counts by class) of one instruction inside a function.
+    """(class, histogram key, scalar counts by class) of one instruction inside a function (zero counts left
+    out; a texture operation counts 1 texture).
 
     The histogram key is ``Op<name>`` for core instructions and the bare
     GLSL.std.450 name (``Exp``, ``FClamp``) for extended ones.
     """
-    n_res = mod.components(ins.type_id) if ins.type_id else 0
-    key = "Op" + ins.name
-    if ins.name in ALU_OPS:
-        return "alu", key, {"alu": _alu_scalars(mod, ins, n_res)}
-    if ins.name == "ExtInst":
-        name = ext_name(mod, ins)
-        if name is None:
-            return "other", key, {}
-        cls, scalars = _ext(mod, ins, n_res)
-        return cls, name, scalars
-    if ins.name in TEXTURE_OPS:
-        return "texture", key, {"texture": 1}
-    if ins.name in ("BranchConditional", "Switch"):
-        return ("other" if mod.is_constant(ins.words[0]) else "branch"), key, {}
-    if ins.name == "Load" and is_handle(mod, ins.type_id):
-        return "other", "OpLoad(handle)", {}
-    if ins.name in LOAD_OPS:
-        if ins.name.startswith("CopyMemory"):
-            width = mod.width(pointee(mod, ins.words[0]))
-            return "load", key, {"load": width, "store": width}
-        width = mod.width(ins.type_id)
-        return "load", key, ({"load": width} if ins.name in ("Load", "AtomicLoad") else {"load": width, "store": width})
-    if ins.name in STORE_OPS:
-        value = {"Store": 1, "AtomicStore": 3, "ImageWrite": 2}[ins.name]
-        return "store", key, {"store": mod.width(mod.value_types.get(ins.words[value], 0))}
-    return "other", key, {}
+    cls, key, *scalars = counts(mod, ins)
+    out = {c: n for c, n in zip(_SCALAR_CLASSES, scalars) if n}
+    if cls == "texture":
+        out["texture"] = 1
+    return cls, key, out
 
 
 STORAGE_CLASSES = {0: "UniformConstant", 1: "Input", 2: "Uniform", 3: "Output", 4: "Workgroup",

@@ -25,6 +25,7 @@ it ranks permutations and bricks, it does not predict occupancy.
 """
 from __future__ import annotations
 
+from collections import deque
 from dataclasses import dataclass
 
 from .spirv import Function, Instruction, Module, successors
@@ -39,35 +40,37 @@ _IMAGE_FIXED = {"ImageSampleImplicitLod": 2, "ImageSampleExplicitLod": 2, "Image
                 "ImageSparseFetch": 2, "ImageSparseGather": 3, "ImageSparseDrefGather": 3, "ImageSparseRead": 2}
 
 
+_NONE: frozenset = frozenset()
+
+
+def _image_ids(k: int):
+    return lambda ops, w: list(ops[:k]) + list(ops[k + 1:])
+
+
+# How each instruction that is not "all operands after the result" names its ids: (operands, words) -> ids.
+_ID_RULES = {
+    "VectorShuffle": lambda ops, w: list(ops[:2]),
+    "CompositeInsert": lambda ops, w: list(ops[:2]),
+    "CompositeExtract": lambda ops, w: list(ops[:1]),
+    "ExtInst": lambda ops, w: list(ops[2:]),
+    **dict.fromkeys(("Switch", "BranchConditional", "ReturnValue"), lambda ops, w: [w[0]]),
+    **dict.fromkeys(("Branch", "SelectionMerge", "LoopMerge", "Label"), lambda ops, w: []),
+    **dict.fromkeys(("Load", "AtomicLoad"), lambda ops, w: list(ops[:1])),
+    **dict.fromkeys(("Store", "CopyMemory", "CopyMemorySized"), lambda ops, w: list(w[:2])),
+    "ImageWrite": lambda ops, w: list(w[:3]) + list(w[4:]),
+    **{n: _image_ids(k) for n, k in _IMAGE_FIXED.items()},
+    "Phi": lambda ops, w: list(ops[0::2]),
+    "Variable": lambda ops, w: list(ops[1:]),
+    "FunctionCall": lambda ops, w: list(ops[1:]),
+}
+
+
 def id_operands(ins: Instruction) -> list[int]:
     """The operands of an instruction that are ids (literals, labels and masks left out)."""
-    n, ops, w = ins.name, ins.operands, ins.words
-    if n == "VectorShuffle" or n == "CompositeInsert":
-        return list(ops[:2])
-    if n == "CompositeExtract":
-        return list(ops[:1])
-    if n == "ExtInst":
-        return list(ops[2:])
-    if n in ("Switch", "BranchConditional", "ReturnValue"):
-        return [w[0]]
-    if n in ("Branch", "SelectionMerge", "LoopMerge", "Label"):
-        return []
-    if n in ("Load", "AtomicLoad"):
-        return list(ops[:1])
-    if n in ("Store", "CopyMemory", "CopyMemorySized"):
-        return list(w[:2])
-    if n == "ImageWrite":
-        return list(w[:3]) + list(w[4:])
-    if n in _IMAGE_FIXED:
-        k = _IMAGE_FIXED[n]
-        return list(ops[:k]) + list(ops[k + 1:])
-    if n == "Phi":
-        return list(ops[0::2])
-    if n == "Variable":
-        return list(ops[1:])
-    if n == "FunctionCall":
-        return list(ops[1:])
-    return list(ops) if ins.type_id or ins.result else list(w)
+    rule = _ID_RULES.get(ins.name)
+    if rule is not None:
+        return rule(ins.operands, ins.words)
+    return list(ins.operands) if ins.type_id or ins.result else list(ins.words)
 
 
 @dataclass
@@ -80,98 +83,171 @@ class Liveness:
     peak_block: int                  # a block where the peak is reached
 
 
+class _Values:
+    """The function's values (id -> width) and what each pointer's address uses."""
+
+    def __init__(self, mod: Module, fn: Function):
+        widths: dict[int, int] = {}
+        for p in fn.params:
+            widths[p.result] = mod.width(p.type_id)
+        ptr_deps: dict[int, tuple] = {}
+        type_width = mod.type_widths
+        for b in fn.blocks:
+            for ins in b.body:
+                if ins.name in POINTER_OPS:
+                    ptr_deps[ins.result] = tuple(id_operands(ins))
+                elif ins.type_id:
+                    widths[ins.result] = type_width[ins.type_id]
+        self.widths = {k: v for k, v in widths.items() if v > 0}
+        self.ptr_deps = ptr_deps
+        # One look-up per operand: the values an id stands for (itself when a value, what its address uses
+        # when a pointer); ids that are neither (constants, globals, labels) are absent.
+        self.lookup = {p: tuple(self.pointer_uses(p)) for p in ptr_deps}
+        self.lookup.update((v, (v,)) for v in self.widths)
+
+    def uses(self, ids) -> list[int]:
+        """The values among `ids`, a pointer standing for the values its address uses (a value may come more
+        than once). The same values as one walk over all of them: a pointer's own are worked out once."""
+        out: list[int] = []
+        lookup = self.lookup
+        for i in ids:
+            t = lookup.get(i)
+            if t:
+                out += t
+        return out
+
+    def pointer_uses(self, pointer: int) -> set[int]:
+        """The values a pointer's address uses (through the access chains it is made of)."""
+        out: set[int] = set()
+        stack, seen = [pointer], set()
+        while stack:
+            i = stack.pop()
+            if i in self.widths:
+                out.add(i)
+            elif i in self.ptr_deps and i not in seen:
+                seen.add(i)
+                stack.extend(self.ptr_deps[i])
+        return out
+
+    def block_rows(self, body: list[Instruction], callee_peak: dict[int, int]):
+        """A block's instructions bottom to top as (value defined or None, its width, values used, callee
+        peak), phis left out, with the block's upward-exposed uses (gen) and definitions (kill): the backward
+        walk from a live-out set L ends with gen | (L - kill) live at the top. A value may be listed twice
+        among an instruction's uses: adding it to a live set twice is adding it once. Last, the values its
+        phis define and their (value, predecessor) pairs."""
+        widths, lookup, rules = self.widths, self.lookup, _ID_RULES
+        rows, gen, kill, phi_defs, phi_pairs = [], set(), set(), set(), []
+        for ins in reversed(body):
+            name = ins.name
+            if name == "Phi":
+                if ins.result in widths:
+                    phi_defs.add(ins.result)
+                ops = ins.operands
+                phi_pairs += zip(ops[0::2], ops[1::2])
+                continue
+            rule = rules.get(name)  # id_operands, inlined: this runs for every instruction
+            ids = (ins.operands if ins.type_id or ins.result else ins.words) if rule is None \
+                else rule(ins.operands, ins.words)
+            used: list[int] = []  # uses(ids), inlined
+            for i in ids:
+                t = lookup.get(i)
+                if t:
+                    used += t
+            r = ins.result
+            if r in widths:
+                d, wd = r, widths[r]
+                gen.discard(r)
+                kill.add(r)
+            else:
+                d, wd = None, 0
+            gen.update(used)
+            extra = callee_peak.get(ins.operands[0], 0) if name == "FunctionCall" else 0
+            rows.append((d, wd, used, extra if extra > 0 else 0))
+        return rows, gen, kill, phi_defs, phi_pairs
+
+
 def analyze_function(mod: Module, fn: Function, callee_peak: dict[int, int] | None = None) -> Liveness:
     """Liveness and peak register pressure of one function (callee peaks for its calls)."""
     callee_peak = callee_peak or {}
-    widths: dict[int, int] = {}
-    for p in fn.params:
-        widths[p.result] = mod.width(p.type_id)
-    ptr_deps: dict[int, tuple] = {}
-    for b in fn.blocks:
-        for ins in b.body:
-            if ins.name in POINTER_OPS:
-                ptr_deps[ins.result] = tuple(id_operands(ins))
-            elif ins.type_id:
-                widths[ins.result] = mod.width(ins.type_id)
-    widths = {k: v for k, v in widths.items() if v > 0}
-
-    def uses(ids) -> set[int]:
-        out: set[int] = set()
-        stack, seen = list(ids), set()
-        while stack:
-            i = stack.pop()
-            if i in widths:
-                out.add(i)
-            elif i in ptr_deps and i not in seen:  # a pointer stands for the values its address uses
-                seen.add(i)
-                stack.extend(ptr_deps[i])
-        return out
-
-    def width(values) -> int:
-        return sum(widths[v] for v in values)
+    values = _Values(mod, fn)
+    widths = values.widths
 
     blocks = {b.label: b for b in fn.blocks}
     succ = {b.label: [s for s in successors(mod, b) if s in blocks] for b in fn.blocks}
-    phi_defs = {b.label: {i.result for i in b.body if i.name == "Phi" and i.result in widths} for b in fn.blocks}
-    # edge (pred, block) -> values the block's phis read from pred
-    phi_uses: dict[tuple[int, int], set[int]] = {}
+    rows, phi_defs = {}, {}
+    phi_uses: dict[tuple[int, int], set[int]] = {}  # edge (pred, block) -> values the block's phis read from pred
     for b in fn.blocks:
-        for ins in b.body:
-            if ins.name == "Phi":
-                ops = ins.operands
-                for value, pred in zip(ops[0::2], ops[1::2]):
-                    phi_uses.setdefault((pred, b.label), set()).update(uses([value]))
+        block_rows, gen, kill, phi_defs[b.label], phi_pairs = values.block_rows(b.body, callee_peak)
+        rows[b.label] = block_rows, gen, kill
+        for value, pred in phi_pairs:
+            phi_uses.setdefault((pred, b.label), set()).update(values.uses([value]))
 
     order = _postorder(fn.blocks[0].label, succ) if fn.blocks else []
-    order += [b.label for b in fn.blocks if b.label not in order]  # unreachable blocks last
-    live_in = {label: frozenset() for label in blocks}
-    live_out = {label: frozenset() for label in blocks}
-
-    def scan(label: int):
-        """Walk a block backward from its live-out set; returns (live at top, peak in block). The width of the
-        live set is kept as it changes (one value in or out at a time), not summed again per instruction."""
-        live = set(live_out[label])
-        w = width(live)
-        peak = w
-        for ins in reversed(blocks[label].body):
-            if ins.name == "Phi":
-                continue
-            d = ins.result if ins.result in widths else None
-            if d is not None and d in live:  # live above its definition: no longer
-                live.discard(d)
-                w -= widths[d]
-            wd = widths[d] if d is not None else 0
-            if ins.name == "FunctionCall":
-                peak = max(peak, w + callee_peak.get(ins.operands[0], 0) + wd)
-            peak = max(peak, w + wd)
-            for u in uses(id_operands(ins)):
-                if u not in live:
-                    live.add(u)
-                    w += widths[u]
-            peak = max(peak, w)
-        return live, peak
-
-    changed = True
-    while changed:
-        changed = False
-        for label in order:
+    reached = set(order)
+    order += [b.label for b in fn.blocks if b.label not in reached]  # unreachable blocks last
+    live_in: dict[int, set | frozenset] = {label: frozenset() for label in blocks}
+    live_out: dict[int, set | frozenset] = {label: frozenset() for label in blocks}
+    # A worklist from postorder: a block is worked out again only when a successor's top changed (a block's
+    # top is gen | (out - kill)). The transfer is monotone, so this reaches the same least fixpoint as sweeping
+    # every block until none changes, with fewer visits (a loop no longer sweeps the whole function again).
+    edges = {label: [(s, phi_defs[s], phi_uses.get((label, s), _NONE)) for s in succ[label]] for label in order}
+    preds: dict[int, list[int]] = {label: [] for label in blocks}
+    for label, targets in succ.items():
+        for s in targets:
+            preds[s].append(label)
+    work, pending = deque(order), set(order)
+    while work:
+        label = work.popleft()
+        pending.discard(label)
+        es = edges[label]
+        if len(es) == 1 and not es[0][1] and not es[0][2]:
+            out = live_in[es[0][0]]  # shared, never changed in place
+        else:
             out = set()
-            for s in succ[label]:
-                out |= live_in[s] - phi_defs[s]
-                out |= phi_uses.get((label, s), set())
-            live_out[label] = frozenset(out)
-            top, _ = scan(label)
-            top = frozenset(top)
-            if top != live_in[label]:
-                live_in[label] = top
-                changed = True
+            for s, defs, from_phis in es:
+                out |= live_in[s] - defs if defs else live_in[s]
+                out |= from_phis
+        live_out[label] = out
+        _, gen, kill = rows[label]
+        top = gen | (out - kill) if kill else gen | out
+        if top != live_in[label]:
+            live_in[label] = top
+            for p in preds[label]:
+                if p not in pending:
+                    pending.add(p)
+                    work.append(p)
 
     peak, peak_block = 0, fn.blocks[0].label if fn.blocks else 0
     for label in blocks:
-        _, p = scan(label)
+        p = _block_peak(rows[label][0], live_out[label], widths)
         if p > peak:
             peak, peak_block = p, label
-    return Liveness(live_in, live_out, peak, peak_block)
+    return Liveness({k: frozenset(v) for k, v in live_in.items()}, {k: frozenset(v) for k, v in live_out.items()},
+                    peak, peak_block)
+
+
+def _block_peak(rows, live_out, widths: dict[int, int]) -> int:
+    """Walk a block backward from its live-out set: the widest live set just before and just after each
+    instruction. The width is kept as values enter and leave, not summed again per instruction."""
+    live = set(live_out)
+    w = 0
+    for v in live:
+        w += widths[v]
+    peak = w
+    for d, wd, used, extra in rows:
+        if d in live:  # live above its definition: no longer
+            live.remove(d)
+            w -= wd
+        c = w + wd + extra  # the result takes its register (with a call, the callee's peak on top)
+        if c > peak:
+            peak = c
+        for u in used:
+            if u not in live:
+                live.add(u)
+                w += widths[u]
+        if w > peak:
+            peak = w
+    return peak
 
 
 def _postorder(entry: int, succ: dict[int, list[int]]) -> list[int]:

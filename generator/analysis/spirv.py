@@ -109,19 +109,32 @@ class SpirvError(ValueError):
     """The bytes are not a well-formed SPIR-V module."""
 
 
-@dataclass
 class Instruction:
-    opcode: int
-    name: str          # "FAdd", not "OpFAdd"; "Op<number>" when unknown
-    words: tuple       # operand words (the opcode/word-count word excluded)
-    type_id: int = 0   # result type, 0 when none
-    result: int = 0    # result id, 0 when none
+    """One instruction: opcode, name, operand words, result type and id (0 when none).
 
-    @property
-    def operands(self) -> tuple:
-        """Operand words after the result type and id."""
-        skip = (1 if self.type_id else 0) + (1 if self.result else 0)
-        return self.words[skip:]
+    A plain class with slots, its operands sliced once when made: the cost
+    analysis reads them several times for each of a module's instructions."""
+
+    __slots__ = ("opcode", "name", "words", "type_id", "result", "operands")
+
+    def __init__(self, opcode: int, name: str, words: tuple, type_id: int = 0, result: int = 0):
+        self.opcode = opcode
+        self.name = name          # "FAdd", not "OpFAdd"; "Op<number>" when unknown
+        self.words = words        # operand words (the opcode/word-count word excluded)
+        self.type_id = type_id    # result type, 0 when none
+        self.result = result      # result id, 0 when none
+        # operand words after the result type and id
+        self.operands = words[(1 if type_id else 0) + (1 if result else 0):]
+
+    def _key(self) -> tuple:
+        return self.opcode, self.name, self.words, self.type_id, self.result
+
+    def __eq__(self, other) -> bool:
+        return self._key() == other._key() if type(other) is Instruction else NotImplemented
+
+    def __repr__(self) -> str:
+        return (f"Instruction(opcode={self.opcode!r}, name={self.name!r}, words={self.words!r}, "
+                f"type_id={self.type_id!r}, result={self.result!r})")
 
 
 @dataclass
@@ -150,6 +163,52 @@ class Type:
     args: tuple                   # operand words after the result id
 
 
+class _ByType(dict):
+    """A property of types by type id, worked out on first use and kept. It holds the module's types and
+    constants, not the module: no cycle keeps a module alive after its last use."""
+
+    __slots__ = ("types", "constants", "rule")
+
+    def __init__(self, types: dict, constants: dict, rule):
+        super().__init__()
+        self.types, self.constants, self.rule = types, constants, rule
+
+    def __missing__(self, type_id: int) -> int:
+        value = self[type_id] = self.rule(self, type_id)
+        return value
+
+
+def _width(memo: _ByType, type_id: int) -> int:
+    t = memo.types.get(type_id)
+    if t is None:
+        return 0
+    if t.op in ("TypeFloat", "TypeInt"):
+        return 2 if t.args[0] == 64 else 1
+    if t.op == "TypeBool":
+        return 1
+    if t.op == "TypeVector":
+        return memo[t.args[0]] * t.args[1]
+    if t.op == "TypeMatrix":
+        return memo[t.args[0]] * t.args[1]
+    if t.op == "TypeStruct":
+        return sum(memo[m] for m in t.args)
+    if t.op == "TypeArray":
+        length = memo.constants.get(t.args[1])
+        return memo[t.args[0]] * (length.operands[0] if length and length.name == "Constant" else 1)
+    return 0
+
+
+def _components(memo: _ByType, type_id: int) -> int:
+    t = memo.types.get(type_id)
+    if t is None:
+        return 0
+    if t.op == "TypeVector":
+        return t.args[1]
+    if t.op == "TypeMatrix":
+        return memo[t.args[0]] * t.args[1]
+    return 1 if t.op in ("TypeFloat", "TypeInt", "TypeBool") else 0
+
+
 @dataclass
 class Module:
     version: tuple[int, int]
@@ -162,6 +221,13 @@ class Module:
     entry_points: dict[str, tuple[str, int]] = field(default_factory=dict)  # name -> (model, function id)
     functions: dict[int, Function] = field(default_factory=dict)
     value_types: dict[int, int] = field(default_factory=dict)        # any result id -> its type id
+    # width() and components() by type id, each worked out on first use (the analysis asks for every value's)
+    type_widths: dict[int, int] = field(init=False, repr=False, compare=False)
+    type_components: dict[int, int] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.type_widths = _ByType(self.types, self.constants, _width)
+        self.type_components = _ByType(self.types, self.constants, _components)
 
     def name(self, id_: int) -> str:
         """The debug name of an id (OpName) or ``%<id>``."""
@@ -169,41 +235,18 @@ class Module:
 
     def width(self, type_id: int) -> int:
         """32-bit scalar components of a value of this type (0 for pointers and opaque handles)."""
-        t = self.types.get(type_id)
-        if t is None:
-            return 0
-        if t.op in ("TypeFloat", "TypeInt"):
-            return 2 if t.args[0] == 64 else 1
-        if t.op == "TypeBool":
-            return 1
-        if t.op == "TypeVector":
-            return self.width(t.args[0]) * t.args[1]
-        if t.op == "TypeMatrix":
-            return self.width(t.args[0]) * t.args[1]
-        if t.op == "TypeStruct":
-            return sum(self.width(m) for m in t.args)
-        if t.op == "TypeArray":
-            length = self.constants.get(t.args[1])
-            return self.width(t.args[0]) * (length.operands[0] if length and length.name == "Constant" else 1)
-        return 0
+        return self.type_widths[type_id]
 
     def components(self, type_id: int) -> int:
         """Scalar components of a type (a vec3 has 3, a mat4 16), ignoring bit width."""
-        t = self.types.get(type_id)
-        if t is None:
-            return 0
-        if t.op == "TypeVector":
-            return t.args[1]
-        if t.op == "TypeMatrix":
-            return self.components(t.args[0]) * t.args[1]
-        return 1 if t.op in ("TypeFloat", "TypeInt", "TypeBool") else 0
+        return self.type_components[type_id]
 
     def is_constant(self, id_: int) -> bool:
         return id_ in self.constants
 
 
 def _string(words) -> str:
-    raw = b"".join(struct.pack("<I", w) for w in words)
+    raw = struct.pack(f"<{len(words)}I", *words)
     return raw.split(b"\0", 1)[0].decode("utf-8", errors="replace")
 
 
@@ -232,6 +275,26 @@ def instructions(data: bytes):
         i += count
 
 
+# What read does with each opcode besides making its Instruction (0: keep it in the current block, if any).
+_NAME, _EXT_IMPORT, _ENTRY_POINT, _TYPE, _CONSTANT, _VARIABLE, _FUNCTION, _PARAMETER, _FUNCTION_END, _LABEL, \
+    _DEBUG_LINE = range(1, 12)
+
+
+def _action(name: str) -> int:
+    if name in ("Name", "ExtInstImport", "EntryPoint"):
+        return {"Name": _NAME, "ExtInstImport": _EXT_IMPORT, "EntryPoint": _ENTRY_POINT}[name]
+    if name.startswith("Type"):
+        return _TYPE
+    if name.startswith(("Constant", "SpecConstant")) or name == "Undef":
+        return _CONSTANT
+    return {"Variable": _VARIABLE, "Function": _FUNCTION, "FunctionParameter": _PARAMETER,
+            "FunctionEnd": _FUNCTION_END, "Label": _LABEL, "Line": _DEBUG_LINE, "NoLine": _DEBUG_LINE}.get(name, 0)
+
+
+# opcode -> (name, shape: 0 no result, 1 result only, 2 type and result, action)
+_OPCODE_INFO = {op: (n, 0 if n in NO_RESULT else 1 if n in RESULT_ONLY else 2, _action(n)) for op, n in OPCODES.items()}
+
+
 def read(data: bytes) -> Module:
     """Parse a SPIR-V module from its bytes (either endianness)."""
     endian = "<" if data[:4] == struct.pack("<I", MAGIC) else ">"
@@ -239,46 +302,87 @@ def read(data: bytes) -> Module:
     if not header or header[0] != MAGIC:
         raise SpirvError("not SPIR-V: bad magic number")
     mod = Module(((header[1] >> 16) & 0xFF, (header[1] >> 8) & 0xFF), header[3])
+    if len(data) % 4:
+        raise SpirvError(f"not SPIR-V: {len(data)} bytes is not a whole number of 32-bit words after a header")
     fn: Function | None = None
     block: Block | None = None
-    for opcode, words in instructions(data):
-        name = OPCODES.get(opcode, f"Op{opcode}")
-        if name in NO_RESULT:
-            ins = Instruction(opcode, name, words)
-        elif name in RESULT_ONLY:
-            ins = Instruction(opcode, name, words, 0, words[0])
-        elif opcode in OPCODES:
-            ins = Instruction(opcode, name, words, words[0], words[1])
-        else:  # unknown: assume <type> <id> when inside a block (the common shape of value instructions)
+    body: list | None = None  # block.body
+    value_types, info = mod.value_types, _OPCODE_INFO
+    # One pass over the words (decoded at once), in the order instructions() yields them: an instruction
+    # is made only when something keeps it, a value's type is noted for every instruction that has one.
+    words_all = struct.unpack(f"{endian}{len(data) // 4}I", data)
+    end, i = len(words_all), 5
+    while i < end:
+        first = words_all[i]
+        count, opcode = first >> 16, first & 0xFFFF
+        if count == 0 or i + count > end:
+            raise SpirvError(f"malformed instruction at word {i}: word count {count}")
+        words = words_all[i + 1:i + count]
+        i += count
+        known = info.get(opcode)
+        if known is None:  # unknown: assume <type> <id> when inside a block (the common shape of value instructions)
+            name = f"Op{opcode}"
             ins = Instruction(opcode, name, words, *(words[:2] if block is not None and len(words) >= 2 else (0, 0)))
-        if ins.type_id:
-            mod.value_types[ins.result] = ins.type_id
-        if name == "Name":
+            if ins.type_id:
+                value_types[ins.result] = ins.type_id
+            if body is not None:
+                body.append(ins)
+            continue
+        name, shape, action = known
+        if action == 0:  # the common case: an instruction of a block, or one nothing keeps
+            if body is None:
+                if shape == 2:
+                    type_id, result = words[0], words[1]
+                    if type_id:
+                        value_types[result] = type_id
+                elif shape == 1:
+                    words[0]  # a result-only instruction without words fails as before (IndexError)
+                continue
+            if shape == 2:
+                ins = Instruction(opcode, name, words, words[0], words[1])
+                if ins.type_id:
+                    value_types[ins.result] = ins.type_id
+            elif shape == 1:
+                ins = Instruction(opcode, name, words, 0, words[0])
+            else:
+                ins = Instruction(opcode, name, words)
+            body.append(ins)
+            continue
+        if shape == 0:
+            ins = Instruction(opcode, name, words)
+        elif shape == 1:
+            ins = Instruction(opcode, name, words, 0, words[0])
+        else:
+            ins = Instruction(opcode, name, words, words[0], words[1])
+            if ins.type_id:
+                value_types[ins.result] = ins.type_id
+        if action == _NAME:
             mod.names[words[0]] = _string(words[1:])
-        elif name == "ExtInstImport":
+        elif action == _EXT_IMPORT:
             mod.ext_imports[words[0]] = _string(words[1:])
-        elif name == "EntryPoint":
+        elif action == _ENTRY_POINT:
             n = _string_words(words[2:])
             mod.entry_points[_string(words[2:2 + n])] = (words[0], words[1])
-        elif name.startswith("Type"):
+        elif action == _TYPE:
             mod.types[words[0]] = Type(name, tuple(words[1:]))
-        elif name.startswith(("Constant", "SpecConstant")) or name == "Undef":
+        elif action == _CONSTANT:
             # OpUndef inside a function is no computation either: treated like a constant.
             mod.constants[ins.result] = ins
-        elif name == "Variable" and fn is None:
+        elif action == _VARIABLE and fn is None:
             mod.globals[ins.result] = ins
-        elif name == "Function":
+        elif action == _FUNCTION:
             fn = Function(ins.result, ins.type_id)
             mod.functions[fn.id] = fn
-        elif name == "FunctionParameter" and fn is not None:
+        elif action == _PARAMETER and fn is not None:
             fn.params.append(ins)
-        elif name == "FunctionEnd":
-            fn, block = None, None
-        elif name == "Label" and fn is not None:
+        elif action == _FUNCTION_END:
+            fn, block, body = None, None, None
+        elif action == _LABEL and fn is not None:
             block = Block(ins.result)
+            body = block.body
             fn.blocks.append(block)
-        elif block is not None and name not in ("Line", "NoLine"):
-            block.body.append(ins)
+        elif body is not None and action != _DEBUG_LINE:
+            body.append(ins)
     return mod
 
 
