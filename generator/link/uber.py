@@ -39,15 +39,14 @@ from ..library.inputs import SURFACE
 from ..spec.permutation import Permutation
 from ..spec.resolve import Resolved, resolve
 from ..spec.where import KeyProblem, within
-from .glue import _Binder, _sample, brdf_glue, coverage_texture, has_tangent, read_slot, shading_tangent
+from .glue import _Binder, brdf_glue, has_tangent, read_slot, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, layout
 from .irgen import Builder
 from .program import Program
 from .glue import UV_LOCAL  # the ubershader's variants share the specialized glue's uv local
+from .uber_surface import ALPHA_IDS, ALPHA_MODE_FUNCTION, surface_alpha  # noqa: F401 (ALPHA_IDS re-exported)
 
 IVEC4 = vector("int", 4)
-ALPHA_IDS = {"opaque": 0, "mask": 1, "blend": 2}  # MaterialEntry.ids.y: the material's alpha mode
-ALPHA_MODE_FUNCTION = "surface_alpha_mode"  # int (int material): ids.y of its entry, for the fragment main
 
 
 @dataclass
@@ -257,7 +256,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         stmts.append(b.decl("color", b.construct(VEC4, b.const(0.0))))
         outs = [[b.assign(b.var("color", VEC4), bind.call(prog, on, "output", "o_", "material", None, {},
                                                           {**material_args(k), "color": b.var("Lo", VEC3)}))]
-                + (_surface_alpha(b, bind, me, mat_data, surface_at, packings[k], bool(uvs[k]))
+                + (surface_alpha(b, bind, me, mat_data, surface_at, packings[k], bool(uvs[k]))
                    if k in alpha_variants else [])
                 for k, on in enumerate(outputs)]
         stmts.append(_switch(b, b.copy(variant), outs))
@@ -298,27 +297,6 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         nxt[tex.group] += 2
     return Uber(prog, variants, light_types, shadows, shadowed, M, A, K, layouts, bind.textures, sig, surface, reads,
                 surface_at, [m for m in ALPHA_IDS if m in modes], double_sided)
-
-
-def _surface_alpha(b: Builder, bind: _Binder, me: ir.Expr, mat_data: Type, at: int, packing, filtered_uv: bool
-                   ) -> list[ir.Stmt]:
-    """`if (me.ids.y != 0) color.a = coverage or 1 / 0 against the cutoff`: the specialized glue's surface_output
-    (link/glue.py coverage, coverage_alpha) with base_alpha and alpha_cutoff read from data[at] (x, y). The base
-    colour texture is sampled at uv_t where the variant's packing has a uv filler (what its other samples read)."""
-    mode = ir.Swizzle(INT, b.here(), ir.Member(IVEC4, b.here(), b.copy(me), "ids"), "y")
-    cov = read_slot(b, me, mat_data, Slot("m_base_alpha", "base_alpha", FLOAT, at, component=0))
-    cutoff = read_slot(b, me, mat_data, Slot("m_alpha_cutoff", "alpha_cutoff", FLOAT, at, component=1))
-    tex = coverage_texture(packing)
-    if tex:
-        bind.uv = b.var(UV_LOCAL, SURFACE["uv"]) if filtered_uv else None
-        cov = b.arith("*", cov, ir.Swizzle(FLOAT, b.here(), _sample(b, bind, f"t_{tex}", tex, True), "w"))
-        bind.uv = None
-    masked = ir.Select(FLOAT, b.here(), b.compare(">=", b.var("coverage", FLOAT), cutoff), b.const(1.0), b.const(0.0))
-    alpha = ir.Select(FLOAT, b.here(), b.compare("==", b.copy(mode), ir.Const(INT, b.here(), ALPHA_IDS["mask"])),
-                      masked, b.var("coverage", FLOAT))
-    rgb = ir.Swizzle(VEC3, b.here(), b.var("color", VEC4), "xyz")
-    return [b.if_(b.compare("!=", mode, ir.Const(INT, b.here(), ALPHA_IDS["opaque"])),
-                  [b.decl("coverage", cov), b.assign(b.var("color", VEC4), b.construct(VEC4, rgb, alpha))])]
 
 
 def _texture_types(node) -> dict[str, Type]:
