@@ -8,12 +8,14 @@ stands in for computes the same code; `coverage()` proves every axis value reach
 Data (documented in docs/design/link.md, "The ubershader's data"; the manifest lists the tables):
 - `material_buffer`: MaterialEntry { ids: ivec4; data: vec4[M] } per material. ids.x is the
   material *variant* — a (BRDF, packing, output) combination of the table `variants`; ids.y the
-  material's alpha mode (ALPHA_IDS: 0 opaque, 1 mask, 2 blend); ids.z and ids.w are reserved (0).
+  material's alpha mode (ALPHA_IDS: 0 opaque, 1 mask, 2 blend), ids.z its emission (EMISSIVE_IDS: 0 none,
+  1 factor, 2 texture); ids.w is reserved (0).
   `data` holds the bricks' part of the variant's specialized Material block (the same bytes as the
   specialized permutation's `uploads`, less the surface state's vec4s at its end), M the largest
   of them; where a permutation is masked or blended, data[surface_at] (= that M, and M grows by
-  one) holds (base_alpha, alpha_cutoff, 0, 0), the surface state's values at one place for every
-  variant (a specialized block packs them after its bricks' part, where each variant's ends).
+  one) holds (base_alpha, alpha_cutoff, 0, 0) and, where a permutation emits, data[surface_at + 1]
+  (emissive, 0): the surface state's values at one place for every variant (a specialized block
+  packs them after its bricks' part, where each variant's ends).
 - Surface state (spec/surface.py), as the specialized shader does it: a variant used by a masked
   or blended permutation computes the same coverage (base_alpha · the packing's base colour
   texture's A) after its output brick and returns it as alpha (BLEND) or 1 / 0 against the cutoff
@@ -22,7 +24,9 @@ Data (documented in docs/design/link.md, "The ubershader's data"; the manifest l
   and B on back faces, which reach it only where the pipeline culls nothing (a single-sided
   object's pipeline culls them). Blending, culling and depth writes are pipeline state: an object
   is drawn with the ubershader under its permutation's render_state (runtime/pipeline_state.py),
-  one pipeline per distinct state. Vertex colours and emission are not in the ubershader.
+  one pipeline per distinct state. Emission is added to the radiance before the output brick as the
+  specialized glue adds it (· the emissive_map's RGB for "texture"). Vertex colours are not in the
+  ubershader.
 - `light_buffer`: LightEntry { ids: ivec4; data: vec4[K] } per light, looped over with a
   runtime count. ids.x indexes `light_types`, ids.y `shadows`, ids.z the shadow map the
   light's filter samples (0 … shadow_maps-1). data[0 …) holds the light brick's parameters,
@@ -44,7 +48,7 @@ from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Sl
 from .irgen import Builder
 from .program import Program
 from .glue import UV_LOCAL  # the ubershader's variants share the specialized glue's uv local
-from .uber_surface import ALPHA_IDS, ALPHA_MODE_FUNCTION, surface_alpha  # noqa: F401 (ALPHA_IDS re-exported)
+from .uber_surface import ALPHA_IDS, ALPHA_MODE_FUNCTION, EMISSIVE_IDS, emission, surface_alpha  # noqa: F401
 
 IVEC4 = vector("int", 4)
 
@@ -83,6 +87,7 @@ class Uber:
     surface_at: int | None = None  # the vec4 of MaterialEntry.data holding (base_alpha, alpha_cutoff, 0, 0)
     alpha_modes: list[str] = field(default_factory=list)  # the permutations' alpha modes, in ALPHA_IDS order
     double_sided: bool = False  # a permutation is double-sided: the main reverses N, T, B on back faces
+    emissive: list[str] = field(default_factory=list)  # the permutations' emission modes, in EMISSIVE_IDS order
 
     def interface(self, kernel: bool = False) -> Interface:
         """The ubershader's Interface: its buffers, the Draw block, textures, inputs and outputs."""
@@ -109,8 +114,8 @@ class Uber:
                 "light_types": self.light_types, "shadows": self.shadows, "shadow_maps": self.shadow_maps,
                 "render_state": "an object's permutation's render_state (cull, blend, depth write): one pipeline per "
                                 "distinct state; its material's alpha mode in the entry's ids.y",
-                "material_entry": {"ids": "ivec4 (variant, alpha mode, 0, 0)", "data_vec4s": self.material_vec4s,
-                                   "alpha_modes": dict(ALPHA_IDS),
+                "material_entry": {"ids": "ivec4 (variant, alpha mode, emission, 0)", "data_vec4s": self.material_vec4s,
+                                   "alpha_modes": dict(ALPHA_IDS), "emissive_modes": dict(EMISSIVE_IDS),
                                    **({"surface_at": self.surface_at} if self.surface_at is not None else {})},
                 "light_entry": {"ids": "ivec4 (light type, shadow, shadow map, 0)", "data_vec4s": self.light_vec4s,
                                 "shadow_parameters_at": self.light_split}}
@@ -150,7 +155,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     lights, shadow_of = {}, {}  # light type -> its LightPart's params; shadow spec -> the filter's node, params
     shadowed = 0
     alpha_variants: set[int] = set()  # the variants a masked or blended permutation uses
-    modes, double_sided = {"opaque"}, False
+    modes, double_sided, emits = {"opaque"}, False, {"none"}
     for r in [p if isinstance(p, Resolved) else resolve(p, lib) for p in perms]:
         p = r.perm
         if (p.brdf, p.packing, p.output) not in [v.key for v in variants]:
@@ -161,6 +166,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
             alpha_variants.add([v.key for v in variants].index((p.brdf, p.packing, p.output)))
         modes.add(p.surface.alpha)
         double_sided = double_sided or p.surface.double_sided
+        emits.add(p.surface.emissive)
         for lk, lt in zip(p.lights, r.lights):
             if lk.light not in light_types:
                 light_types.append(lk.light)
@@ -172,8 +178,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     prog, b = Program(lib_memo=lib.memo), Builder()
     bind = _Binder(b)
     M = max([1] + [max([1] + [s.index + s.width for s in v.slots]) for v in variants])
-    surface_at = M if alpha_variants else None
-    M += surface_at is not None
+    surface_at = M if alpha_variants or len(emits) > 1 else None  # alpha values there, the emission after
+    M += 0 if surface_at is None else 1 + (len(emits) > 1)
     lnodes = {t: lights[t][0] for t in light_types}
     snodes = {s: shadow_of[s][0] for s in shadows}
     A = max([1] + [_vec4s(lights[t][1]) for t in light_types])
@@ -253,6 +259,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         if lnodes:  # a scene without lights shades black: no loop, the light buffer is still bound
             stmts.append(_light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues,
                                      packings, provided, material_args, variant, shadowed, twisted))
+        if len(emits) > 1:
+            stmts += emission(b, bind, me, mat_data, surface_at + 1, "texture" in emits, bool(any(uvs)))
         stmts.append(b.decl("color", b.construct(VEC4, b.const(0.0))))
         outs = [[b.assign(b.var("color", VEC4), bind.call(prog, on, "output", "o_", "material", None, {},
                                                           {**material_args(k), "color": b.var("Lo", VEC3)}))]
@@ -296,7 +304,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         tex.binding = nxt[tex.group]
         nxt[tex.group] += 2
     return Uber(prog, variants, light_types, shadows, shadowed, M, A, K, layouts, bind.textures, sig, surface, reads,
-                surface_at, [m for m in ALPHA_IDS if m in modes], double_sided)
+                surface_at, [m for m in ALPHA_IDS if m in modes], double_sided, [m for m in EMISSIVE_IDS if m in emits])
 
 
 def _texture_types(node) -> dict[str, Type]:

@@ -54,7 +54,8 @@ export's draw_order), single-sided surfaces cull their back faces, all as the ma
 given build's entry, else runtime/pipeline_state.py, the function the build writes it with). The ubershader reads
 a material's alpha mode and coverage values from its MaterialEntry (link/uber.py) and is drawn with the object's
 render state: one ubershader pipeline per distinct (cull, blend, depth) state, and per variant with
-uber_ids="specialization". Vertex colours and emission are the specialized shaders' only. Pipelines are created through
+uber_ids="specialization"; it adds a material's emission too. Vertex colours are the specialized shaders' only.
+Pipelines are created through
 a persisted pipeline cache (runtime/pipeline_cache.py), and when the render opens its own device,
 Mesa's shader disk cache lives in out/shader_cache and the driver's hit and miss counts go into the
 report (runtime/shader_cache.py).
@@ -191,7 +192,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..toolchain import CompileJob, compile_many
     from . import graphics as gx
     from .device import Device, validation_requested
-    from ..link.uber import ALPHA_IDS, SPEC_VARIANT
+    from ..link.uber import ALPHA_IDS, EMISSIVE_IDS, SPEC_VARIANT
     from ..spec.resolve import resolve
     from .pipeline_cache import PipelineCacheFile
     from .depth_images import ComparisonSampler, DepthImage
@@ -397,7 +398,10 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 at = {s.param: s for s in composed[obj["permutation"]].material if s.light is None}
                 data[u.surface_at, :2] = [block[at[x].index, at[x].component] if x in at else 0.0
                                           for x in ("base_alpha", "alpha_cutoff")]
-            mat_ids.append((k, ALPHA_IDS[p.surface.alpha], 0, 0))
+                if "emissive" in at:  # and the emission after them (a vec3: three components of its vec4)
+                    e = at["emissive"]
+                    data[u.surface_at + 1, :3] = block[e.index, e.component:e.component + 3]
+            mat_ids.append((k, ALPHA_IDS[p.surface.alpha], EMISSIVE_IDS[p.surface.emissive], 0))
             mat_rows.append(data)
         material_buffer = buf(entry_bytes(np.array(mat_ids), np.stack(mat_rows)), S)
         light_buffers, slot_lights = {}, {}

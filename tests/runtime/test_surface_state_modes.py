@@ -1,11 +1,12 @@
 """The surface state drawn alike by the specialized pipelines, the ubershader and the hybrid, and blended objects
 sorted back to front, on lavapipe with the Khronos validation layer on (and silent).
 
-- tests/scenes/surface_state.toml: a leaf card masked by its albedo texture's alpha (stripes), a blended ball and a
-  double-sided roof seen from below: every mode draws the same frame, within the mode comparison's tolerance of
+- tests/scenes/surface_state.toml: a leaf card masked by its albedo texture's alpha (stripes), two blended balls
+  (the nearer one first in scene order) and a double-sided roof seen from below, the leaf emitting a constant and
+  the roof its emissive map: every mode draws the same frame, within the mode comparison's tolerance of
   tests/runtime/test_render.py (1 LSB on at most 1 % of channels; measured: identical, max difference 0, in GLSL,
   HLSL and WGSL). On the ubershader that ignored the surface state the leaf had no holes, the ball was opaque and
-  the roof black (255 max, 4.4 % of channels).
+  the roof black (255 max, 4.4 % of channels); without the emission it is off by up to 127.
 - Two blended quads given in the wrong scene order (the near one first): the near one's colour is on top in
   every mode, and the frame export's draw_order is back to front.
 
