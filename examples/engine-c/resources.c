@@ -387,17 +387,21 @@ static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkB
             const cJSON *name = j_opt(slot, "name");
             int offset, bytes;
             if (!cJSON_IsString(name) || !j_int(src, slot, "offset", where, 0, stride - 4, &offset)
-                || !j_int(src, slot, "size", where, 4, stride, &bytes) || offset + bytes > stride || offset % 4) {
+                || !j_int(src, slot, "size", where, 4, stride, &bytes) || offset + bytes > stride || offset % 4
+                || bytes % 4 || bytes > 64) {  /* at most a mat4 (16 floats), whole floats */
                 ok = ok && j_fail(src, where, "a layout entry of %s this engine cannot place", b->name);
                 break;
             }
             const cJSON *v = j_opt(params, name->valuestring);
             int n = bytes / 4;
             double values[16] = {0};
+            bool numbers = cJSON_IsArray(v) && cJSON_GetArraySize(v) == n;
+            for (int c = 0; numbers && c < n; c++)
+                numbers = cJSON_IsNumber(cJSON_GetArrayItem(v, c));
             if (cJSON_IsNumber(v))
-                for (int c = 0; c < n && c < 16; c++)
+                for (int c = 0; c < n; c++)
                     values[c] = v->valuedouble;  /* a scalar fills a vector's components, as the generator packs */
-            else if (cJSON_IsArray(v) && cJSON_GetArraySize(v) == n && n <= 16)
+            else if (numbers)
                 for (int c = 0; c < n; c++)
                     values[c] = cJSON_GetArrayItem(v, c)->valuedouble;
             else {

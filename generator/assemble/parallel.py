@@ -29,11 +29,14 @@ from dataclasses import dataclass, field, replace
 
 from ..io import Store
 from ..lang.errors import EnvironmentMissing, UserError
+from ..link.values import light_buffer_block
 from ..toolchain import CompileStats, compile_many
 from .context import BuildContext
 from .entries import Entries, compose_ubershader
 from .loop import Compiled, compose_chunk
 from .workers import Workers
+
+LIGHT_BUFFER = light_buffer_block(0)[:-1]  # the blocks' names but their index
 
 _PRELOAD = ["generator.assemble.parallel", "generator.compose", "generator.analysis", "jinja2"]
 _CONTEXT: list[tuple] = []  # in a worker: the build's (context, entries), set once by _start
@@ -129,7 +132,11 @@ def _ubershader(ctx: BuildContext, entries: Entries, memo: dict | None) -> Chunk
 def _bare(c):
     """A Composed as the building process reads it once its entry is made: its material slots, its interface's
     parameters (reflection.scene_tables) and its templates. The rest (the sources, the interface's blocks and
-    textures, the light slots: the entry holds them) would be a third of what it unpickles per permutation."""
+    textures, the light slots: the entry holds them) would be a third of what it unpickles per permutation. A
+    permutation of a dynamic light set keeps its interface whole: reflection.dynamic_tables reads its light
+    buffers' blocks and their bindings on every platform from it."""
+    if any(b.name.startswith(LIGHT_BUFFER) for b in c.interface.blocks):
+        return replace(c, sources=[], dialects=[], lights=[])
     iface = replace(c.interface, stage_entries={}, shading_inputs=[], surface=[], blocks=[], textures=[], outputs=[])
     return replace(c, sources=[], dialects=[], lights=[], interface=iface)
 

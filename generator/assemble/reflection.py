@@ -70,11 +70,13 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
     for name, dyn in sorted(scene.dynamic_sets.items()):
         c = next((interfaces[o["permutation"]] for o in scene.objects
                   if o["light_set"] == name and o["permutation"] in interfaces), None)
-        if c is None:
-            if name in old:
-                out[name] = old[name]
-            continue
         members = scene.light_sets[name]
+        if c is None:  # its blocks as the last build described them; its capacity and lights as the scene says now
+            if name in old:
+                out[name] = {**old[name], "max": dyn.max, "fill": FILL, "pairs": [
+                    {**p, "lights": [n for n in members if dyn.pair_of(scene.lights[n]) == p["light_index"]]}
+                    for p in old[name]["pairs"]]}
+            continue
         pairs = []
         for i, pair in enumerate(dyn.model):
             block = c.interface.block(light_buffer_block(i))

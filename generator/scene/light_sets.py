@@ -115,6 +115,9 @@ def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library, header: tupl
         model = tuple(_model_entry(loc, at("model"), name, e, lib) for e in t["model"])
         if len(set(model)) != len(model):
             raise loc.error(at("model"), f"light set '{name}': its model names a pair twice", "name each pair once")
+        if not model:
+            raise loc.error(at("model"), f"dynamic light set '{name}' has an empty model",
+                            'give the pairs its lights may be: model = ["point/none"]')
     else:
         model = tuple(dict.fromkeys(LightKey(scene.lights[n].type, scene.lights[n].shadow, True) for n in members))
         if not model:

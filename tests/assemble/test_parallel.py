@@ -231,3 +231,24 @@ def test_a_worker_that_dies_fails_the_build_instead_of_hanging_it(scene, tmp_pat
     os.kill(workers[0], signal.SIGKILL)  # as the kernel's OOM killer would
     _ends(p, 1, "error: a worker process of the build died (killed, or out of memory) — build again, or with "
                 "fewer jobs (-j)\n")
+
+
+def test_a_dynamic_light_set_built_by_workers_is_described_as_in_process(tmp_path, monkeypatch):
+    """The workers send each permutation back without what its entry already holds, but a dynamic set's light
+    buffers are described from its interface (reflection.dynamic_tables): workers and one process agree."""
+    import json
+
+    import generator.assemble.loop as loop
+    from generator.assemble import BuildContext, build
+    from generator.io import Store
+    from generator.library.bricks import load_library
+    from generator.scene.load import load_scene
+    lib = load_library()
+    scene = load_scene(REPO / "tests" / "scenes" / "dynamic_lights.toml", lib)
+    tables = []
+    for jobs in (1, 2):
+        monkeypatch.setattr(loop, "MIN_PERMUTATIONS", 1)  # workers for any scene with -j 2
+        out = tmp_path / f"j{jobs}"
+        build(scene, out, BuildContext(lib, platforms=("vulkan",), store=Store(tmp_path / "cache"), jobs=jobs))
+        tables.append(json.loads((out / "manifest.json").read_text())["dynamic_light_sets"])
+    assert tables[0] and tables[0] == tables[1]

@@ -64,6 +64,8 @@ CASES = [  # (id, table, extra lights, line of the error, words of the message)
      "lights in a buffer cannot have a shadow map yet", "use shadow none, or a static set"),
     ("malformed-model-entry", _crowd(2, 'model = ["point"]\n'), "", 14, "model entry 'point' is not TYPE/SHADOW"),
     ("unknown-type-in-model", _crowd(2, 'model = ["lamp/none"]\n'), "", 14, "unknown light type 'lamp'"),
+    ("empty-model", "[light_sets.crowd]\ndynamic = true\nlights = []\nmodel = []\n", "", 14,
+     "dynamic light set 'crowd' has an empty model"),
     ("max-below-the-lights", _crowd(2, "max = 1\n"), "", 14, "holds 2 lights, more than its max = 1"),
     ("max-zero", _crowd(2, "max = 0\n"), "", 14, "max is 0, not between 1 and"),
     ("max-not-whole", _crowd(2, "max = 2.5\n"), "", 14, "'light_sets.crowd.max' must be a whole number"),
@@ -144,3 +146,21 @@ def test_a_wrong_gltf_lights_file_is_one_located_error(tmp_path, sidecar, line, 
     msg = str(e.value)
     assert msg.startswith(f"{tmp_path / 'model.lights.toml'}:{line}:") and " — " in msg, msg
     assert all(w in msg for w in words), msg
+
+
+@pytest.mark.toolchain
+def test_a_new_max_or_light_reaches_the_manifest_though_no_shader_changes(tmp_path):
+    """max and the set's lights are not in any key: a rebuild that composes nothing still describes them anew."""
+    import json
+
+    from generator.assemble import BuildContext, build
+    from generator.io import Store
+    from generator.library.bricks import load_library
+    from generator.scene.load import load_scene
+    lib, out = load_library(), tmp_path / "out"
+    for n, cap in ((2, 8), (2, 16), (3, 16)):
+        path = tmp_path / "scene.toml"
+        path.write_text(_scene(n, _crowd(n, f"max = {cap}\n")))
+        build(load_scene(path, lib), out, BuildContext(lib, platforms=("vulkan",), store=Store(tmp_path / "cache")))
+        table = json.loads((out / "manifest.json").read_text())["dynamic_light_sets"]["crowd"]
+        assert table["max"] == cap and table["pairs"][0]["lights"] == [f"p{i}" for i in range(n)], table
