@@ -30,6 +30,7 @@ import numpy as np
 import pytest
 
 from tests.lavapipe import device, no_validation_messages  # noqa: F401 (fixtures)
+from tests.runtime.test_shadows import camera_rays  # a pixel's camera ray, as the shadow test builds it
 
 REPO = Path(__file__).resolve().parents[2]
 SCENE = REPO / "tests" / "scenes" / "spot_shadow.toml"
@@ -112,13 +113,7 @@ def _shadowed(g, light, box):
 def _floor_pixels(pl):
     """(seen, g): which pixels' camera rays reach the floor before any box, and where, (H, W) and (H, W, 3)."""
     floor = next(o for o in pl.objects if o.name == "floor")
-    eye, vp = pl.camera(W, H)
-    inv = np.linalg.inv(vp)
-    x = 2.0 * (np.arange(W) + 0.5) / W - 1.0
-    y = 2.0 * (np.arange(H) + 0.5) / H - 1.0
-    nx, ny = np.meshgrid(x, y)  # row 0: clip y = −1, the image's top row
-    far = np.stack([nx, ny, np.ones_like(nx), np.ones_like(nx)], -1) @ inv.T
-    d = far[..., :3] / far[..., 3:] - eye
+    eye, d = camera_rays(pl, W, H)
     t = (floor.translate[1] - eye[1]) / d[..., 1]
     g = eye + t[..., None] * d
     c = floor.corners()

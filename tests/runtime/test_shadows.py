@@ -67,19 +67,26 @@ def _render(scene, lib, device, out, mode):
     return np.asarray(Image.open(out / "frame_0000.png").convert("RGB")).astype(int), rep
 
 
+def camera_rays(pl, width: int, height: int):
+    """(eye, d): the placement's camera position and, per pixel of a width × height image, the direction from it
+    through the pixel's centre to the far plane ((height, width, 3), not normalized; row 0: clip y = −1, the image's
+    top row)."""
+    eye, vp = pl.camera(width, height)
+    inv = np.linalg.inv(vp)
+    x = 2.0 * (np.arange(width) + 0.5) / width - 1.0
+    y = 2.0 * (np.arange(height) + 0.5) / height - 1.0
+    nx, ny = np.meshgrid(x, y)
+    far = np.stack([nx, ny, np.ones_like(nx), np.ones_like(nx)], -1) @ inv.T
+    return eye, far[..., :3] / far[..., 3:] - eye
+
+
 def _footprint(scene, lib):
     """(inside, outside): floor pixels seen by the camera, well inside / well outside the ball's shadow."""
     from generator.runtime.placement import load_placement
 
     pl = load_placement(scene)
     floor, ball = pl.objects
-    eye, vp = pl.camera(W, H)
-    inv = np.linalg.inv(vp)
-    x = 2.0 * (np.arange(W) + 0.5) / W - 1.0
-    y = 2.0 * (np.arange(H) + 0.5) / H - 1.0
-    nx, ny = np.meshgrid(x, y)  # row 0: clip y = −1, the image's top row
-    far = np.stack([nx, ny, np.ones_like(nx), np.ones_like(nx)], -1) @ inv.T
-    d = far[..., :3] / far[..., 3:] - eye
+    eye, d = camera_rays(pl, W, H)
     d /= np.linalg.norm(d, axis=-1, keepdims=True)
     t = (floor.translate[1] - eye[1]) / d[..., 1]
     g = eye + t[..., None] * d
