@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 from tests.lavapipe import device, no_validation_messages  # noqa: F401 (fixtures)
+from tests.runtime.test_shadows import camera_rays  # a pixel's camera ray
 
 REPO = Path(__file__).resolve().parents[2]
 SCENE = REPO / "tests" / "scenes" / "shadow.toml"
@@ -71,13 +72,7 @@ def _regions(scene, outer=1.15):
 
     pl = load_placement(scene)
     floor, ball = pl.objects
-    eye, vp = pl.camera(W, H)
-    inv = np.linalg.inv(vp)
-    x = 2.0 * (np.arange(W) + 0.5) / W - 1.0
-    y = 2.0 * (np.arange(H) + 0.5) / H - 1.0
-    nx, ny = np.meshgrid(x, y)
-    far = np.stack([nx, ny, np.ones_like(nx), np.ones_like(nx)], -1) @ inv.T
-    d = far[..., :3] / far[..., 3:] - eye
+    eye, d = camera_rays(pl, W, H)
     d /= np.linalg.norm(d, axis=-1, keepdims=True)
     t = (floor.translate[1] - eye[1]) / d[..., 1]
     g = eye + t[..., None] * d
