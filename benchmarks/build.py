@@ -111,6 +111,12 @@ def scene_load(tmp: Path) -> dict:
     return out
 
 
+def _content_key(language: str, stage: str, text: str) -> str:
+    """A source's identity as the compile cache sees it: its language, its stage, its text without comment lines."""
+    return hashlib.sha256(f"{language}{stage}".encode() + "\n".join(
+        x for x in text.split("\n") if not x.lstrip().startswith("//")).encode()).hexdigest()
+
+
 def distinct_shaders(out: Path, dest: Path) -> dict[str, int]:
     """Copy the build's distinct shaders (comments aside, as the compile cache keys them) into dest/<lang>/<stage>."""
     m = json.loads((out / "manifest.json").read_text())
@@ -119,8 +125,7 @@ def distinct_shaders(out: Path, dest: Path) -> dict[str, int]:
         for lang, stages in e.get("languages", {}).items():
             for stage, item in stages.items():
                 text = (out / item["source"]).read_text()
-                key = hashlib.sha256(f"{lang}{stage}".encode() + "\n".join(
-                    x for x in text.split("\n") if not x.lstrip().startswith("//")).encode()).hexdigest()
+                key = _content_key(lang, stage, text)
                 if key in seen:
                     continue
                 seen.add(key)
@@ -140,8 +145,7 @@ def gl_sources(out: Path, dest: Path) -> int:
         for stage, dialects in e["platforms"].get("gl", {}).get("stages", {}).items():
             for dialect, item in dialects.items():
                 text = (out / item["path"]).read_text()
-                key = hashlib.sha256(f"{dialect}{stage}".encode() + "\n".join(
-                    x for x in text.split("\n") if not x.lstrip().startswith("//")).encode()).hexdigest()
+                key = _content_key(dialect, stage, text)
                 if key in seen:
                     continue
                 seen.add(key)

@@ -29,14 +29,12 @@ from dataclasses import dataclass, field, replace
 
 from ..io import Store
 from ..lang.errors import EnvironmentMissing, UserError
-from ..link.values import light_buffer_block
+from ..link.values import LIGHT_BUFFER
 from ..toolchain import CompileStats, compile_many
 from .context import BuildContext
 from .entries import Entries, compose_ubershader
 from .loop import Compiled, compose_chunk
 from .workers import Workers
-
-LIGHT_BUFFER = light_buffer_block(0)[:-1]  # the blocks' names but their index
 
 _PRELOAD = ["generator.assemble.parallel", "generator.compose", "generator.analysis", "jinja2"]
 _CONTEXT: list[tuple] = []  # in a worker: the build's (context, entries), set once by _start

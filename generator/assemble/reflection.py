@@ -71,11 +71,13 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
         c = next((interfaces[o["permutation"]] for o in scene.objects
                   if o["light_set"] == name and o["permutation"] in interfaces), None)
         members = scene.light_sets[name]
+
+        def lights_of(i, members=members, dyn=dyn):  # the set's lights of pair i, in its order
+            return [n for n in members if dyn.pair_of(scene.lights[n]) == i]
         if c is None:  # its blocks as the last build described them; its capacity and lights as the scene says now
             if name in old:
                 out[name] = {**old[name], "max": dyn.max, "fill": FILL, "pairs": [
-                    {**p, "lights": [n for n in members if dyn.pair_of(scene.lights[n]) == p["light_index"]]}
-                    for p in old[name]["pairs"]]}
+                    {**p, "lights": lights_of(p["light_index"])} for p in old[name]["pairs"]]}
             continue
         pairs = []
         for i, pair in enumerate(dyn.model):
@@ -91,6 +93,6 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
                           "binding": block.binding, "bindings": bindings, "stride": stride,
                           "layout": [{k: v for k, v in sl.as_dict().items() if k in ("name", "type", "offset", "size")}
                                      for sl in block.slots],
-                          "lights": [n for n in members if dyn.pair_of(scene.lights[n]) == i]})
+                          "lights": lights_of(i)})
         out[name] = {"max": dyn.max, "pairs": pairs, "fill": FILL}
     return out

@@ -54,9 +54,12 @@ def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None) -> list[
     return out
 
 
+LIGHT_BUFFER = "LightBuffer"  # the storage blocks of dynamic lights: LightBuffer<i>, the ubershader's LightBuffer
+
+
 def light_buffer_block(i: int) -> str:
     """The storage block of the key's dynamic light i (link.link_permutation names it)."""
-    return f"LightBuffer{i}"
+    return f"{LIGHT_BUFFER}{i}"
 
 
 def light_buffers(scene: Scene, names: list[str], dyn, c) -> dict[str, bytes]:
