@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from ..compose import Composed
 
 MIN_PERMUTATIONS = 64  # below this, starting worker processes costs more than it saves (measured: ~1.4 s at 36)
+WORKERS_FROM_ENV = "SHADERMATRIX_WORKERS_FROM"  # another threshold (a machine whose workers start faster or slower)
 CHUNK = 64  # permutations composed per compile batch in this process
 _POLL_S = 0.2  # the longest this thread waits on the compile thread without looking at signals
 
@@ -61,7 +62,20 @@ def compose_chunk(ctx: BuildContext, items) -> tuple[dict[str, Composed], dict[s
 def in_workers(ctx: BuildContext, permutations: int) -> bool:
     """Whether a build of this many permutations runs its chunks in worker processes or on the cluster."""
     n = ctx.jobs or os.cpu_count() or 1
-    return ctx.executor is not None or (n > 1 and permutations >= MIN_PERMUTATIONS)
+    return ctx.executor is not None or (n > 1 and permutations >= workers_from())
+
+
+def workers_from() -> int:
+    """The fewest permutations a -j N build (N > 1) runs in worker processes: MIN_PERMUTATIONS, or
+    $SHADERMATRIX_WORKERS_FROM when set (a whole number >= 1; anything else is refused, never ignored)."""
+    raw = os.environ.get(WORKERS_FROM_ENV)
+    if raw is None:
+        return MIN_PERMUTATIONS
+    if not raw.strip().isdigit() or int(raw) < 1:
+        from ..lang.errors import UserError
+        raise UserError(f"{WORKERS_FROM_ENV}={raw!r} is not a whole number of permutations >= 1 — "
+                        f"set it to a count such as {MIN_PERMUTATIONS}, or unset it")
+    return int(raw)
 
 
 def compile_permutations(ctx: BuildContext, permutations: dict, extra=(), on_done=None,

@@ -42,19 +42,29 @@ def scene(tmp_path_factory) -> Path:
 
 
 @pytest.fixture(scope="module")
+def few(tmp_path_factory) -> Path:
+    """12 permutations, built in worker processes under FEW_ENV: what a worker makes is the same for 12 as
+    for 68 (the signal tests keep `scene`, whose build lasts long enough to be interrupted mid-write)."""
+    return _generated(tmp_path_factory, 12)
+
+
+FEW_ENV = {**os.environ, "SHADERMATRIX_WORKERS_FROM": "8"}
+
+
+@pytest.fixture(scope="module")
 def small_scene(tmp_path_factory) -> Path:
     """Too few permutations for worker processes: `-j 2` is two tool processes of the building process."""
     from generator.assemble.loop import MIN_PERMUTATIONS
     return _generated(tmp_path_factory, MIN_PERMUTATIONS - 1)
 
 
-def test_worker_processes_build_what_one_process_builds(scene, tmp_path):
-    one = _cli("build", scene, "--out", tmp_path / "one", "--no-cache", "-j", "1", *ONE,
+def test_worker_processes_build_what_one_process_builds(few, tmp_path):
+    one = _cli("build", few, "--out", tmp_path / "one", "--no-cache", "-j", "1", *ONE,
                "--depfile", tmp_path / "one.d")
     assert one.returncode == 0, one.stderr
     # a fresh cache: the workers compose, compile and analyse everything themselves
-    two = _cli("build", scene, "--out", tmp_path / "two", "--cache-dir", tmp_path / "cache", "-j", "2", *ONE,
-               "--depfile", tmp_path / "two.d")
+    two = _cli("build", few, "--out", tmp_path / "two", "--cache-dir", tmp_path / "cache", "-j", "2", *ONE,
+               "--depfile", tmp_path / "two.d", env=FEW_ENV)
     assert two.returncode == 0, two.stderr
     assert _tree(tmp_path / "one") == _tree(tmp_path / "two")
     summary = [line.split("→")[0] for r in (one, two) for line in r.stdout.splitlines() if "shaders," in line]
@@ -64,17 +74,17 @@ def test_worker_processes_build_what_one_process_builds(scene, tmp_path):
     assert deps[0] == deps[1] and "fragment.glsl.j2" in deps[1]  # the templates the workers read
 
 
-def test_a_permutation_that_fails_in_a_worker_is_reported_located(scene, tmp_path):
+def test_a_permutation_that_fails_in_a_worker_is_reported_located(few, tmp_path):
     engine = tmp_path / "engine"
     engine.mkdir()
     good = (REPO / "bricks" / "output" / "linear.py").read_text()
     (engine / "tinted.py").write_text(good.replace("return vec4(color, 1.0)", "k = 1\n    q = k / 0\n"
                                                    "    return vec4(color * float(q), 1.0)"))
-    text = scene.read_text()
+    text = few.read_text()
     assert "[scene]" in text
     bad = tmp_path / "bad.toml"
     bad.write_text(text.replace("[scene]", '[scene]\noutput = "tinted"', 1))
-    r = _cli("build", bad, "--out", tmp_path / "out", "--bricks", engine, "--no-cache", "-j", "2", *ONE)
+    r = _cli("build", bad, "--out", tmp_path / "out", "--bricks", engine, "--no-cache", "-j", "2", *ONE, env=FEW_ENV)
     assert r.returncode == 1 and "Traceback" not in r.stderr
     heads = [line for line in r.stderr.splitlines() if line.startswith("error: ")]
     assert heads and all(line.startswith(f"error: {bad}:") and "does not build" in line for line in heads)
@@ -252,3 +262,18 @@ def test_a_dynamic_light_set_built_by_workers_is_described_as_in_process(tmp_pat
         build(scene, out, BuildContext(lib, platforms=("vulkan",), store=Store(tmp_path / "cache"), jobs=jobs))
         tables.append(json.loads((out / "manifest.json").read_text())["dynamic_light_sets"])
     assert tables[0] and tables[0] == tables[1]
+
+
+def test_the_worker_threshold_is_64_or_what_the_environment_says(monkeypatch):
+    from generator.assemble import loop
+    from generator.assemble.context import BuildContext
+    from generator.lang.errors import UserError
+    ctx = BuildContext(library=None, jobs=2)
+    monkeypatch.delenv(loop.WORKERS_FROM_ENV, raising=False)
+    assert not loop.in_workers(ctx, 12) and loop.in_workers(ctx, 64)
+    monkeypatch.setenv(loop.WORKERS_FROM_ENV, FEW_ENV[loop.WORKERS_FROM_ENV])  # what the tests above build under
+    assert loop.in_workers(ctx, 12) and not loop.in_workers(ctx, 7)
+    for bad in ("0", "-3", "many", ""):
+        monkeypatch.setenv(loop.WORKERS_FROM_ENV, bad)
+        with pytest.raises(UserError, match="SHADERMATRIX_WORKERS_FROM=.* — set it to"):
+            loop.in_workers(ctx, 12)
