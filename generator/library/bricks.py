@@ -19,6 +19,7 @@ from ..lang.exprs import F32_MAX
 from ..lang.types import BUILTIN_TYPES, INT, Type, array
 from .inputs import BY_NAME, SHADING, SURFACE
 from .kinds import KINDS
+from .sampling import slot_sampling_externals, split_sampling
 
 BRDF_ARRAY_KINDS = ("diffuse", "specular", "ndf", "fresnel", "visibility")
 
@@ -65,6 +66,9 @@ class Brick:
     # an output brick's: what its colour is, "linear" radiance or display-encoded ("srgb", "sqrt"), which decides
     # the colour attachment that stores it (runtime/pipeline_state.py); "linear" unless the brick says otherwise
     encodes: str = "linear"
+    # the sampling entries (sample, pdf; an NDF's sample_h, pdf_h) and the helpers only they call, in file order:
+    # kept out of `module` so that shading programs never link them (library/sampling.py)
+    sampling: dict[str, ir.Function] = field(default_factory=dict)
 
     @property
     def fp16_unsafe(self) -> str:
@@ -279,6 +283,7 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
         k = KINDS[s["kind"]]
         if k.slot:  # called from this brick's code, type-checked against the contract's arguments
             externals[sname] = Signature(k.signature(k.entries[0].name), k.entries[0].ret)
+            externals.update(slot_sampling_externals(sname, k))  # `<slot>_sample_h(...)`: library/sampling.py
     module = parse_module(text, shown, externals)
     for g in module.globals.values():
         where = g.loc or loc
@@ -305,6 +310,7 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
                   str(meta.get("fp16", "")).strip(), float(meta.get("tolerance", 0.0)),
                   meta.get("encodes", "linear"))
     _check_entries(brick, loc)
+    brick.sampling = split_sampling(brick)
     return brick
 
 
@@ -421,9 +427,10 @@ def _check_entries(b: Brick, loc) -> None:
             args = ", ".join(f"{a.name}: {a.ty}" for a in e.args if a.required)
             raise _meta_error(b.display_path, loc, f"a {b.kind} brick must define '{e.name}'",
                               f"add def {e.name}({args}) -> {e.ret}")
-    inputs = SHADING if k.reads == "shading" else SURFACE
+    kind_inputs = SHADING if k.reads == "shading" else SURFACE
     for f in b.entries:
         contract = k.entry(f.name)
+        inputs = {} if contract.sampling else kind_inputs  # a sampling entry reads its arguments and params only
         if contract.ret is not None and f.ret != contract.ret:
             raise SourceError(b.display_path, f.loc.line, f.loc.col, f"'{f.name}' must return {contract.ret}, not {f.ret}",
                               "fix the return annotation")
@@ -460,7 +467,7 @@ def _check_entries(b: Brick, loc) -> None:
                                   f"annotate it {want}")
     needs = b.module.meta.get("needs")
     if needs is not None:
-        used = sorted({p.name for f in b.entries for p in f.params if p.name in SHADING})
+        used = sorted({p.name for f in b.entries if not k.entry(f.name).sampling for p in f.params if p.name in SHADING})
         if sorted(needs) != used:
             raise _meta_error(b.display_path, loc, f"BRICK['needs'] {sorted(needs)} differs from the inputs the entry reads {used}",
                               "list exactly the shading inputs named as parameters (or drop 'needs')")

@@ -32,6 +32,9 @@ class Entry:
     ret: Type | None  # None: the type of what it provides (a packing's get_<input>)
     args: tuple[Arg, ...] = ()
     optional: bool = False  # a brick of the kind may leave it out (the glue then does without it)
+    # a sampling entry (sample, pdf, sample_h, pdf_h): called by the sampler, never by the shading glue; it reads
+    # only its arguments and the brick's parameters (no shading input), and is linked only into sampling programs
+    sampling: bool = False
 
 
 @dataclass(frozen=True)
@@ -65,10 +68,28 @@ class Kind:
         return tuple((a.name, a.ty) for a in self.entry(entry).args)
 
 
+def _frame(first: str, ty: Type, *more: Arg) -> tuple[Arg, ...]:
+    return (Arg(first, ty), Arg("V", VEC3), Arg("N", VEC3), Arg("T", VEC3), Arg("B", VEC3)) + more
+
+
+# The sampling contract (docs/guide/sampling.md). The caller gives an orthonormal frame: N the shading normal,
+# T, B the tangent and bitangent (any orthonormal pair for an isotropic BRDF), V the unit view vector.
+# `sample(u, ...)` maps a uniform u in [0, 1)^2 to a unit direction L; `pdf(L, ...)` is the density of L per
+# unit solid angle that `sample` draws with. A sampler may return L below the surface (n·l <= 0: a lobe
+# clipped by the horizon); the caller scores such a sample 0 (f_r is 0 there), and pdf is 0 there, so pdf
+# integrates to 1 minus the mass the sampler loses below the horizon. A BRDF term without a sampler is
+# sampled cosine-weighted (link/sampling.py decides it and says so). The NDF slot's `sample_h` / `pdf_h` do the
+# same for the half vector H (density per unit solid angle of H); the microfacet host reflects V about H.
+SAMPLE = Entry("sample", VEC3, _frame("u", VEC2), optional=True, sampling=True)
+PDF = Entry("pdf", FLOAT, _frame("L", VEC3), optional=True, sampling=True)
+SAMPLING_ENTRIES = ("sample", "pdf", "sample_h", "pdf_h")
+
 KINDS: dict[str, Kind] = {k.name: k for k in (
-    Kind("diffuse", (Entry("diffuse", VEC3),), "shading", doc="a diffuse BRDF term f_r (1/sr)"),
-    Kind("specular", (Entry("specular", VEC3),), "shading", doc="a specular BRDF term f_r (1/sr)"),
-    Kind("ndf", (Entry("ndf", FLOAT, (Arg("NdotH", FLOAT), Arg("NxH2", FLOAT), Arg("alpha", FLOAT))),),
+    Kind("diffuse", (Entry("diffuse", VEC3), SAMPLE, PDF), "shading", doc="a diffuse BRDF term f_r (1/sr)"),
+    Kind("specular", (Entry("specular", VEC3), SAMPLE, PDF), "shading", doc="a specular BRDF term f_r (1/sr)"),
+    Kind("ndf", (Entry("ndf", FLOAT, (Arg("NdotH", FLOAT), Arg("NxH2", FLOAT), Arg("alpha", FLOAT))),
+                 Entry("sample_h", VEC3, _frame("u", VEC2, Arg("alpha", FLOAT)), optional=True, sampling=True),
+                 Entry("pdf_h", FLOAT, _frame("H", VEC3, Arg("alpha", FLOAT)), optional=True, sampling=True)),
          "shading", slot=True, doc="a normal distribution D(h), normalized: ∫ D cosθ_h dω = 1"),
     Kind("fresnel", (Entry("fresnel", VEC3, (Arg("f0", VEC3), Arg("VdotH", FLOAT))),), "shading", slot=True,
          doc="a Fresnel reflectance F"),
