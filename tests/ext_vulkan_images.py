@@ -9,15 +9,26 @@ from __future__ import annotations
 import numpy as np
 
 
-class Image:
-    """An R32G32B32A32_SFLOAT image (H, W, 4) or cube (6, H, W, 4), uploaded and ready to sample."""
+_VIEWS = {"2d": "VK_IMAGE_VIEW_TYPE_2D", "cube": "VK_IMAGE_VIEW_TYPE_CUBE", "2d_array": "VK_IMAGE_VIEW_TYPE_2D_ARRAY",
+          "cube_array": "VK_IMAGE_VIEW_TYPE_CUBE_ARRAY"}
 
-    def __init__(self, device, texels: np.ndarray, cube: bool = False):
+
+class Image:
+    """An R32G32B32A32_SFLOAT image (H, W, 4) or cube (6, H, W, 4), uploaded and ready to sample; with `view`
+    "2d_array" (L, H, W, 4) or "cube_array" (L, 6, H, W, 4) layers; depth: a D32_SFLOAT image of (L, H, W)
+    depths in [0, 1] (a 2d_array view) for a comparison sampler."""
+
+    def __init__(self, device, texels: np.ndarray, cube: bool = False, view: str | None = None,
+                 depth: bool = False):
         vk = self.vk = device.vk
-        self.device = device
+        self.device, self.depth = device, depth
+        view = view or ("cube" if cube else "2d")
         texels = np.ascontiguousarray(texels, np.float32)
-        layers = 6 if cube else 1
-        h, w = texels.shape[-3], texels.shape[-2]
+        cube = view.startswith("cube")
+        layers = {"2d": 1, "cube": 6}.get(view) or int(np.prod(texels.shape[:-2 if depth else -3]))
+        h, w = (texels.shape[-2], texels.shape[-1]) if depth else (texels.shape[-3], texels.shape[-2])
+        fmt = vk.VK_FORMAT_D32_SFLOAT if depth else vk.VK_FORMAT_R32G32B32A32_SFLOAT
+        aspect = vk.VK_IMAGE_ASPECT_DEPTH_BIT if depth else vk.VK_IMAGE_ASPECT_COLOR_BIT
         dev = device.handle
         self.handle = self.memory = self.view = None
         staging = device.buffer(texels.nbytes, vk.VK_BUFFER_USAGE_TRANSFER_SRC_BIT)
@@ -25,7 +36,7 @@ class Image:
             staging.write(texels)
             self.handle = vk.vkCreateImage(dev, vk.VkImageCreateInfo(
                 flags=vk.VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT if cube else 0, imageType=vk.VK_IMAGE_TYPE_2D,
-                format=vk.VK_FORMAT_R32G32B32A32_SFLOAT, extent=vk.VkExtent3D(width=w, height=h, depth=1),
+                format=fmt, extent=vk.VkExtent3D(width=w, height=h, depth=1),
                 mipLevels=1, arrayLayers=layers, samples=vk.VK_SAMPLE_COUNT_1_BIT, tiling=vk.VK_IMAGE_TILING_OPTIMAL,
                 usage=vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
                 sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED), None)
@@ -33,7 +44,7 @@ class Image:
             self.memory = vk.vkAllocateMemory(dev, vk.VkMemoryAllocateInfo(
                 allocationSize=req.size, memoryTypeIndex=device.host_memory_type(req.memoryTypeBits)), None)
             vk.vkBindImageMemory(dev, self.handle, self.memory, 0)
-            rng = vk.VkImageSubresourceRange(aspectMask=vk.VK_IMAGE_ASPECT_COLOR_BIT, baseMipLevel=0, levelCount=1,
+            rng = vk.VkImageSubresourceRange(aspectMask=aspect, baseMipLevel=0, levelCount=1,
                                              baseArrayLayer=0, layerCount=layers)
 
             def barrier(old, new, src, dst):
@@ -49,7 +60,7 @@ class Image:
                                             0, vk.VK_ACCESS_TRANSFER_WRITE_BIT)])
                 region = vk.VkBufferImageCopy(
                     bufferOffset=0, bufferRowLength=0, bufferImageHeight=0,
-                    imageSubresource=vk.VkImageSubresourceLayers(aspectMask=vk.VK_IMAGE_ASPECT_COLOR_BIT, mipLevel=0,
+                    imageSubresource=vk.VkImageSubresourceLayers(aspectMask=aspect, mipLevel=0,
                                                                  baseArrayLayer=0, layerCount=layers),
                     imageOffset=vk.VkOffset3D(x=0, y=0, z=0), imageExtent=vk.VkExtent3D(width=w, height=h, depth=1))
                 vk.vkCmdCopyBufferToImage(cmd, staging.handle, self.handle, vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
@@ -62,8 +73,7 @@ class Image:
 
             device.submit(record)
             self.view = vk.vkCreateImageView(dev, vk.VkImageViewCreateInfo(
-                image=self.handle, viewType=vk.VK_IMAGE_VIEW_TYPE_CUBE if cube else vk.VK_IMAGE_VIEW_TYPE_2D,
-                format=vk.VK_FORMAT_R32G32B32A32_SFLOAT, subresourceRange=rng,
+                image=self.handle, viewType=getattr(vk, _VIEWS[view]), format=fmt, subresourceRange=rng,
                 components=vk.VkComponentMapping(r=vk.VK_COMPONENT_SWIZZLE_IDENTITY, g=vk.VK_COMPONENT_SWIZZLE_IDENTITY,
                                                  b=vk.VK_COMPONENT_SWIZZLE_IDENTITY,
                                                  a=vk.VK_COMPONENT_SWIZZLE_IDENTITY)), None)
@@ -84,13 +94,15 @@ class Image:
         self.view = self.handle = self.memory = None
 
 
-def linear_clamp_sampler(device):
+def linear_clamp_sampler(device, compare: bool = False):
+    """The linear clamp-to-edge level-0 sampler (compare: with compareOp LESS_OR_EQUAL, for depth images)."""
     vk = device.vk
     clamp = vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
     return vk.vkCreateSampler(device.handle, vk.VkSamplerCreateInfo(
         magFilter=vk.VK_FILTER_LINEAR, minFilter=vk.VK_FILTER_LINEAR, mipmapMode=vk.VK_SAMPLER_MIPMAP_MODE_NEAREST,
         addressModeU=clamp, addressModeV=clamp, addressModeW=clamp, mipLodBias=0.0, anisotropyEnable=vk.VK_FALSE,
-        maxAnisotropy=1.0, compareEnable=vk.VK_FALSE, compareOp=vk.VK_COMPARE_OP_ALWAYS, minLod=0.0, maxLod=0.0,
+        maxAnisotropy=1.0, compareEnable=vk.VK_TRUE if compare else vk.VK_FALSE,
+        compareOp=vk.VK_COMPARE_OP_LESS_OR_EQUAL if compare else vk.VK_COMPARE_OP_ALWAYS, minLod=0.0, maxLod=0.0,
         borderColor=vk.VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK, unnormalizedCoordinates=vk.VK_FALSE), None)
 
 
@@ -107,6 +119,8 @@ def run_sampling_kernel(device, spirv: bytes, samples: np.ndarray, out_vec4s: in
     try:
         bufs[0].write(samples)
         objs["sampler"] = linear_clamp_sampler(device)
+        if any(getattr(i, "depth", False) for i in images):
+            objs["compare_sampler"] = linear_clamp_sampler(device, compare=True)
         objs["module"] = vk.vkCreateShaderModule(dev, vk.VkShaderModuleCreateInfo(codeSize=len(spirv), pCode=spirv), None)
         objs["set_layout"] = vk.vkCreateDescriptorSetLayout(dev, vk.VkDescriptorSetLayoutCreateInfo(pBindings=[
             vk.VkDescriptorSetLayoutBinding(binding=i, descriptorType=t, descriptorCount=1,
@@ -138,7 +152,7 @@ def run_sampling_kernel(device, spirv: bytes, samples: np.ndarray, out_vec4s: in
             writes.append(vk.VkWriteDescriptorSet(
                 dstSet=dset, dstBinding=3 + 2 * j, dstArrayElement=0, descriptorCount=1,
                 descriptorType=vk.VK_DESCRIPTOR_TYPE_SAMPLER, pImageInfo=[vk.VkDescriptorImageInfo(
-                    sampler=objs["sampler"])]))
+                    sampler=objs["compare_sampler" if getattr(img, "depth", False) else "sampler"])]))
         vk.vkUpdateDescriptorSets(dev, len(writes), writes, 0, None)
 
         def record(cmd):
@@ -153,6 +167,7 @@ def run_sampling_kernel(device, spirv: bytes, samples: np.ndarray, out_vec4s: in
             b.destroy()
         for key, destroy in (("pipeline", vk.vkDestroyPipeline), ("pool", vk.vkDestroyDescriptorPool),
                              ("layout", vk.vkDestroyPipelineLayout), ("set_layout", vk.vkDestroyDescriptorSetLayout),
-                             ("module", vk.vkDestroyShaderModule), ("sampler", vk.vkDestroySampler)):
+                             ("module", vk.vkDestroyShaderModule), ("sampler", vk.vkDestroySampler),
+                             ("compare_sampler", vk.vkDestroySampler)):
             if key in objs:
                 destroy(dev, objs[key], None)

@@ -12,7 +12,8 @@ import ast
 
 from . import ir
 from .intrinsics import CONSTANTS, INTRINSICS
-from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, TEXTURE2D, TEXTURE2D_SHADOW, TEXTURECUBE, UINT, Type, vector
+from .sampling import SAMPLING_SIGS, SamplingError, sample_call
+from .types import BOOL, BUILTIN_TYPES, FLOAT, INT, UINT, Type, vector
 
 ARITH = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/", ast.Mod: "%"}
 _CMP = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">=", ast.Eq: "==", ast.NotEq: "!="}
@@ -260,9 +261,10 @@ class ExprChecker:
     def intrinsic(self, n, name, args) -> ir.Expr:
         loc = self.loc(n)
         sig = INTRINSICS[name]["sig"]
+        if sig in SAMPLING_SIGS:
+            return self.sampling(n, name, args)
         arity = {"gen": 1, "gen2": 2, "gen3": 3, "mix": 3, "minmax": 2, "absign": 1, "dot": 2, "length": 1,
-                 "cross": 2, "normalize": 1, "reflect": 2, "step": 2, "select": 3, "sample": 2, "sample_lod": 3,
-                 "sample_compare": 3, "buffer_length": 1}[sig]
+                 "cross": 2, "normalize": 1, "reflect": 2, "step": 2, "select": 3, "buffer_length": 1}[sig]
         if len(args) != arity:
             raise self.err(n, f"{name} takes {arity} argument{'s' if arity != 1 else ''}, got {len(args)}",
                            "see the intrinsics table in generator/lang/intrinsics.py")
@@ -308,28 +310,22 @@ class ExprChecker:
             if types[0] != BOOL or types[1] != types[2] or types[1].kind not in ("scalar", "vector"):
                 raise fail("(bool, T, T) with T a scalar or vector (WGSL select)")
             return ir.Intrinsic(types[1], loc, name, args)
-        if sig in ("sample", "sample_lod") and types[0] == TEXTURE2D_SHADOW:
-            raise self.err(n, f"{name}() cannot read a texture2d_shadow: a depth texture is read through its "
-                           "comparison sampler", "call sample_compare(shadow_tex, uv, depth_ref), which returns "
-                           "the filtered compare result")
-        if sig == "sample_compare":
-            if types != [TEXTURE2D_SHADOW, vector("float", 2), FLOAT]:
-                raise fail("(texture2d_shadow, vec2 uv, float depth_ref)")
-            if not isinstance(args[0], ir.Var) or args[0].scope != "param":
-                raise self.err(n, f"{name}() takes a texture parameter", "pass the texture as a function parameter")
-            return ir.Intrinsic(FLOAT, loc, name, args)
-        if sig in ("sample", "sample_lod"):
-            coord = vector("float", 3) if types[0] == TEXTURECUBE else vector("float", 2)
-            tex = TEXTURECUBE if types[0] == TEXTURECUBE else TEXTURE2D
-            want = [tex, coord] + ([FLOAT] if sig == "sample_lod" else [])
-            if types != want:
-                lod = ", float" if sig == "sample_lod" else ""
-                raise fail(f"(texture2d, vec2{lod}) or (texturecube, vec3{lod})")
-            if not isinstance(args[0], ir.Var) or args[0].scope != "param":
-                raise self.err(n, f"{name}() takes a texture parameter", "pass the texture as a function parameter")
-            return ir.Intrinsic(vector("float", 4), loc, name, args)
         if sig == "buffer_length":
             if types[0].kind != "buffer":
                 raise fail("a buffer declared at the top level of the brick")
             return ir.Intrinsic(UINT, loc, name, args)
         raise AssertionError(sig)
+
+    def sampling(self, n, name, args) -> ir.Expr:
+        """sample, sample_level, sample_compare (generator/lang/sampling.py); the texture is a parameter."""
+        if not args or args[0].ty.kind != "texture" or len(args) < 2:
+            shown = ", ".join(str(a.ty) for a in args)
+            raise self.err(n, f"{name}({shown}) is not defined", f"{name} takes a texture parameter and a coordinate "
+                           "(see the intrinsics table in generator/lang/intrinsics.py)")
+        try:
+            call = sample_call(name, self.loc(n), *args)
+        except SamplingError as e:
+            raise self.err(n, e.message, e.hint) from None
+        if not isinstance(args[0], ir.Var) or args[0].scope != "param":
+            raise self.err(n, f"{name}() takes a texture parameter", "pass the texture as a function parameter")
+        return call

@@ -17,15 +17,30 @@ Typing rules (`sig`):
   reflect    f(vN, vN) -> vN
   step       f(T, T) -> T
   select     f(bool, T, T) -> T           select(cond, if_true, if_false)
-  sample     f(texture2d, vec2) -> vec4       also f(texturecube, vec3 direction) -> vec4
-  sample_lod f(texture2d, vec2, float) -> vec4  also f(texturecube, vec3, float) -> vec4
+  sample     f(texture2d, vec2) -> vec4       also f(texturecube, vec3 direction) -> vec4,
+                                          f(texture2d_array, vec2, int layer) -> vec4 and
+                                          f(texturecube_array, vec3, int layer) -> vec4; a layer
+                                          (int or uint) is clamped to [0, layers - 1] in every
+                                          target: GLSL texture on a sampler2DArray or
+                                          samplerCubeArray with the layer as float(layer) in the
+                                          last coordinate, HLSL Texture2DArray / TextureCubeArray
+                                          Sample with a float3 / float4, WGSL textureSample(t, s,
+                                          coord, layer) on a texture_2d_array / texture_cube_array
+  sample_lod f(texture2d, vec2, float) -> vec4  also f(texturecube, vec3, float) -> vec4 and the
+                                          arrays with int layer before the lod: GLSL textureLod,
+                                          HLSL SampleLevel, WGSL textureSampleLevel
   sample_compare f(texture2d_shadow, vec2 uv, float ref) -> float
                                           the hardware depth compare (ref <= stored depth: 1,
                                           else 0) of each texel of the bilinear 2×2 footprint,
                                           weighted by the bilinear weights, at LOD 0 (valid in
                                           non-uniform control flow): GLSL textureLod on a
                                           sampler2DShadow, HLSL SampleCmpLevelZero, WGSL
-                                          textureSampleCompareLevel
+                                          textureSampleCompareLevel; also f(texture2d_array_shadow,
+                                          vec2 uv, int layer, float ref) -> float: GLSL textureGrad
+                                          with zero gradients on a sampler2DArrayShadow (GLSL has
+                                          no textureLod for it), HLSL SampleCmpLevelZero with a
+                                          float3, WGSL textureSampleCompareLevel(t, s, uv, layer,
+                                          ref) on a texture_depth_2d_array
   buffer_length f(buffer) -> uint         elements in a storage buffer (run time),
                                           a uniform buffer's capacity (constant)
 

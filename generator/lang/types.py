@@ -22,9 +22,9 @@ class Type:
         structs) or "uniform" (uniform block holding array[elem, size]); "" otherwise.
 
     Construct arrays, buffers and textures with array(), storage_buffer(),
-    uniform_buffer(), TEXTURE2D, TEXTURECUBE and TEXTURE2D_SHADOW below (a
-    texture2d_shadow is a depth texture read only through its comparison sampler,
-    by sample_compare); buffers are global resources only (never parameters, locals
+    uniform_buffer(), TEXTURE2D, TEXTURECUBE, TEXTURE2D_SHADOW and their arrays
+    (texture_type(dim, compare)) below (a texture2d_shadow or texture2d_array_shadow
+    is a depth texture read only through its comparison sampler, by sample_compare); buffers are global resources only (never parameters, locals
     or struct fields) and their element structs obey buffer_layout_error().
     """
 
@@ -57,13 +57,19 @@ class Type:
 
     @property
     def dim(self) -> str:
-        """A texture's dimension: "2d" or "cube" ("" for other types); a texture2d_shadow is "2d"."""
+        """A texture's dimension: "2d", "cube", "2d_array" or "cube_array" ("" for other types); a
+        texture2d_shadow is "2d", a texture2d_array_shadow "2d_array"."""
         return _TEXTURE_DIMS.get(self.name, "") if self.kind == "texture" else ""
 
     @property
     def compare(self) -> bool:
-        """A depth texture sampled through a comparison sampler (texture2d_shadow)."""
-        return self.kind == "texture" and self.name == "texture2d_shadow"
+        """A depth texture sampled through a comparison sampler (texture2d_shadow, texture2d_array_shadow)."""
+        return self.kind == "texture" and self.name in _COMPARE_TEXTURES
+
+    @property
+    def arrayed(self) -> bool:
+        """A texture array: its sampling calls take a layer after the coordinate (texture_type)."""
+        return self.dim.endswith("_array")
 
     @property
     def components(self) -> int:
@@ -120,12 +126,42 @@ TEXTURECUBE = Type("texture", "float", 1, "texturecube")
 # sample_compare, which returns the filtered result of the depth compares (percentage-closer filtering in
 # hardware: GLSL sampler2DShadow, HLSL SamplerComparisonState, WGSL texture_depth_2d + sampler_comparison).
 TEXTURE2D_SHADOW = Type("texture", "float", 1, "texture2d_shadow")
-_TEXTURE_DIMS = {"texture2d": "2d", "texturecube": "cube", "texture2d_shadow": "2d"}
+# Arrays of layers of one size (VK_IMAGE_VIEW_TYPE_2D_ARRAY, CUBE_ARRAY): sample(t, uv, layer) and the others
+# take an int or uint layer after the coordinate; a layer outside [0, L-1] reads the nearest layer (clamped),
+# as Vulkan does to its rounded layer coordinate and WGSL to its integer index, so no target rounds.
+TEXTURE2D_ARRAY = Type("texture", "float", 1, "texture2d_array")
+TEXTURE2D_ARRAY_SHADOW = Type("texture", "float", 1, "texture2d_array_shadow")
+TEXTURECUBE_ARRAY = Type("texture", "float", 1, "texturecube_array")
+_TEXTURE_DIMS = {"texture2d": "2d", "texturecube": "cube", "texture2d_shadow": "2d",
+                 "texture2d_array": "2d_array", "texturecube_array": "cube_array", "texture2d_array_shadow": "2d_array"}
+_COMPARE_TEXTURES = ("texture2d_shadow", "texture2d_array_shadow")
+TEXTURE_DIMS = ("2d", "cube", "2d_array", "cube_array")
+_TEXTURES = {("2d", False): TEXTURE2D, ("cube", False): TEXTURECUBE, ("2d", True): TEXTURE2D_SHADOW,
+             ("2d_array", False): TEXTURE2D_ARRAY, ("cube_array", False): TEXTURECUBE_ARRAY,
+             ("2d_array", True): TEXTURE2D_ARRAY_SHADOW}
+
+
+def texture_type(dim: str, compare: bool = False) -> Type:
+    """The texture type of dimension `dim` (TEXTURE_DIMS) and, compare, a depth texture read through a
+    comparison sampler (2d and 2d_array only: the language has no cube depth texture)."""
+    try:
+        return _TEXTURES[(dim, bool(compare))]
+    except KeyError:
+        raise ValueError(f"no texture of dimension {dim!r}{' with a comparison sampler' if compare else ''}: "
+                         f"one of {', '.join(TEXTURE_DIMS)} (compare: 2d or 2d_array)") from None
+
+
+def arrayed_texture(t: Type) -> Type:
+    """The array of layers of texture type t (texture2d -> texture2d_array, texture2d_shadow ->
+    texture2d_array_shadow, texturecube -> texturecube_array); an array stays itself."""
+    return t if t.arrayed else texture_type(t.dim + "_array", t.compare)
+
 
 BUILTIN_TYPES: dict[str, Type] = {
     "float": FLOAT, "int": INT, "uint": UINT, "bool": BOOL,
     "mat3": MAT3, "mat4": MAT4, "texture2d": TEXTURE2D, "texturecube": TEXTURECUBE,
-    "texture2d_shadow": TEXTURE2D_SHADOW,
+    "texture2d_shadow": TEXTURE2D_SHADOW, "texture2d_array": TEXTURE2D_ARRAY,
+    "texture2d_array_shadow": TEXTURE2D_ARRAY_SHADOW, "texturecube_array": TEXTURECUBE_ARRAY,
 }
 for _s, _p in _VEC_PREFIX.items():
     for _n in (2, 3, 4):

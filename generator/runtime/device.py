@@ -258,10 +258,15 @@ class Device:
         features = features if features is not None else f16
         # anisotropic filtering is an optional feature: a scene's sampler asks for it (runtime/images.Sampler clamps
         # the state to 1 where the device lacks it, and says so)
-        self.sampler_anisotropy = bool(vk.vkGetPhysicalDeviceFeatures(self.physical).samplerAnisotropy)
+        have_features = vk.vkGetPhysicalDeviceFeatures(self.physical)
+        self.sampler_anisotropy = bool(have_features.samplerAnisotropy)
+        # a brick's texturecube_array is a CUBE_ARRAY view and SPIR-V's SampledCubeArray: enabled where present
+        self.image_cube_array = bool(have_features.imageCubeArray)
         self.handle = vk.vkCreateDevice(self.physical, vk.VkDeviceCreateInfo(
             pNext=features, pQueueCreateInfos=[queue_info],
             pEnabledFeatures=vk.VkPhysicalDeviceFeatures(samplerAnisotropy=vk.VK_TRUE if self.sampler_anisotropy
+                                                         else vk.VK_FALSE,
+                                                         imageCubeArray=vk.VK_TRUE if self.image_cube_array
                                                          else vk.VK_FALSE),
             ppEnabledExtensionNames=self.extensions), None)
         del features, f16, s16  # alive across the call

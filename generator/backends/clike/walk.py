@@ -91,6 +91,9 @@ class CLikeTarget(ControlMixin, ResourceMixin):
     TEXTURE = ""                    # texture2d parameter type
     TEXTURE_CUBE = ""               # texturecube parameter type
     TEXTURE_SHADOW = ""             # texture2d_shadow parameter type (a depth texture)
+    TEXTURE_ARRAY = ""              # texture2d_array parameter type
+    TEXTURE_CUBE_ARRAY = ""         # texturecube_array parameter type
+    TEXTURE_ARRAY_SHADOW = ""       # texture2d_array_shadow parameter type
     SAMPLER = ""                    # separate sampler parameter type ("" = combined)
     SAMPLER_COMPARE = ""            # the comparison sampler of a texture2d_shadow
     FLOAT_SUFFIX = ""
@@ -100,7 +103,8 @@ class CLikeTarget(ControlMixin, ResourceMixin):
     SIGNED_MOD_BY_DIVISION = True   # write signed int % as a - b*(a/b) (see expr_binary)
     UNARY_OPS = {"-": "-", "not": "!"}
     # intrinsic -> format over {0}, {1}, ... (texture args also give {smp}); missing = same name;
-    # "name@cube" overrides "name" when the first argument is a cube texture
+    # "name@DIM" overrides "name" when the first argument is a texture of dimension DIM other than "2d"
+    # ("sample@cube", "sample_compare@2d_array"); an array's {2} is its int or uint layer
     INTRINSICS: dict[str, str] = {}
 
     # ------------------------------------------------------------ public interface
@@ -206,16 +210,17 @@ class CLikeTarget(ControlMixin, ResourceMixin):
         return f'#line {int(line)} "{directive_path(path)}"'
 
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
-        """A global texture resource NAME ("2d" or "cube") and its sampler at bindings B and B+1 of set S
-        (compare: a 2D depth texture and a comparison sampler, for sample_compare)."""
+        """A global texture resource NAME ("2d", "cube", "2d_array", "cube_array") and its sampler at bindings
+        B and B+1 of set S (compare: a 2D depth texture or array of them and a comparison sampler)."""
         raise NotImplementedError
 
     def image_type(self, dim: str, compare: bool = False) -> str:
-        """The spelling of a texture of dimension `dim` ("2d", "cube"; compare: a 2D depth texture)."""
+        """The spelling of a texture of dimension `dim` ("2d", "cube", "2d_array", "cube_array"; compare: a 2D
+        depth texture or an array of them)."""
         if compare:
-            assert dim == "2d", "comparison textures are 2D"
-            return self.TEXTURE_SHADOW
-        return {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE}[dim]
+            return {"2d": self.TEXTURE_SHADOW, "2d_array": self.TEXTURE_ARRAY_SHADOW}[dim]
+        return {"2d": self.TEXTURE, "cube": self.TEXTURE_CUBE, "2d_array": self.TEXTURE_ARRAY,
+                "cube_array": self.TEXTURE_CUBE_ARRAY}[dim]
 
     def sampler_type(self, compare: bool = False) -> str:
         """The sampler that travels with a texture (compare: a comparison sampler)."""
@@ -460,8 +465,9 @@ class CLikeTarget(ControlMixin, ResourceMixin):
         if e.name == "buffer_length":
             return self.buffer_length(e.args[0])
         fmt = None
-        if e.args and e.args[0].ty.dim == "cube":
-            fmt = self.INTRINSICS.get(e.name + "@cube")
+        if e.args and e.args[0].ty.dim not in ("", "2d"):
+            fmt = self.INTRINSICS.get(f"{e.name}@{e.args[0].ty.dim}")
+            assert fmt or not e.args[0].ty.arrayed, f"{self.name}: no spelling of {e.name} on a {e.args[0].ty}"
         fmt = fmt or self.INTRINSICS.get(e.name)
         if fmt is None:
             return f"{e.name}({', '.join(self.expr(a) for a in e.args)})"

@@ -6,7 +6,8 @@ OpenGL's binding model (GLSL 4.50 spec §4.4.5 "Uniform and Shader Storage Block
 
 - **Combined samplers.** OpenGL has no separate `texture2D`/`sampler` objects (those are
   GL_KHR_vulkan_glsl): a texture is one `sampler2D` (`samplerCube`, `sampler2DShadow` for a compare)
-  bound to a texture unit, passed to brick functions alone, sampled as `texture(t, uv)`.
+  bound to a texture unit, passed to brick functions alone, sampled as `texture(t, uv)`; arrays are
+  `sampler2DArray`, `sampler2DArrayShadow` and (desktop GL 4.00+ only) `samplerCubeArray`.
 - **No descriptor sets.** `layout(binding = N)` only. Uniform blocks, texture units and shader
   storage blocks are three separate binding namespaces; Vulkan's (set, binding) pairs are
   flattened per namespace in (set, binding) order (:func:`gl_bindings`): Frame is always uniform
@@ -16,13 +17,19 @@ OpenGL's binding model (GLSL 4.50 spec §4.4.5 "Uniform and Shader Storage Block
   `constant_id` specialization constants (GLSL for OpenGL has none without GL_ARB_gl_spirv).
 - **ES 3.10** (`EsslTarget`): `#version 310 es` and default precision qualifiers — `highp`, or
   `mediump` in the fragment stage of a permutation whose key says fp16 (ESSL's way of allowing half
-  precision; ESSL 3.10 §4.7.2: mediump has at least 16-bit float range and 10-bit mantissa).
+  precision; ESSL 3.10 §4.7.2: mediump has at least 16-bit float range and 10-bit mantissa). The
+  array samplers have no default precision (§4.7.4) and are spelled `highp sampler2DArray` where
+  declared, so the precision statements of shaders without them stay as they were; ES 3.10 has no
+  `samplerCubeArray` (ES 3.20 and OES_texture_cube_map_array do): a brick that takes a
+  texturecube_array is refused at its parameter for the essl dialect.
 
 Desktop GL at fp16 is emitted at 32-bit floats: GL has no portable half arithmetic (the float16
 extension is the Vulkan path's).
 """
 from __future__ import annotations
 
+from ...lang import ir
+from ...lang.errors import at
 from ...lang.types import Type
 from ..glsl.emit import GlslTarget
 
@@ -52,6 +59,9 @@ class GlTarget(GlslTarget):
     TEXTURE = "sampler2D"
     TEXTURE_CUBE = "samplerCube"
     TEXTURE_SHADOW = "sampler2DShadow"
+    TEXTURE_ARRAY = "sampler2DArray"
+    TEXTURE_CUBE_ARRAY = "samplerCubeArray"
+    TEXTURE_ARRAY_SHADOW = "sampler2DArrayShadow"
     SAMPLER = ""  # combined: a texture carries its sampler
     SAMPLER_COMPARE = ""
     INTRINSICS = {
@@ -62,6 +72,12 @@ class GlTarget(GlslTarget):
         "sample_level@cube": "textureLod({0}, {1}, {2})",
         # textureLod on sampler2DShadow exists in GLSL 4.50 and ESSL 3.00+: level 0, valid in non-uniform flow
         "sample_compare": "textureLod({0}, vec3({1}, {2}), 0.0)",
+        "sample@2d_array": "texture({0}, vec3({1}, float({2})))",
+        "sample_level@2d_array": "textureLod({0}, vec3({1}, float({2})), {3})",
+        "sample@cube_array": "texture({0}, vec4({1}, float({2})))",
+        "sample_level@cube_array": "textureLod({0}, vec4({1}, float({2})), {3})",
+        # GLSL 4.50 and ESSL 3.00+ have textureGrad, not textureLod, on sampler2DArrayShadow: zero gradients, level 0
+        "sample_compare@2d_array": "textureGrad({0}, vec4({1}, float({2}), {3}), vec2(0.0), vec2(0.0))",
     }
 
     def __init__(self, bindings: dict | None = None, precision: str = "fp32"):
@@ -109,6 +125,21 @@ class EsslTarget(GlTarget):
     name = "essl"
     ext = "essl"
     version = "310 es"
+    TEXTURE_ARRAY = "highp sampler2DArray"
+    TEXTURE_CUBE_ARRAY = ""  # none in ES 3.10: refused where a brick takes one (emit)
+    TEXTURE_ARRAY_SHADOW = "highp sampler2DArrayShadow"
+
+    def emit(self, structs, functions, globals=(), records=None):
+        """As GlTarget's, after refusing a texturecube_array at the brick line that takes or declares one."""
+        for f in functions:
+            for p in f.params:
+                if p.ty.dim == "cube_array":
+                    raise _no_cube_array(p.loc, f"parameter '{p.name}' of '{f.name}'")
+        for g in globals:
+            if g.ty.dim == "cube_array":
+                raise ValueError(f"texture '{g.name}' is a texturecube_array: GLSL ES 3.10 has no samplerCubeArray "
+                                 "— build the gl platform's gl dialect only, or take a texturecube per layer")
+        return super().emit(structs, functions, globals, records)
 
     def precision_lines(self, stage: str) -> list[str]:
         """ESSL has no default float precision in fragment shaders (§4.7.4), and samplers default to lowp:
@@ -120,6 +151,12 @@ class EsslTarget(GlTarget):
         p = "mediump" if self.key_precision == "fp16" and stage == "frag" else "highp"
         types = ["float", "int"] + (["sampler2D", "samplerCube", "sampler2DShadow"] if stage == "frag" else [])
         return [f"precision {p if t == 'float' else 'highp'} {t};" for t in types]
+
+
+def _no_cube_array(loc: ir.Loc, what: str):
+    return at(loc, f"{what} is a texturecube_array, which GLSL ES 3.10 does not have (samplerCubeArray is ES 3.20 "
+              "or OES_texture_cube_map_array)", "take a texturecube per layer or a texture2d_array of faces, or "
+              "build without the gl platform's essl dialect (desktop GL 4.50 has cube arrays)")
 
 
 DIALECTS = {"gl": GlTarget, "essl": EsslTarget}  # the gl platform's sources, validated by glslangValidator

@@ -3,7 +3,10 @@
 Textures are a `texture2D` (or `textureCube`) and a `sampler` (Vulkan GLSL), joined
 at the call as `sampler2D(t, s)` (`samplerCube(t, s)`), so the descriptor layout is the
 same as HLSL's and WGSL's: image at binding B, sampler at B+1. A texture2d_shadow is a
-`texture2D` and a `samplerShadow`, joined as `sampler2DShadow(t, s)`. Buffers are interface
+`texture2D` and a `samplerShadow`, joined as `sampler2DShadow(t, s)`; arrays are `texture2DArray`
+(`sampler2DArray`, `sampler2DArrayShadow`) and `textureCubeArray` (`samplerCubeArray`, the
+SampledCubeArray capability: Vulkan's imageCubeArray feature), their int layer converted to the float
+last coordinate, which is exact (generator/lang/sampling.py). Buffers are interface
 blocks with one member `data` (clike/resources.py).
 """
 from __future__ import annotations
@@ -23,6 +26,9 @@ class GlslTarget(CLikeTarget):
     TEXTURE = "texture2D"
     TEXTURE_CUBE = "textureCube"
     TEXTURE_SHADOW = "texture2D"  # a depth texture; joined with a samplerShadow as sampler2DShadow
+    TEXTURE_ARRAY = "texture2DArray"
+    TEXTURE_CUBE_ARRAY = "textureCubeArray"
+    TEXTURE_ARRAY_SHADOW = "texture2DArray"  # joined with a samplerShadow as sampler2DArrayShadow
     SAMPLER = "sampler"
     SAMPLER_COMPARE = "samplerShadow"
     INTRINSICS = {
@@ -36,6 +42,14 @@ class GlslTarget(CLikeTarget):
         # GLSL 4.50 has textureLod for sampler2DShadow (not for the cube and array shadow samplers):
         # level 0 explicitly, valid in non-uniform control flow; the reference is P's third component
         "sample_compare": "textureLod(sampler2DShadow({0}, {smp}), vec3({1}, {2}), 0.0)",
+        "sample@2d_array": "texture(sampler2DArray({0}, {smp}), vec3({1}, float({2})))",
+        "sample_level@2d_array": "textureLod(sampler2DArray({0}, {smp}), vec3({1}, float({2})), {3})",
+        "sample@cube_array": "texture(samplerCubeArray({0}, {smp}), vec4({1}, float({2})))",
+        "sample_level@cube_array": "textureLod(samplerCubeArray({0}, {smp}), vec4({1}, float({2})), {3})",
+        # no textureLod on sampler2DArrayShadow (without GL_EXT_texture_shadow_lod): zero gradients select
+        # level 0 as explicitly, also valid in non-uniform flow; P is (uv, layer, ref)
+        "sample_compare@2d_array": "textureGrad(sampler2DArrayShadow({0}, {smp}), vec4({1}, float({2}), {3}), "
+                                   "vec2(0.0), vec2(0.0))",
     }
 
     def header(self) -> str:
@@ -46,7 +60,7 @@ class GlslTarget(CLikeTarget):
         return f"layout(constant_id = {int(constant_id)}) const {self.type_name(ty)} {self.ident(name)} = 0;"
 
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
-        """texture2D (textureCube) NAME at binding B and sampler (compare: samplerShadow) _smp_NAME at B+1 of
+        """texture2D (textureCube, texture2DArray, textureCubeArray) NAME at binding B and sampler (compare: samplerShadow) _smp_NAME at B+1 of
         set S (as HLSL and WGSL)."""
         s, b = int(set), int(binding)
         image = self.image_type(dim, compare)

@@ -28,6 +28,9 @@ class HlslTarget(CLikeTarget):
     TEXTURE = "Texture2D"
     TEXTURE_CUBE = "TextureCube"
     TEXTURE_SHADOW = "Texture2D"  # a depth texture is a Texture2D; its sampler makes the compare
+    TEXTURE_ARRAY = "Texture2DArray"
+    TEXTURE_CUBE_ARRAY = "TextureCubeArray"
+    TEXTURE_ARRAY_SHADOW = "Texture2DArray"
     SAMPLER = "SamplerState"
     SAMPLER_COMPARE = "SamplerComparisonState"
     INTRINSICS = {
@@ -38,13 +41,19 @@ class HlslTarget(CLikeTarget):
         "sample_level": "{0}.SampleLevel({smp}, {1}, {2})",
         # level 0 (valid in non-uniform control flow, unlike SampleCmp's implicit LOD)
         "sample_compare": "{0}.SampleCmpLevelZero({smp}, {1}, {2})",
+        # an array's layer is the last coordinate, a float (exact for an int layer: generator/lang/sampling.py)
+        "sample@2d_array": "{0}.Sample({smp}, float3({1}, float({2})))",
+        "sample_level@2d_array": "{0}.SampleLevel({smp}, float3({1}, float({2})), {3})",
+        "sample@cube_array": "{0}.Sample({smp}, float4({1}, float({2})))",
+        "sample_level@cube_array": "{0}.SampleLevel({smp}, float4({1}, float({2})), {3})",
+        "sample_compare@2d_array": "{0}.SampleCmpLevelZero({smp}, float3({1}, float({2})), {3})",
     }
 
     def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
         return f"[[vk::constant_id({int(constant_id)})]] const {self.type_name(ty)} {self.ident(name)} = 0;"
 
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
-        """Texture2D (TextureCube) NAME at binding B and SamplerState (compare: SamplerComparisonState)
+        """Texture2D (TextureCube, Texture2DArray, TextureCubeArray) NAME at binding B and SamplerState (compare: SamplerComparisonState)
         _smp_NAME at B+1 of set S (t/s registers alike)."""
         s, b = int(set), int(binding)
         image = self.image_type(dim, compare)

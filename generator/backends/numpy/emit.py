@@ -66,6 +66,9 @@ def _float_lit(v: float) -> str:
     return f"F({float(v)!r})"
 
 
+# the resources.py helper that samples a texture of each dimension (level 0)
+_SAMPLERS = {"2d": "_tex2d", "cube": "_texcube", "2d_array": "_tex2d_array", "cube_array": "_texcube_array"}
+
 class _FunctionEmitter(ControlEmitter):
     def __init__(self, target: "NumpyTarget", fn: ir.Function):
         self.t, self.fn = target, fn
@@ -259,8 +262,12 @@ class _FunctionEmitter(ControlEmitter):
         args = [self.expr(a) for a in e.args]
         n = e.name
         if n in ("sample", "sample_level"):  # level 0 only: the lod of sample_level is not read
-            return f"{'_texcube' if e.args[0].ty.dim == 'cube' else '_tex2d'}({args[0]}, {args[1]})"
+            dim = e.args[0].ty.dim
+            layer = f", {args[2]}" if e.args[0].ty.arrayed else ""
+            return f"{_SAMPLERS[dim]}({args[0]}, {args[1]}{layer})"
         if n == "sample_compare":
+            if e.args[0].ty.arrayed:
+                return f"_tex2d_array_compare({args[0]}, {args[1]}, {args[2]}, {args[3]})"
             return f"_tex2d_compare({args[0]}, {args[1]}, {args[2]})"
         if n == "buffer_length":
             buf = e.args[0].ty

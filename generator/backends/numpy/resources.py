@@ -30,6 +30,10 @@ depth image (Vulkan, "Depth Compare Operation" then "Texel Filtering"): each tex
 bilinear 2×2 footprint is compared first (1 where ref <= D, else 0) and the four results are
 weighted by the bilinear weights (percentage-closer filtering of Reeves et al. 1987 over 2×2
 texels, what lavapipe does); ref is not clamped, as the D32_SFLOAT depth format asks.
+A texture2d_array is an array (L, H, W, C) of L layers, a texturecube_array (L, 6, H, W, C), a
+texture2d_array_shadow (L, H, W) (or (L, H, W, C)); their int layer is clamped to [0, L-1] per lane,
+as Vulkan clamps its rounded layer coordinate and WGSL its array index (generator/lang/sampling.py),
+and the layer is then sampled as a texture2d, texturecube or texture2d_shadow is.
 Cube maps pick the face by the major axis (ties: X over Y over Z) and then
 filter within that face, clamped to its edge; Vulkan filters seamlessly across
 faces, so values within half a texel of a face edge differ from a GPU's.
@@ -116,6 +120,11 @@ def _image(t, cube: bool):
         shape = "(6, H, W, C)" if cube else "(H, W, C)"
         raise ValueError(f"a {'texturecube' if cube else 'texture2d'} is an array {shape} with C ≤ 4, "
                          f"got shape {np.shape(t)}")
+    return _rgba(img)
+
+
+def _rgba(img):
+    """Texels (..., C) with C ≤ 4 as (..., 4): missing channels 0, alpha 1 (Vulkan's format expansion)."""
     c = img.shape[-1]
     if c < 4:
         pad = np.zeros(img.shape[:-1] + (4 - c,))
@@ -163,6 +172,55 @@ def _tex2d_compare(t, uv, ref):
 
     def lit(j, i):
         return (r <= depth[j, i]).astype(np.float64)
+
+    out = (lit(j0, i0) * (1 - ax) + lit(j0, i1) * ax) * (1 - ay) + (lit(j1, i0) * (1 - ax) + lit(j1, i1) * ax) * ay
+    return out.astype(uv.dtype)
+
+
+def _layers(t, per_layer: int, what: str, shape: str):
+    """A texture array as (L · per_layer, H, W, 4) texels (per_layer: 6 for a cube array) and its L."""
+    a = np.asarray(t, np.float64)
+    want = 4 if per_layer == 1 else 5
+    if a.ndim == want - 1 and what.endswith("_shadow"):
+        a = a[..., None]
+    if a.ndim != want or a.shape[0] < 1 or a.shape[-1] > 4 or (per_layer == 6 and a.shape[1] != 6):
+        raise ValueError(f"a {what} is an array {shape} with L ≥ 1 and C ≤ 4, got shape {np.shape(t)}")
+    return _rgba(a.reshape((-1,) + a.shape[-3:])), a.shape[0]
+
+
+def _layer_index(layer, n, shape):
+    """The layer of each lane, clamped to [0, n - 1], broadcast to the coordinate's sample axes."""
+    return np.broadcast_to(np.clip(np.asarray(layer).astype(np.int64), 0, n - 1), shape).astype(np.intp)
+
+
+def _tex2d_array(t, uv, layer):
+    """sample / sample_level of a texture2d_array (L, H, W, C) at uv in layer `layer` (clamped; level 0)."""
+    uv = np.asarray(uv)
+    img, n = _layers(t, 1, "texture2d_array", "(L, H, W, C)")
+    c = uv.astype(np.float64)
+    return _bilinear(img, _layer_index(layer, n, c.shape[:-1]), c[..., 0], c[..., 1]).astype(uv.dtype)
+
+
+def _texcube_array(t, d, layer):
+    """sample / sample_level of a texturecube_array (L, 6, H, W, C) in direction d, layer `layer` (clamped)."""
+    d = np.asarray(d)
+    img, n = _layers(t, 6, "texturecube_array", "(L, 6, H, W, C)")
+    face, s, tt = cube_face(d)
+    return _bilinear(img, 6 * _layer_index(layer, n, face.shape) + face.astype(np.intp), s, tt).astype(d.dtype)
+
+
+def _tex2d_array_compare(t, uv, layer, ref):
+    """sample_compare of a texture2d_array_shadow (L, H, W): _tex2d_compare in layer `layer` (clamped)."""
+    uv = np.asarray(uv)
+    img, n = _layers(t, 1, "texture2d_array_shadow", "(L, H, W)")
+    depth = img[..., 0]
+    c = uv.astype(np.float64)
+    k = _layer_index(layer, n, c.shape[:-1])
+    i0, i1, j0, j1, ax, ay = _footprint(depth.shape[1], depth.shape[2], c[..., 0], c[..., 1])
+    r = np.asarray(ref, np.float64)
+
+    def lit(j, i):
+        return (r <= depth[k, j, i]).astype(np.float64)
 
     out = (lit(j0, i0) * (1 - ax) + lit(j0, i1) * ax) * (1 - ay) + (lit(j1, i0) * (1 - ax) + lit(j1, i1) * ax) * ay
     return out.astype(uv.dtype)

@@ -24,6 +24,9 @@ class WgslTarget(CLikeTarget):
     TEXTURE = "texture_2d<f32>"
     TEXTURE_CUBE = "texture_cube<f32>"
     TEXTURE_SHADOW = "texture_depth_2d"
+    TEXTURE_ARRAY = "texture_2d_array<f32>"
+    TEXTURE_CUBE_ARRAY = "texture_cube_array<f32>"
+    TEXTURE_ARRAY_SHADOW = "texture_depth_2d_array"
     SAMPLER = "sampler"
     SAMPLER_COMPARE = "sampler_comparison"
     DEFAULT_REQUIRED = True
@@ -39,6 +42,12 @@ class WgslTarget(CLikeTarget):
         "sample_level": "textureSampleLevel({0}, {smp}, {1}, {2})",
         # level 0: valid in non-uniform control flow, unlike textureSampleCompare
         "sample_compare": "textureSampleCompareLevel({0}, {smp}, {1}, {2})",
+        # an array's layer is WGSL's integer array_index (i32 or u32), after the coordinate
+        "sample@2d_array": "textureSample({0}, {smp}, {1}, {2})",
+        "sample_level@2d_array": "textureSampleLevel({0}, {smp}, {1}, {2}, {3})",
+        "sample@cube_array": "textureSample({0}, {smp}, {1}, {2})",
+        "sample_level@cube_array": "textureSampleLevel({0}, {smp}, {1}, {2}, {3})",
+        "sample_compare@2d_array": "textureSampleCompareLevel({0}, {smp}, {1}, {2}, {3})",
     }
 
     def declare_spec_constant(self, name: str, ty: Type, constant_id: int) -> str:
@@ -46,7 +55,8 @@ class WgslTarget(CLikeTarget):
         return f"@id({int(constant_id)}) override {self.ident(name)}: {self.type_name(ty)} = {zero};"
 
     def declare_texture(self, name: str, set: int, binding: int, dim: str = "2d", compare: bool = False) -> str:
-        """texture_2d<f32> (texture_cube<f32>; compare: texture_depth_2d) NAME at binding B and sampler
+        """texture_2d<f32> (texture_cube<f32>, texture_2d_array<f32>, texture_cube_array<f32>; compare:
+        texture_depth_2d, texture_depth_2d_array) NAME at binding B and sampler
         (compare: sampler_comparison) _smp_NAME at B+1 of group S."""
         s, b = int(set), int(binding)
         return (f"@group({s}) @binding({b}) var {self.ident(name)}: {self.image_type(dim, compare)};\n"
