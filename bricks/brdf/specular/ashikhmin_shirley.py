@@ -43,3 +43,32 @@ def specular(NdotL: float, NdotV: float, NdotH: float, LdotH: float, HdotT: floa
     # pow(0, n_u) = 0); floored at 1e-30 so that 0/0 is 0. Cost: none (f_r <= 4e3 / 1e-30 is finite).
     d = max(LdotH * max(NdotL, NdotV), 1e-30)
     return fresnel * (sqrt((n_u + 1.0) * (n_v + 1.0)) / (8.0 * PI) * pow(NdotH, e) / d)
+
+
+# Sampling (the contract: library/kinds.py): Ashikhmin & Shirley 2000 §3, eqs. 9-10: phi_h =
+# atan(sqrt((n_u+1)/(n_v+1)) tan(pi xi / 2)) per quadrant, written as atan2(sqrt(n_u+1) sin 2 pi xi,
+# sqrt(n_v+1) cos 2 pi xi) (the same map over the four quadrants at once), cos theta_h =
+# xi'^(1/(n_u cos^2 phi_h + n_v sin^2 phi_h + 1)); h's density is p_h = sqrt((n_u+1)(n_v+1))/(2 pi)
+# (n.h)^(n_u cos^2 phi_h + n_v sin^2 phi_h) (eq. 6) and l = reflect(-v, h) has p_h / (4 (k.h)) (eq. 8).
+def sample(u: vec2, V: vec3, N: vec3, T: vec3, B: vec3, n_u: float, n_v: float) -> vec3:
+    a = TWO_PI * u.x
+    phi = atan2(sqrt(n_u + 1.0) * sin(a), sqrt(n_v + 1.0) * cos(a))
+    cp = cos(phi)
+    sp = sin(phi)
+    c = pow(u.y, 1.0 / (n_u * cp * cp + n_v * sp * sp + 1.0))
+    s = sqrt(max(1.0 - c * c, 0.0))
+    return reflect(-V, T * (s * cp) + B * (s * sp) + N * c)
+
+
+def pdf(L: vec3, V: vec3, N: vec3, T: vec3, B: vec3, n_u: float, n_v: float) -> float:
+    S = L + V
+    s2 = dot(S, S)
+    H = S * rsqrt(max(s2, 1e-30))
+    c = dot(N, H)
+    vh = dot(V, H)
+    tu = dot(H, T) * dot(H, T)
+    tv = dot(H, B) * dot(H, B)
+    # the exponent as the specular term writes it: (h.t)^2 + (h.b)^2 for 1 - (n.h)^2, n_u at h = n
+    e = (n_u * tu + n_v * tv) / (tu + tv) if tu + tv > 0.0 else n_u
+    ok = s2 > 0.0 and c > 0.0 and vh > 0.0 and dot(N, L) > 0.0
+    return sqrt((n_u + 1.0) * (n_v + 1.0)) * INV_TWO_PI * pow(c, e) / (4.0 * vh) if ok else 0.0

@@ -44,3 +44,62 @@ def specular(NdotL: float, NdotV: float, LdotT: float, VdotT: float, LdotB: floa
         t = pow(d, c.w) if d > 0.0 else (1.0 if c.w == 0.0 else 0.0)
         f += K[j] * t
     return f
+
+
+
+# Sampling (the contract: library/kinds.py). Lobe j is K_j (l.w_j)^n_j with w_j = (C_x v_x, C_y v_y, C_z v_z)
+# in the local frame (t, b, n), i.e. |w_j|^n_j times a cosine lobe about w_j / |w_j| (Lafortune et al. 1997
+# §4; Lafortune & Willems 1994): one lobe is picked with probability proportional to its integral over the
+# sphere, lum(K_j) |w_j|^n_j 2 pi / (n_j + 1) (lum: the mean of K's channels), by the first uniform, which is
+# then rescaled to [0, 1) within the lobe's share, and the cos^n_j sampler draws about w_j (Bikker 2017). The
+# density is the mixture: sum_j p_j (n_j + 1)/(2 pi) max(0, l.w_j/|w_j|)^n_j (the course's multi-layer rule).
+def lobe_axis(c: vec4, V: vec3, N: vec3, T: vec3, B: vec3) -> vec3:
+    return T * (c.x * dot(V, T)) + B * (c.y * dot(V, B)) + N * (c.z * clamp(dot(V, N), 0.0001, 1.0))
+
+
+def lobe_weight(c: vec4, k: vec3, w: vec3) -> float:
+    return (k.x + k.y + k.z) * pow(length(w), c.w) * TWO_PI / (c.w + 1.0) if dot(w, w) > 0.0 else 0.0
+
+
+def sample(u: vec2, V: vec3, N: vec3, T: vec3, B: vec3, lobes: array[vec4, 4], lobes_count: int,
+           K: array[vec3, 4]) -> vec3:
+    total = 0.0
+    for j in range(lobes_count):
+        total += lobe_weight(lobes[j], K[j], lobe_axis(lobes[j], V, N, T, B))
+    t = u.x * total
+    below = 0.0
+    axis = N
+    ux = u.x
+    n = 1.0
+    for j in range(lobes_count):
+        w = lobe_axis(lobes[j], V, N, T, B)
+        p = lobe_weight(lobes[j], K[j], w)
+        if p > 0.0 and t >= below and t < below + p:
+            axis = normalize(w)
+            ux = min((t - below) / p, 1.0)
+            n = lobes[j].w
+        below += p
+    c = pow(ux, 1.0 / (n + 1.0))
+    s = sqrt(max(1.0 - c * c, 0.0))
+    phi = TWO_PI * u.y
+    sg = 1.0 if axis.z >= 0.0 else -1.0
+    # an orthonormal frame about the axis (Duff et al. 2017, listing 3)
+    kk = -1.0 / (sg + axis.z)
+    bb = axis.x * axis.y * kk
+    e1 = vec3(1.0 + sg * axis.x * axis.x * kk, sg * bb, -sg * axis.x)
+    e2 = vec3(bb, sg + axis.y * axis.y * kk, -axis.y)
+    return e1 * (s * cos(phi)) + e2 * (s * sin(phi)) + axis * c
+
+
+def pdf(L: vec3, V: vec3, N: vec3, T: vec3, B: vec3, lobes: array[vec4, 4], lobes_count: int,
+        K: array[vec3, 4]) -> float:
+    total = 0.0
+    acc = 0.0
+    for j in range(lobes_count):
+        w = lobe_axis(lobes[j], V, N, T, B)
+        p = lobe_weight(lobes[j], K[j], w)
+        d = dot(L, w) * rsqrt(max(dot(w, w), 1e-30))
+        lobe = pow(d, lobes[j].w) if d > 0.0 else 0.0
+        total += p
+        acc += p * (lobes[j].w + 1.0) * INV_TWO_PI * lobe
+    return acc / total if total > 0.0 and dot(N, L) > 0.0 else 0.0

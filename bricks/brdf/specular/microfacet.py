@@ -27,3 +27,21 @@ def specular(NdotL: float, NdotV: float, NdotH: float, NxH2: float, VdotH: float
     D = ndf(NdotH, NxH2, alpha)
     Vis = vis(NdotL, NdotV, NdotH, VdotH, alpha)
     return fresnel(f0, VdotH) * (D * Vis)
+
+
+# Sampling (the contract: library/kinds.py): the NDF filler draws the half vector h (its sample_h; GGX by
+# visible normals, Heitz 2018; Beckmann and Blinn-Phong by D cos theta_h, Walter et al. 2007 eqs. 28-30) and
+# l = reflect(-v, h); the density of l is the density of h over 4 (v.h), the Jacobian of the reflection
+# (Walter et al. 2007 eq. 14). An NDF filler without sample_h makes this BRDF fall back to cosine-weighted
+# sampling (link/sampling.py says so).
+def sample(u: vec2, V: vec3, N: vec3, T: vec3, B: vec3, alpha: float) -> vec3:
+    return reflect(-V, ndf_sample_h(u, V, N, T, B, alpha))
+
+
+def pdf(L: vec3, V: vec3, N: vec3, T: vec3, B: vec3, alpha: float) -> float:
+    S = L + V
+    s2 = dot(S, S)
+    H = S * rsqrt(max(s2, 1e-30))
+    vh = dot(V, H)
+    ok = s2 > 0.0 and vh > 0.0 and dot(N, L) > 0.0
+    return ndf_pdf_h(H, V, N, T, B, alpha) / (4.0 * vh) if ok else 0.0

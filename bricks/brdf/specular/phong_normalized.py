@@ -23,3 +23,32 @@ def specular(RdotV: float, n: float, f0: vec3) -> vec3:
     # RdotV arrives clamped to [0, 1]: pow of a negative base is undefined, and a
     # dot slightly above 1 (fp32 rounding) would push the lobe above its peak.
     return f0 * ((n + 2.0) * INV_TWO_PI * pow(RdotV, n))
+
+
+# Sampling (the contract: library/kinds.py): the lobe (r.v)^n about the mirror direction r of v, by the
+# course's cos^alpha sampler (Bikker 2017, "Fixing Phong": z = xi^(1/(alpha+1)), phi = 2 pi xi'; Lafortune &
+# Willems 1994), whose density is (n + 1)/(2 pi) (r.l)^n per unit solid angle over the sphere. The course's
+# (alpha + 2)/(2 pi) cos^alpha is the BRDF's normalization, not this sampler's density (the test of a wrong
+# pdf uses it). The part of the lobe below the horizon is returned as drawn (the caller scores it 0): pdf
+# integrates to 1 minus that mass.
+def lobe_frame(a: vec3, x: float, y: float, z: float) -> vec3:
+    # (x, y, z) in an orthonormal frame about the unit axis a, with no branch on a reference axis (Duff et al.
+    # 2017, "Building an Orthonormal Basis, Revisited", listing 3)
+    s = 1.0 if a.z >= 0.0 else -1.0
+    k = -1.0 / (s + a.z)
+    b = a.x * a.y * k
+    t = vec3(1.0 + s * a.x * a.x * k, s * b, -s * a.x)
+    w = vec3(b, s + a.y * a.y * k, -a.y)
+    return t * x + w * y + a * z
+
+
+def sample(u: vec2, V: vec3, N: vec3, n: float) -> vec3:
+    c = pow(u.x, 1.0 / (n + 1.0))
+    s = sqrt(max(1.0 - c * c, 0.0))
+    phi = TWO_PI * u.y
+    return lobe_frame(reflect(-V, N), s * cos(phi), s * sin(phi), c)
+
+
+def pdf(L: vec3, V: vec3, N: vec3, n: float) -> float:
+    c = dot(reflect(-V, N), L)
+    return (n + 1.0) * INV_TWO_PI * pow(c, n) if c > 0.0 and dot(N, L) > 0.0 else 0.0

@@ -31,3 +31,34 @@ def ndf(NdotH: float, NxH2: float, alpha: float) -> float:
     a2 = max(alpha * alpha, ALPHA2_MIN)
     c2 = max(NdotH * NdotH, COS2_MIN)
     return exp(-NxH2 / (a2 * c2)) / (PI * a2 * c2 * c2)
+
+
+# Sampling (the contract: library/kinds.py): h drawn proportional to D(h) cos theta_h (Walter et al. 2007
+# eqs. 28-29; the anisotropic case as Walter 2005, "Notes on the Ward BRDF", eqs. 6-7), through the slopes:
+# the Beckmann slope density is the Gaussian exp(-(x^2/ax^2 + y^2/ay^2)) / (pi ax ay), so
+# (x/ax, y/ay) = sqrt(-log(1 - xi)) (cos 2 pi xi', sin 2 pi xi') and h = normalize(-x, -y, 1); the density
+# per unit solid angle of h is D(h) cos theta_h = exp(-tan^2 theta_h (cos^2 phi/ax^2 + sin^2 phi/ay^2)) /
+# (pi ax ay cos^3 theta_h). Not by visible normals: the mass the host's reflection sends below the horizon
+# is lost (the caller scores it 0) and the estimator's weight carries G.
+def slope_sample(u: vec2, N: vec3, T: vec3, B: vec3, ax: float, ay: float) -> vec3:
+    r = sqrt(-log(max(1.0 - u.x, 1e-30)))
+    phi = TWO_PI * u.y
+    return normalize(T * (-ax * r * cos(phi)) + B * (-ay * r * sin(phi)) + N)
+
+
+def slope_pdf(H: vec3, N: vec3, T: vec3, B: vec3, ax: float, ay: float) -> float:
+    c = dot(N, H)
+    x = dot(H, T) / ax
+    y = dot(H, B) / ay
+    c2 = max(c * c, COS2_MIN)
+    return exp(-min((x * x + y * y) / c2, 1000.0)) / (PI * ax * ay * c2 * c) if c > 0.0 else 0.0
+
+
+def sample_h(u: vec2, N: vec3, T: vec3, B: vec3, alpha: float) -> vec3:
+    a = sqrt(max(alpha * alpha, ALPHA2_MIN))
+    return slope_sample(u, N, T, B, a, a)
+
+
+def pdf_h(H: vec3, N: vec3, T: vec3, B: vec3, alpha: float) -> float:
+    a = sqrt(max(alpha * alpha, ALPHA2_MIN))
+    return slope_pdf(H, N, T, B, a, a)

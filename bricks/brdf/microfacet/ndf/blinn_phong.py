@@ -37,3 +37,22 @@ def ndf(NdotH: float, NxH2: float, alpha: float) -> float:
     x = NxH2
     ln_c2 = -x * (1.0 + x * (0.5 + x * (1.0 / 3.0 + x * 0.25))) if x < 0.01 else 2.0 * log(max(NdotH, COS_MIN))
     return (n + 2.0) * INV_TWO_PI * exp(0.5 * n * ln_c2)
+
+
+# Sampling (the contract: library/kinds.py): h drawn proportional to D(h) cos theta_h, the course's cos^alpha
+# sampler with alpha = n + 1 (Bikker 2017; Walter et al. 2007 eq. 30: cos theta_h = xi^(1/(n+2))), density
+# (n + 2)/(2 pi) (n.h)^(n+1) per unit solid angle of h.
+def sample_h(u: vec2, N: vec3, T: vec3, B: vec3, alpha: float) -> vec3:
+    a = max(alpha, ALPHA_MIN)
+    n = 2.0 / (a * a) - 2.0
+    c = pow(u.x, 1.0 / (n + 2.0))
+    s = sqrt(max(1.0 - c * c, 0.0))
+    phi = TWO_PI * u.y
+    return T * (s * cos(phi)) + B * (s * sin(phi)) + N * c
+
+
+def pdf_h(H: vec3, N: vec3, alpha: float) -> float:
+    a = max(alpha, ALPHA_MIN)
+    n = 2.0 / (a * a) - 2.0
+    c = dot(N, H)
+    return (n + 2.0) * INV_TWO_PI * pow(c, n + 1.0) if c > 0.0 else 0.0

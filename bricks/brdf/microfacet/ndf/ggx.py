@@ -30,3 +30,46 @@ def ndf(NdotH: float, NxH2: float, alpha: float) -> float:
     a2 = a * a
     d = a2 * NdotH * NdotH + NxH2
     return a2 / (PI * d * d)
+
+
+# Sampling (the contract: library/kinds.py): h drawn from the distribution of normals visible from v,
+# D_v(h) = G1(v) max(0, v.h) D(h) / (n.v) (Heitz 2018, "Sampling the GGX Distribution of Visible Normals",
+# JCGT 7(4), listing 1 and eq. 3), with Smith's G1(v) = 2 / (1 + sqrt(1 + (ax^2 v_t^2 + ay^2 v_b^2) / v_n^2))
+# (Heitz 2014 eqs. 43, 86). n.v is clamped at 1e-4 as the shading policy clamps it. The microfacet host
+# reflects v about h; directions it sends below the horizon are the masked part, which the caller scores 0.
+def vndf_sample(u: vec2, V: vec3, N: vec3, T: vec3, B: vec3, ax: float, ay: float) -> vec3:
+    vh = normalize(vec3(ax * dot(V, T), ay * dot(V, B), max(dot(V, N), 0.0001)))
+    lensq = vh.x * vh.x + vh.y * vh.y
+    t1 = vec3(-vh.y, vh.x, 0.0) * rsqrt(max(lensq, 1e-30)) if lensq > 0.0 else vec3(1.0, 0.0, 0.0)
+    t2 = cross(vh, t1)
+    r = sqrt(u.x)
+    phi = TWO_PI * u.y
+    p1 = r * cos(phi)
+    s = 0.5 * (1.0 + vh.z)
+    p2 = (1.0 - s) * sqrt(max(1.0 - p1 * p1, 0.0)) + s * (r * sin(phi))
+    nh = t1 * p1 + t2 * p2 + vh * sqrt(max(1.0 - p1 * p1 - p2 * p2, 0.0))
+    ne = normalize(vec3(ax * nh.x, ay * nh.y, max(nh.z, 0.0)))
+    return T * ne.x + B * ne.y + N * ne.z
+
+
+def vndf_pdf(H: vec3, V: vec3, N: vec3, T: vec3, B: vec3, ax: float, ay: float) -> float:
+    vn = max(dot(V, N), 0.0001)
+    vt = ax * dot(V, T)
+    vb = ay * dot(V, B)
+    g1 = 2.0 / (1.0 + sqrt(1.0 + (vt * vt + vb * vb) / (vn * vn)))
+    ht = dot(H, T) / ax
+    hb = dot(H, B) / ay
+    hn = dot(H, N)
+    d = ht * ht + hb * hb + hn * hn
+    vdh = dot(V, H)
+    return g1 * vdh / (PI * ax * ay * d * d * vn) if hn > 0.0 and vdh > 0.0 else 0.0
+
+
+def sample_h(u: vec2, V: vec3, N: vec3, T: vec3, B: vec3, alpha: float) -> vec3:
+    a = max(alpha, ALPHA_MIN)
+    return vndf_sample(u, V, N, T, B, a, a)
+
+
+def pdf_h(H: vec3, V: vec3, N: vec3, T: vec3, B: vec3, alpha: float) -> float:
+    a = max(alpha, ALPHA_MIN)
+    return vndf_pdf(H, V, N, T, B, a, a)
