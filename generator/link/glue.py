@@ -22,6 +22,7 @@ from ..spec.params import Params
 from ..spec.permutation import Node
 from ..spec.resolve import LightPart, Resolved, ResolvedBrdf
 from ..spec.surface import EMISSIVE_MAP
+from .faces import FACE_MATRICES, face_params, faced, faced_call
 from .interface import Slot, Texture, layout, texture_type
 from .irgen import Builder
 from .program import Program
@@ -145,8 +146,8 @@ class _Binder:
         self.uv: ir.Expr | None = None  # the packing's uv filler's result (uv_transform): what a read of uv gets
 
     def call(self, prog: Program, node: Node, fname: str, prefix: str, group: str, light: int | None,
-             locals_: dict[str, Type], args: dict[str, ir.Expr] | None = None) -> ir.Call:
-        f = prog.entry(node, fname)
+             locals_: dict[str, Type], args: dict[str, ir.Expr] | None = None, fn: ir.Function | None = None) -> ir.Call:
+        f = fn or prog.entry(node, fname)  # fn: a linker-made variant of the entry (link/faces.py)
         out = []
         for p in f.params:
             if args and p.name in args:
@@ -173,6 +174,11 @@ class _Binder:
                 self.params[prefix + p.name] = p.ty
                 out.append(self.b.var(prefix + p.name, p.ty, "param"))
         return self.b.call(f, out)
+
+    def param(self, name: str, ty: Type) -> ir.Var:
+        """shade()'s parameter `name` (a value of the Lights or Material block), bound."""
+        self.params[name] = ty
+        return self.b.var(name, ty, "param")
 
 
 def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
@@ -216,7 +222,12 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             cos = b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var(Li, VEC3))
             body_i.append(b.decl(f"NdotL{i}", cos))
             c = b.decl(f"c{i}", bind.call(prog, ln, "light_radiance", pre, "light", i, locals_, values))
-            s = b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_, values))
+            if faced(lt.brick.id, lt.textures):  # six faces: the face's matrix and layer (link/faces.py)
+                mats = [values[n] if values else bind.param(pre + n, MAT4) for n in FACE_MATRICES]
+                s = faced_call(b, bind, prog, sh, i, b.var(f"L{i}", VEC3), mats, lambda fn, a, sh=sh, pre=pre, i=i, v=values:
+                               bind.call(prog, sh, "", pre, "light", i, locals_, {**(v or {}), **a}, fn))
+            else:
+                s = [b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_, values))]
             brdf_args = []
             for n, t in bg.signature:
                 if n == "L":
@@ -237,7 +248,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             term = b.arith("*", b.arith("*", b.arith("*", b.named_const("PI"), f_r), b.var(f"c{i}", VEC3)),
                            b.arith("*", b.var(f"NdotL{i}", FLOAT), b.var(f"s{i}", FLOAT)))
             add = b.assign(b.var("Lo", VEC3), term, "+")
-            body_i.append(b.if_(b.compare(">", b.var(f"NdotL{i}", FLOAT), b.const(0.0)), [c, s, add]))
+            body_i.append(b.if_(b.compare(">", b.var(f"NdotL{i}", FLOAT), b.const(0.0)), [c, *s, add]))
             if dyn:
                 g = dynamic_lights[-1]
                 bound = b.intrinsic("buffer_length", UINT, ir.Var(g.ty, b.here(), g.name, "global"))
@@ -264,7 +275,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     material += [(f"m_{n}", n, None, sp.ty, sp) for n, sp in r.surface_params.items()]
     light_values = []
     for i, lt in enumerate(r.lights):
-        light_values.append([] if lt.dynamic else [(f"l{i}_{n}", k, e, ty, p) for n, k, e, ty, p in lt.params.flat])
+        light_values.append([] if lt.dynamic else [(f"l{i}_{n}", k, e, ty, p) for n, k, e, ty, p in face_params(lt).flat])
     values = [(n, t) for n, _, _, t, _ in material] + [(n, t) for vals in light_values for n, _, _, t, _ in vals]
     missing = [n for n in bind.params if n not in dict(values)]
     assert not missing, f"shade() binds {missing}, which no brick declares"

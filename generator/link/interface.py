@@ -16,7 +16,8 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass, field
 
-from ..lang.types import TEXTURE2D, TEXTURE2D_SHADOW, TEXTURECUBE, Type
+from ..lang import types
+from ..lang.types import Type
 from ..spec.params import ParamSpec
 
 VEC4_BYTES = 16
@@ -188,7 +189,7 @@ class Texture:
     param: str  # the brick's texture name
     group: str  # "material" | "light"
     srgb: bool
-    dim: str = "2d"  # "2d" | "cube"
+    dim: str = "2d"  # "2d" | "cube" | "2d_array" | "cube_array" (types.TEXTURE_DIMS; the manifest's dimension)
     light: int | None = None
     set: int = 0
     binding: int = 0
@@ -210,10 +211,9 @@ class Texture:
 
 
 def texture_type(dim: str, compare: bool = False) -> Type:
-    """The brick-language type of a texture of dimension `dim` ("2d", "cube"; compare: a 2D depth texture)."""
-    if compare:
-        return TEXTURE2D_SHADOW
-    return TEXTURECUBE if dim == "cube" else TEXTURE2D
+    """The brick-language type of a texture of dimension `dim` ("2d", "cube", "2d_array", "cube_array"; compare:
+    a 2D depth texture or an array of them)."""
+    return types.texture_type(dim, compare)
 
 
 def assign_bindings(textures: list[Texture], first: dict[str, int]) -> None:

@@ -35,14 +35,16 @@ Data (documented in docs/design/link.md, "The ubershader's data"; the manifest l
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 from ..lang import ir
-from ..lang.types import FLOAT, INT, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
+from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, arrayed_texture, storage_buffer, struct, vector
 from ..library.inputs import SURFACE
 from ..spec.permutation import Permutation
 from ..spec.resolve import Resolved, resolve
 from ..spec.where import KeyProblem, within
+from .faces import CUBE_TYPES, FACE_MATRICES, FACES, SHADOW_LAYER, arrayed_entry, face_select, faced
 from .glue import _Binder, brdf_glue, has_tangent, read_slot, shading_tangent
 from .interface import FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, layout
 from .irgen import Builder
@@ -88,6 +90,7 @@ class Uber:
     alpha_modes: list[str] = field(default_factory=list)  # the permutations' alpha modes, in ALPHA_IDS order
     double_sided: bool = False  # a permutation is double-sided: the main reverses N, T, B on back faces
     emissive: list[str] = field(default_factory=list)  # the permutations' emission modes, in EMISSIVE_IDS order
+    faced_shadows: list[str] = field(default_factory=list)  # filters whose maps are 2D arrays (link/faces.py)
 
     def interface(self, kernel: bool = False) -> Interface:
         """The ubershader's Interface: its buffers, the Draw block, textures, inputs and outputs."""
@@ -118,7 +121,17 @@ class Uber:
                                    "alpha_modes": dict(ALPHA_IDS), "emissive_modes": dict(EMISSIVE_IDS),
                                    **({"surface_at": self.surface_at} if self.surface_at is not None else {})},
                 "light_entry": {"ids": "ivec4 (light type, shadow, shadow map, 0)", "data_vec4s": self.light_vec4s,
-                                "shadow_parameters_at": self.light_split}}
+                                "shadow_parameters_at": self.light_split, **self._faces()}}
+
+    def _faces(self) -> dict:
+        """What a light entry of a point light's six faces holds (only when some filter reads them)."""
+        if not self.faced_shadows:
+            return {}
+        return {"ids": "ivec4 (light type, shadow, shadow map, 1 for a point light's six faces, else 0)",
+                "faced_shadows": list(self.faced_shadows),
+                "faces": "a faced filter's shadow maps are 2D arrays: a point light's six faces (ids.w = 1; "
+                         "shadow_matrix face 0's, shadow_matrix_1 ... _5 in its entry as light_layouts say), "
+                         "any other light's one map as layer 0"}
 
 
 def _zero(b: Builder, ty: Type) -> ir.Expr:
@@ -154,6 +167,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     shadows: list[str] = []
     lights, shadow_of = {}, {}  # light type -> its LightPart's params; shadow spec -> the filter's node, params
     shadowed = 0
+    faced_shadows: set[str] = set()  # the filters some point light reads six faces with (link/faces.py)
     alpha_variants: set[int] = set()  # the variants a masked or blended permutation uses
     modes, double_sided, emits = {"opaque"}, False, {"none"}
     for r in [p if isinstance(p, Resolved) else resolve(p, lib) for p in perms]:
@@ -174,6 +188,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
             if lk.shadow not in shadows:
                 shadows.append(lk.shadow)
                 shadow_of[lk.shadow] = (lt.shadow, lt.shadow_params)
+            if faced(lk.light, lt.textures):  # its filter's maps are arrays: a point light's six faces
+                faced_shadows.add(lk.shadow)
         shadowed = max(shadowed, sum(1 for lt in r.lights if lt.textures))
     prog, b = Program(lib_memo=lib.memo), Builder()
     bind = _Binder(b)
@@ -184,7 +200,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     snodes = {s: shadow_of[s][0] for s in shadows}
     A = max([1] + [_vec4s(lights[t][1]) for t in light_types])
     S = max([0] + [_vec4s(shadow_of[s][1]) for s in shadows])
-    K = A + max(S, 1)
+    F = 4 * (FACES - 1) if faced_shadows else 0  # the faces' matrices 1 … 5 after every filter's parameters
+    K = A + max(S, 1) + F
     mat_data, light_data = array(VEC4, M), array(VEC4, K)
     MaterialEntry = struct("MaterialEntry", (("ids", IVEC4), ("data", mat_data)))
     LightEntry = struct("LightEntry", (("ids", IVEC4), ("data", light_data)))
@@ -206,6 +223,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     for t in lnodes:
         for s in snodes:
             own = _packed(lights[t][1]) + _packed(shadow_of[s][1], A)
+            if t in CUBE_TYPES and s in faced_shadows:
+                own += _face_slots(shadow_of[s][1], A + max(S, 1))
             layouts[(t, s)] = {x.name: x for x in own}
 
     me = b.var("me", MaterialEntry)
@@ -258,7 +277,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         stmts.append(b.decl("Lo", b.construct(VEC3, b.const(0.0))))
         if lnodes:  # a scene without lights shades black: no loop, the light buffer is still bound
             stmts.append(_light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues,
-                                     packings, provided, material_args, variant, shadowed, twisted))
+                                     packings, provided, material_args, variant, shadowed, twisted, faced_shadows))
         if len(emits) > 1:
             stmts += emission(b, bind, me, mat_data, surface_at + 1, "texture" in emits, bool(any(uvs)))
         stmts.append(b.decl("color", b.construct(VEC4, b.const(0.0))))
@@ -304,7 +323,31 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
         tex.binding = nxt[tex.group]
         nxt[tex.group] += 2
     return Uber(prog, variants, light_types, shadows, shadowed, M, A, K, layouts, bind.textures, sig, surface, reads,
-                surface_at, [m for m in ALPHA_IDS if m in modes], double_sided, [m for m in EMISSIVE_IDS if m in emits])
+                surface_at, [m for m in ALPHA_IDS if m in modes], double_sided, [m for m in EMISSIVE_IDS if m in emits],
+                sorted(faced_shadows))
+
+
+def _face_slots(shadow_params, start: int) -> list[Slot]:
+    """Faces 1 … 5's matrices (FACE_MATRICES) packed from vec4 `start`, each like the filter's shadow_matrix."""
+    base = shadow_params["shadow_matrix"]
+    return layout([(n, n, None, base.ty, dataclasses.replace(base, name=n), None) for n in FACE_MATRICES[1:]],
+                  start)[0]
+
+
+def _faced_case(b, prog, bind, sn, sel, le, light_data, slots, args, call) -> list:
+    """The statements of filter `sn`'s case for arrays: face 0 and `shadow_matrix`, or where ids.w is 1 (a point
+    light's six faces) the face of -L and its matrix from the entry (`slots`: faces 1 … 5's), then `call(fn,
+    targs)` with the face as layer (link/faces.py)."""
+    m = b.var("shadow_m", MAT4)
+    pick = face_select(b, ir.Unary(VEC3, b.here(), "-", b.var("L", VEC3)), "cube_face")
+    pick.append(b.assign(b.var("face", INT), b.var("cube_face", INT)))
+    for k, n in enumerate(FACE_MATRICES[1:], 1):
+        pick.append(b.if_(b.compare("==", b.var("face", INT), ir.Const(INT, b.here(), k)),
+                          [b.assign(b.copy(m), read_slot(b, le, light_data, slots[n]))]))
+    return [b.decl("face", ir.Const(INT, b.here(), 0)), b.decl("shadow_m", b.copy(args["shadow_matrix"])),
+            b.if_(b.compare("==", sel("w"), ir.Const(INT, b.here(), 1)), pick),
+            call(arrayed_entry(prog, sn), {**args, "shadow_matrix": b.var("shadow_m", MAT4),
+                                           SHADOW_LAYER: b.var("face", INT)})]
 
 
 def _texture_types(node) -> dict[str, Type]:
@@ -324,7 +367,7 @@ def _vec4s(params) -> int:
 
 
 def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, layouts, glues, packings, provided,
-                material_args, variant, shadowed, twisted=False) -> ir.For:
+                material_args, variant, shadowed, twisted=False, faced_shadows=()) -> ir.For:
     """for i in range(buffer_length(light_buffer)): switch on light type, on shadow filter, on variant."""
     le = b.var("le", LightEntry)
     ids = ir.Member(IVEC4, b.here(), b.copy(le), "ids")
@@ -358,15 +401,24 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
                                                                        "light", None, {"N": VEC3}, args))])
             continue
         per_map = []
+        arrays = s in faced_shadows  # every map of this filter is a 2D array (one layer, or a point light's six)
+        if arrays:
+            textype = {t: arrayed_texture(ty) for t, ty in textype.items()}
+            faces_at = layouts[(next(t for t in lnodes if t in CUBE_TYPES), s)]
         for j in range(max(shadowed, 1)):
             targs = dict(args)
             for tex in texnames:
                 name = f"shadow{j}_{tex}"
                 if name not in {t.name for t in bind.textures}:
-                    bind.textures.append(Texture(name, tex, "light", False, "2d", j, compare=textype[tex].compare))
+                    bind.textures.append(Texture(name, tex, "light", False, textype[tex].dim, j,
+                                                 compare=textype[tex].compare))
                 targs[tex] = b.var(name, textype[tex], "param")
-            per_map.append([b.assign(b.var("s", FLOAT), bind.call(prog, sn, sn.brick.entries[0].name, "l_", "light",
-                                                                  None, {"N": VEC3}, targs))])
+            if arrays:
+                per_map.append(_faced_case(b, prog, bind, sn, sel, le, light_data, faces_at, targs, lambda fn, a: b.assign(
+                    b.var("s", FLOAT), bind.call(prog, sn, "", "l_", "light", None, {"N": VEC3}, a, fn))))
+            else:
+                per_map.append([b.assign(b.var("s", FLOAT), bind.call(prog, sn, sn.brick.entries[0].name, "l_",
+                                                                      "light", None, {"N": VEC3}, targs))])
         shadow_cases.append([_switch(b, sel("z"), per_map)])
     lit.append(_switch(b, sel("y"), shadow_cases))
     lit.append(b.decl("f", b.construct(VEC3, b.const(0.0))))

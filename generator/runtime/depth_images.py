@@ -83,3 +83,117 @@ class ComparisonSampler(Sampler):
 
     compare_op = "VK_COMPARE_OP_LESS_OR_EQUAL"
     border_color = "VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE"
+
+
+class LayeredImage(Image):
+    """One 2D array image whose layer k is a copy of `sources[k]`: drawn depth targets (their sampled image,
+    depth or the R32 copy) or moments targets (their blurred colour), all of one format and size — a point
+    light's six faces (runtime/shadow_pass.py). Each face is drawn by the depth pass as a light's one map is,
+    then copied into its layer on the device (vkCmdCopyImage: nothing goes through the host), so the pass and its
+    blur stay those of one map; the view is VK_IMAGE_VIEW_TYPE_2D_ARRAY over every layer, SHADER_READ_ONLY.
+    With `clear`, every layer is cleared to that value instead (sources give the format and size only: a lit
+    stand-in where no light's map is bound). Owned by its device: released by Device.close unless destroyed
+    earlier."""
+
+    def __init__(self, device: "Device", sources: list, clear: float | None = None):  # no super().__init__
+        vk = device.vk
+        first = [_attachment_of(s) for s in sources]
+        att = first[0]
+        self.device, self.srgb, self.cube, self.levels = device, False, False, 1
+        self.layers, self.width, self.height = len(sources), sources[0].width, sources[0].height
+        self.format, self.dtype = att.format, np.float32
+        self.depth_format, self.sampled = att.format, getattr(sources[0], "sampled", "depth")
+        texel = 16 if att.format == vk.VK_FORMAT_R32G32B32A32_SFLOAT else 4  # moments, or one depth
+        self.nbytes = texel * self.width * self.height * self.layers
+        self.layout = vk.VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
+        self.handle = self.memory = self.view = None
+        depth = att.format == getattr(vk, DEPTH_FORMAT)
+        aspect = vk.VK_IMAGE_ASPECT_DEPTH_BIT if depth else vk.VK_IMAGE_ASPECT_COLOR_BIT
+        dev = device.handle
+        try:
+            self.handle = vk.vkCreateImage(dev, vk.VkImageCreateInfo(
+                imageType=vk.VK_IMAGE_TYPE_2D, format=self.format,
+                extent=vk.VkExtent3D(width=self.width, height=self.height, depth=1), mipLevels=1,
+                arrayLayers=self.layers, samples=vk.VK_SAMPLE_COUNT_1_BIT, tiling=vk.VK_IMAGE_TILING_OPTIMAL,
+                usage=vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE, initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED), None)
+            req = vk.vkGetImageMemoryRequirements(dev, self.handle)
+            self.memory = vk.vkAllocateMemory(dev, vk.VkMemoryAllocateInfo(
+                allocationSize=req.size, memoryTypeIndex=device.local_memory_type(req.memoryTypeBits)), None)
+            vk.vkBindImageMemory(dev, self.handle, self.memory, 0)
+            self.view = vk.vkCreateImageView(dev, vk.VkImageViewCreateInfo(
+                image=self.handle, viewType=vk.VK_IMAGE_VIEW_TYPE_2D_ARRAY, format=self.format,
+                components=vk.VkComponentMapping(**dict.fromkeys("rgba", vk.VK_COMPONENT_SWIZZLE_IDENTITY)),
+                subresourceRange=vk.VkImageSubresourceRange(aspectMask=aspect, baseMipLevel=0, levelCount=1,
+                                                            baseArrayLayer=0, layerCount=self.layers)), None)
+            device.submit(lambda cmd: self._copy(cmd, first, aspect) if clear is None
+                          else self._clear(cmd, float(clear), aspect))
+        except BaseException:
+            self.destroy()
+            raise
+        device.own(self)
+
+    def _clear(self, cmd, value: float, aspect) -> None:
+        vk = self.device.vk
+        ignored, dst = vk.VK_QUEUE_FAMILY_IGNORED, vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL
+        rng = vk.VkImageSubresourceRange(aspectMask=aspect, baseMipLevel=0, levelCount=1, baseArrayLayer=0,
+                                         layerCount=self.layers)
+
+        def barrier(old, new, src, dst_access):
+            return vk.VkImageMemoryBarrier(srcAccessMask=src, dstAccessMask=dst_access, oldLayout=old, newLayout=new,
+                                           srcQueueFamilyIndex=ignored, dstQueueFamilyIndex=ignored,
+                                           image=self.handle, subresourceRange=rng)
+        vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, vk.VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                                None, 0, None, 1, [barrier(vk.VK_IMAGE_LAYOUT_UNDEFINED, dst, 0,
+                                                           vk.VK_ACCESS_TRANSFER_WRITE_BIT)])
+        if aspect == vk.VK_IMAGE_ASPECT_DEPTH_BIT:
+            vk.vkCmdClearDepthStencilImage(cmd, self.handle, dst, vk.VkClearDepthStencilValue(depth=value, stencil=0),
+                                           1, [rng])
+        else:
+            vk.vkCmdClearColorImage(cmd, self.handle, dst, vk.VkClearColorValue(float32=[value] * 4), 1, [rng])
+        vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TRANSFER_BIT, vk.VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0,
+                                0, None, 0, None, 1, [barrier(dst, self.layout, vk.VK_ACCESS_TRANSFER_WRITE_BIT,
+                                                              vk.VK_ACCESS_SHADER_READ_BIT)])
+
+    def _copy(self, cmd, sources, aspect) -> None:
+        vk = self.device.vk
+        ignored, read = vk.VK_QUEUE_FAMILY_IGNORED, vk.VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL
+        src_layout, dst_layout = vk.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL
+        shaders = vk.VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | vk.VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT
+        late = vk.VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT | vk.VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT
+
+        def rng(first, n):
+            return vk.VkImageSubresourceRange(aspectMask=aspect, baseMipLevel=0, levelCount=1, baseArrayLayer=first,
+                                              layerCount=n)
+
+        def barrier(image, old, new, src, dst, first=0, n=1):
+            return vk.VkImageMemoryBarrier(srcAccessMask=src, dstAccessMask=dst, oldLayout=old, newLayout=new,
+                                           srcQueueFamilyIndex=ignored, dstQueueFamilyIndex=ignored, image=image,
+                                           subresourceRange=rng(first, n))
+        pre = [barrier(s.handle, read, src_layout, vk.VK_ACCESS_SHADER_READ_BIT | vk.VK_ACCESS_TRANSFER_WRITE_BIT
+                       | vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, vk.VK_ACCESS_TRANSFER_READ_BIT) for s in sources]
+        pre.append(barrier(self.handle, vk.VK_IMAGE_LAYOUT_UNDEFINED, dst_layout, 0, vk.VK_ACCESS_TRANSFER_WRITE_BIT,
+                           0, self.layers))
+        vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TRANSFER_BIT | shaders | late,
+                                vk.VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, None, 0, None, len(pre), pre)
+        for k, s in enumerate(sources):
+            layers = [vk.VkImageSubresourceLayers(aspectMask=aspect, mipLevel=0, baseArrayLayer=x, layerCount=1)
+                      for x in (0, k)]
+            region = vk.VkImageCopy(srcSubresource=layers[0], srcOffset=vk.VkOffset3D(x=0, y=0, z=0),
+                                    dstSubresource=layers[1], dstOffset=vk.VkOffset3D(x=0, y=0, z=0),
+                                    extent=vk.VkExtent3D(width=self.width, height=self.height, depth=1))
+            vk.vkCmdCopyImage(cmd, s.handle, src_layout, self.handle, dst_layout, 1, [region])
+        post = [barrier(s.handle, src_layout, read, vk.VK_ACCESS_TRANSFER_READ_BIT, vk.VK_ACCESS_SHADER_READ_BIT)
+                for s in sources]
+        post.append(barrier(self.handle, dst_layout, read, vk.VK_ACCESS_TRANSFER_WRITE_BIT,
+                            vk.VK_ACCESS_SHADER_READ_BIT, 0, self.layers))
+        vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TRANSFER_BIT, shaders, 0, 0, None, 0, None,
+                                len(post), post)
+
+
+def _attachment_of(source):
+    """The image a drawn target (or an Image) is sampled through: .handle and .format."""
+    if hasattr(source, "_image"):  # a DepthTarget
+        return source._image
+    return getattr(source, "attachment", source)  # a target's colour view, or an Image itself
+

@@ -212,10 +212,14 @@ class Drawn:
     gpu_ms: float = 0.0
     pipeline_ms: float = 0.0
     units: list = field(default_factory=list)
+    layered: Image | None = None  # a point light's faces, copied into the layers of one array (what is sampled)
+    faces: list = field(default_factory=list)  # and each face's own Drawn
 
     @property
     def moments(self) -> Image | None:
         """The blurred moments as a sampled-image resource."""
+        if self.faces:
+            return self.layered if self.faces[0].blurred is not None else None
         return self.blurred.image if self.blurred is not None else None
 
 
@@ -247,6 +251,26 @@ class DepthPasses:
         p = self._own(GraphicsPipeline(self.device, target, self.spirv[(unit, "vert")], frag, iface.vertex_inputs,
                                        layouts_from_interface(iface), cache=self.cache))
         return p, (time.perf_counter() - t0) * 1e3
+
+    def draw_layers(self, desc: dict, matrices: list, eye, casters: list[Caster]) -> Drawn:
+        """Draw a light's pass once per matrix of `matrices` (column-major: its one shadow_matrix, or a point light's
+        six faces, desc["faces"]), each premultiplied for Vulkan as desc["matrix"] says; six faces are then
+        copied into the layers of one 2D array (depth_images.LayeredImage), which the returned Drawn's `depth`
+        (or `moments`) is."""
+        from .depth_images import LayeredImage
+
+        pre = np.asarray(desc["matrix"]["premultiply"]["vulkan"], np.float64)
+        drawn = [self.draw(desc, pre @ np.asarray(m, np.float64).reshape(4, 4).T, eye, casters) for m in matrices]
+        if "faces" not in desc:
+            return drawn[0]
+        moments = desc["kind"] == "moments"
+        sources = [d.blurred.image if moments else d.depth for d in drawn]
+        layered = self._own(LayeredImage(self.device, sources))
+        layered.sampled = "moments" if moments else drawn[0].depth.sampled
+        out = Drawn(depth=None if moments else layered, layered=layered, faces=drawn,
+                    gpu_ms=sum(d.gpu_ms for d in drawn), pipeline_ms=sum(d.pipeline_ms for d in drawn),
+                    units=list(dict.fromkeys(u for d in drawn for u in d.units)))
+        return out
 
     def draw(self, desc: dict, view_proj, eye, casters: list[Caster]) -> Drawn:
         """Draw one light's pass as `desc` (shadow_pass.depth_pass) says, every caster with Frame.view_proj =

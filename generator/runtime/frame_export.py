@@ -9,7 +9,8 @@ without running any of our Python. The layout is stated once, in the JSON Schema
 
 - ``DIR/frame.json``: the size, the colour attachment drawn into, the clear values, the camera (eye and
   view_proj), the meshes, the objects in the manifest's order (mesh, model matrix, mirrored), the order the
-  draws were made in, and per shadowed light its shadow_matrix, the pcf tap spacing the render wrote (or
+  draws were made in, and per shadowed light its shadow_matrix (a point light's: face 0's, with the six faces'
+  face_matrices, drawn into the six layers of its map in that order), the pcf tap spacing the render wrote (or
   null: the scene's own value is in the build's blocks), its map's size, the depth pass's camera_pos and its
   casters (the objects whose light set holds it: they alone are drawn into its map and fitted);
 - ``DIR/meshes/<name>.<sha12>.bin``: one file per distinct mesh, its vertex attributes back to back
@@ -107,7 +108,8 @@ def frame_document(export: FrameExport, mesh_rows: list[dict]) -> dict:
             "lights": {ln: {"shadow_matrix": _floats(v["shadow_matrix"]),
                             "pcf_texel": None if v["pcf_texel"] is None else float(v["pcf_texel"]),
                             "size": [int(x) for x in v["size"]], "eye": _floats(v["eye"]),
-                            "casters": [int(i) for i in v["casters"]]}
+                            "casters": [int(i) for i in v["casters"]],
+                            **({"face_matrices": [_floats(m) for m in v["faces"]]} if v.get("faces") else {})}
                        for ln, v in sorted(export.lights.items())}}
 
 

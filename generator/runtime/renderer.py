@@ -71,7 +71,8 @@ from pathlib import Path
 import numpy as np
 
 from .placement import load_placement, make_mesh
-from .shadow_pass import MOMENTS, PCF_TEXEL, SHADOW_SIZE, moments_map, shadow_textures  # noqa: F401 (re-exported)
+from ..link.faces import FACE_MATRICES, faced
+from .shadow_pass import MOMENTS, PCF_TEXEL, SHADOW_SIZE, face_values, moments_map, shadow_textures  # noqa: F401
 
 MODES = ("specialized", "ubershader", "hybrid")
 
@@ -161,8 +162,8 @@ def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict, texel
 
     data = np.frombuffer(raw, np.float32).copy()
     for s in slots:
-        if s.param == "shadow_matrix" and s.light is not None and lights[s.light] in matrices:
-            put(data, s, np.asarray(matrices[lights[s.light]], np.float32))
+        if s.param in FACE_MATRICES and s.light is not None and lights[s.light] in matrices:
+            put(data, s, np.asarray(face_values(matrices[lights[s.light]])[s.param], np.float32))
         if s.param == PCF_TEXEL and s.light is not None and lights[s.light] in (texels or {}):
             put(data, s, texels[lights[s.light]])
     return data.tobytes()
@@ -254,7 +255,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     cast_by = {ln: casters_of(scene, ln) for ln in shadowed}
     matrices, shadow_warnings = fit_lights(scene, placed, light_vals, cast_by)
     for ln in shadowed:
-        light_vals[ln]["shadow_matrix"] = matrices[ln]
+        light_vals[ln].update(face_values(matrices[ln]))  # a point light's six faces' (link/faces.py)
     # pcf's tap spacing: one texel of the map this render makes, unless the scene says otherwise
     texels = {ln: 1.0 / shadow_size for ln in shadowed
               if PCF_TEXEL in light_vals[ln] and PCF_TEXEL not in scene.lights[ln].params}
@@ -364,10 +365,10 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 casters.append(Caster(mesh_of[i], object_bufs[i], h, res))
             for ln in shadowed:
                 desc = passes_of[ln]
-                m = np.asarray(desc["matrix"]["premultiply"]["vulkan"]) @ np.asarray(matrices[ln]).reshape(4, 4).T
-                try:
-                    drawn = passes.draw(desc, m, np.append(caster_points(placed, cast_by[ln]).mean(0), 1.0),
-                                        [casters[i] for i in cast_by[ln]])
+                try:  # a point light's six faces, each drawn as one map and copied into its layer
+                    drawn = passes.draw_layers(desc, list(face_values(matrices[ln]).values()),
+                                               np.append(caster_points(placed, cast_by[ln]).mean(0), 1.0),
+                                               [casters[i] for i in cast_by[ln]])
                 except ShadowProblem as e:  # what the device cannot draw for this light's filter
                     raise light_where(scene, ln).error(f"light '{ln}': {e.message}", e.hint) from None
                 if drawn.depth is not None:
@@ -377,7 +378,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 report.shadow_maps[ln] = {"size": desc["size"], "gpu_ms": drawn.gpu_ms,
                                           "sampled": drawn.depth.sampled if drawn.depth is not None else "moments",
                                           "pipeline_ms": drawn.pipeline_ms, "depth_units": drawn.units,
-                                          "shadow_matrix": matrices[ln]}
+                                          "shadow_matrix": matrices[ln], "layers": len(drawn.faces) or 1}
 
         eye, vp = placed.camera(W, H)
         variant = {v.key: k for k, v in enumerate(u.variants)}
@@ -412,7 +413,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                 L = scene.lights[ln]
                 data = light_entry(u, L.type, L.shadow, light_vals[ln])
                 textured = bool(sampled[L.shadow])
-                ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), shadow_slot if textured else 0, 0))
+                ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), shadow_slot if textured else 0,
+                            int(faced(L.type, sampled[L.shadow]))))  # ids.w: a point light's six faces
                 if textured:
                     slot_lights[set_name].append(ln)
                 shadow_slot += textured
@@ -436,7 +438,21 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
 
         def stand_in(t):
             """A light texture no light's depth pass provides: the lit stand-in (a lit depth image if compared)."""
-            return depth_compared(None) if t.compare else textures[t.param]
+            return as_layers(t, depth_compared(None) if t.compare else textures[t.param], lit=True)
+
+        layered_once = {}  # a 2D map bound where an ubershader's filter reads arrays: a copy as one layer
+
+        def as_layers(t, image, lit=False):
+            """`image` as texture t declares it: itself, or (t a 2D array, image one map) a one-layer array of it
+            (lit: of its format and size, every texel 1, as the lit stand-ins are)."""
+            from .depth_images import LayeredImage
+
+            if t.dim != "2d_array" or getattr(image, "layers", 1) > 1 or isinstance(image, LayeredImage):
+                return image
+            if id(image) not in layered_once:
+                layered_once[id(image)] = LayeredImage(device, [image], clear=1.0 if lit else None)
+                owned.append(layered_once[id(image)])
+            return layered_once[id(image)]
 
         compared = {}  # a texture2d_shadow's sampler and lit stand-in, made on first use
 
@@ -496,7 +512,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for t in uber.interface.textures:  # the draw's material's textures and samplers, as the specialized path's
                 if t.group == "light":
                     slots = slot_lights[obj["light_set"]]
-                    res, smp = light_texture(t, slots[t.light]) if t.light < len(slots) else stand_in(t), sampler_of(t)
+                    res = as_layers(t, light_texture(t, slots[t.light])) if t.light < len(slots) else stand_in(t)
+                    smp = sampler_of(t)
                 else:
                     mtex.check_binding(obj["material"], t, ubershader=True)
                     res, smp = material_texture(t, obj["material"])
@@ -512,7 +529,9 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             from .frame_export import FrameExport, placed_meshes
             frame_export = FrameExport(scene.name, (W, H), attachment, clear, eye, gx.column_major(vp),
                                        *placed_meshes(placed.objects, key_of, cpu_meshes), draw_order=blended_last,
-                                       lights={ln: {"shadow_matrix": matrices[ln], "pcf_texel": texels.get(ln),
+                                       lights={ln: {"shadow_matrix": face_values(matrices[ln])["shadow_matrix"],
+                                                    "faces": matrices[ln] if "faces" in passes_of[ln] else None,
+                                                    "pcf_texel": texels.get(ln),
                                                     "size": passes_of[ln]["size"],
                                                     "eye": caster_points(placed, cast_by[ln]).mean(0),
                                                     "casters": cast_by[ln]}

@@ -456,8 +456,8 @@ class DepthTarget(_Target):
                     raise VulkanUnavailable(f"{device.name} can linearly filter neither {DEPTH_FORMAT} nor "
                                             "R32_SFLOAT: no shadow map to sample")
                 self.copy = _Attachment(device, r32, self.width, self.height,
-                                        vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                        vk.VK_IMAGE_ASPECT_COLOR_BIT)
+                                        vk.VK_IMAGE_USAGE_SAMPLED_BIT | vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT
+                                        | vk.VK_IMAGE_USAGE_TRANSFER_SRC_BIT, vk.VK_IMAGE_ASPECT_COLOR_BIT)
             self._create_render_pass()
             self.framebuffer = vk.vkCreateFramebuffer(dev, vk.VkFramebufferCreateInfo(
                 renderPass=self.render_pass, pAttachments=[self.depth.view], width=self.width, height=self.height,

@@ -30,9 +30,17 @@ the same way gets the same matrix), per light brick:
 
 - directional: an orthographic projection along its direction around the centre of the bounds, x and y padded
   by FIT_MARGIN of their extent, depth spanning them;
-- point, point_range: a perspective projection from its position toward the bounds' centre, its field of view
-  covering them up to ±FIT_MAX_HALF_ANGLE degrees (one map, not a cube: cube maps need cube or array textures,
-  which the brick language does not have yet);
+- point, point_range: six faces (:func:`cube_face_matrices`), one 90° perspective projection from its position per
+  cube face in Vulkan's order (+X, -X, +Y, -Y, +Z, -Z), each face's axes those of Vulkan's cube-map face (so the six
+  layers, bound as a cube view, are the cube an engine would sample by direction), all with one near and far: far =
+  the farthest bounds corner's distance × 1.02 + 1e-3, near = max(the distance to the nearest caster's world box
+  (the axis-aligned box of its corners; 0 inside it) × 0.98, far × 1e-3). The map is a texture2d_array of six
+  layers, not a cube texture: the shadow bricks stay as they are (they project P with a matrix and compare
+  depth), and 2D arrays exist in every target, GLSL ES 3.00/3.10 included, where cube arrays do not. The
+  linker (link/faces.py) gives such a light six matrices (`shadow_matrix` is face 0's, `shadow_matrix_1` …
+  `shadow_matrix_5` the others') and picks the face from the direction light → P (its major axis; ties to z,
+  then y), calling the filter with that face's matrix and the face as the layer. The depth pass draws the
+  casters once per face, each face into its layer (vsm: each layer's moments blurred alone);
 - spot: a perspective projection from its position along its `direction`, square, its half-angle the cone's
   (`outer_angle`: outside it the brick gives no light, so nothing there needs a shadow), the tangent widened by
   FIT_PADDING so that the edge texels and pcf's taps around the cone's rim stay inside the map, at most
@@ -49,15 +57,17 @@ axis-aligned bounding box in its own space, transformed by its model matrix (run
 Placement.points); `render` records the matrices it used in its report.
 
 The limit: a perspective map covers less than a half-space. Where a caster's bounds reach outside the map while
-the light may shine there (a point light among its casters, or casters beyond ±FIT_MAX_HALF_ANGLE of a spot's or
-uberlight's axis when its cone is wider), those parts are not shadowed correctly: :func:`uncovered` finds them,
-and `render` warns at the light's scene line (a warning, not a refusal: the map is right wherever it reaches,
-and a point light inside a room is common). What `render` cannot draw at all (a light type with no projection,
+the light may shine there (casters beyond ±FIT_MAX_HALF_ANGLE of a spot's or uberlight's axis when its cone is
+wider), those parts are not shadowed correctly: :func:`uncovered` finds them, and `render` warns at the light's
+scene line (a warning, not a refusal: the map is right wherever it reaches). A point light's six faces cover every
+direction, so it has no such warning. What `render` cannot draw at all (a light type with no projection,
 an axis of no length) is a :class:`ShadowProblem`, located at the light's scene line by :func:`light_where`.
 """
 from __future__ import annotations
 
 import numpy as np
+
+from ..link.faces import CUBE_TYPES, FACE_MATRICES, FACE_NAMES, FACES
 
 SHADOW_SIZE = 512  # the side of a light's map, in texels (render --shadow-size changes the renderer's)
 DEPTH_FORMAT = "D32_SFLOAT"
@@ -231,10 +241,60 @@ def _cone_matrix(light_type: str, values: dict, pts: np.ndarray, name: str) -> n
     return perspective(2.0 * np.degrees(np.arctan(ty)), tx / ty, near, far) @ view
 
 
+def _box_distance(eye: np.ndarray, pts: np.ndarray) -> float:
+    """The distance from eye to the nearest of the world boxes of pts' groups of 8 corners (one per caster; 0
+    inside one); pts not in groups of 8: the nearest point."""
+    if len(pts) % 8:
+        return float(np.linalg.norm(pts - eye, axis=1).min())
+    boxes = pts.reshape(-1, 8, 3)
+    gap = np.maximum(np.maximum(boxes.min(1) - eye, eye - boxes.max(1)), 0.0)
+    return float(np.linalg.norm(gap, axis=1).min())
+
+
+# Per cube face (Vulkan's order): its axis f and the view's x and y rows, so that the face's uv is Vulkan's
+# (s, t) of a cube-map lookup along the same direction (sc = x·r, tc = -(y·r): perspective flips y).
+_CUBE_AXES = (((1, 0, 0), (0, 0, -1), (0, 1, 0)), ((-1, 0, 0), (0, 0, 1), (0, 1, 0)),
+              ((0, 1, 0), (1, 0, 0), (0, 0, -1)), ((0, -1, 0), (1, 0, 0), (0, 0, 1)),
+              ((0, 0, 1), (1, 0, 0), (0, 1, 0)), ((0, 0, -1), (-1, 0, 0), (0, 1, 0)))
+
+
+def cube_face_matrices(position, points) -> list[np.ndarray]:
+    """World → light clip space (row-major, float64) of the six faces of a point light at `position` (Vulkan's
+    cube-face order), fitted to world `points` ((n, 3): every caster's 8 corners) as the module docstring says."""
+    from .camera import perspective
+
+    eye = np.asarray(position, np.float64).reshape(3)
+    pts = np.asarray(points, np.float64).reshape(-1, 3)
+    far = max(float(np.linalg.norm(pts - eye, axis=1).max()), 1e-3) * 1.02 + 1e-3
+    near = max(_box_distance(eye, pts) * 0.98, far * 1e-3)
+    proj = perspective(90.0, 1.0, near, far)
+    out = []
+    for f, x, y in _CUBE_AXES:
+        view = np.eye(4)
+        view[0, :3], view[1, :3], view[2, :3] = x, y, -np.asarray(f, np.float64)
+        view[:3, 3] = -view[:3, :3] @ eye
+        out.append(proj @ view)
+    return out
+
+
+def cube_face(direction) -> int:
+    """The face (layer) of direction light → P, as the linker's glue picks it (link/faces.py): its major axis,
+    ties to z, then y."""
+    r = np.asarray(direction, np.float64).reshape(3)
+    a = np.abs(r)
+    if a[2] >= a[0] and a[2] >= a[1]:
+        return 4 if r[2] >= 0 else 5
+    if a[1] >= a[0]:
+        return 2 if r[1] >= 0 else 3
+    return 0 if r[0] >= 0 else 1
+
+
 def fit_shadow_matrix(light_type: str, values: dict, points, name: str = "") -> np.ndarray:
     """World → light clip space (row-major, float64) of a light of `light_type` with parameters `values`, fitted
     to world `points` ((n, 3): the corners of every caster's bounds). The module docstring states the method; a
-    light it has no projection for is a ShadowProblem."""
+    light it has no projection for is a ShadowProblem. A point light's one map (±FIT_MAX_HALF_ANGLE toward its
+    casters) is what an unshadowed light or a caller without arrays gets; a shadowed one has six faces
+    (:func:`cube_face_matrices`)."""
     from .camera import directional_shadow_matrix, point_shadow_matrix
 
     pts = np.asarray(points, np.float64).reshape(-1, 3)
@@ -276,6 +336,14 @@ def uncovered(light_type: str, values: dict, matrix, points) -> np.ndarray:
     return out & lit
 
 
+def face_values(matrix) -> dict:
+    """{parameter: column-major matrix} a fitted light writes: {"shadow_matrix": m}, or a point light's six faces
+    ({FACE_MATRICES[k]: face k's}) where `matrix` is fit_lights' list of six."""
+    if isinstance(matrix[0], (list, tuple, np.ndarray)):
+        return dict(zip(FACE_MATRICES, matrix))
+    return {"shadow_matrix": matrix}
+
+
 def caster_points(placed, indices: list[int]) -> np.ndarray:
     """The corners of the bounds of placed objects `indices` (runtime/placement.Placement), (8 n, 3): a light's
     casters' bounds, what its fit covers."""
@@ -283,15 +351,19 @@ def caster_points(placed, indices: list[int]) -> np.ndarray:
 
 
 def fit_lights(scene, placed, values: dict, cast_by: dict[str, list[int]]) -> tuple[dict, list[str]]:
-    """({light: its shadow_matrix, column-major}, located warnings) of the shadowed lights `cast_by` ({light: its
-    casters' indices}) of `scene` placed as `placed`, their parameters `values`. A light the renderer cannot
-    project is a SourceError at its scene line; one whose map misses casters it may light is a warning there."""
+    """({light: its shadow_matrix, column-major; a point light's: its six faces' (a list of 6)}, located warnings) of
+    the shadowed lights `cast_by` ({light: its casters' indices}) of `scene` placed as `placed`, their parameters
+    `values`. A light the renderer cannot project is a SourceError at its scene line; one whose map misses
+    casters it may light is a warning there."""
     from .camera import column_major
 
     matrices, warnings = {}, []
     for ln, idx in cast_by.items():
         L = scene.lights[ln]
         pts = caster_points(placed, idx)
+        if L.type in CUBE_TYPES:
+            matrices[ln] = [column_major(m) for m in cube_face_matrices(values[ln]["position"], pts)]
+            continue
         try:
             m = fit_shadow_matrix(L.type, values[ln], pts, ln)
         except ShadowProblem as e:
@@ -300,20 +372,18 @@ def fit_lights(scene, placed, values: dict, cast_by: dict[str, list[int]]) -> tu
         missed = [placed.objects[i].name for i in idx
                   if uncovered(L.type, values[ln], m, placed.objects[i].corners()).any()]
         if missed:
-            cone = "" if L.type in ("point", "point_range") else " inside its cone"
-            param = {"point": "position", "point_range": "position"}.get(L.type, "direction")
-            w = light_where(scene, ln, param)
+            w = light_where(scene, ln, "direction")
             warnings.append(f"{w.path}:{w.line}:{w.col}: warning: light '{ln}': its one shadow map covers "
                             f"±{FIT_MAX_HALF_ANGLE:g}° about its axis, and the bounds of {', '.join(map(repr, missed))} "
-                            f"reach beyond{cone}: shadows there are not drawn correctly — keep the casters ahead of "
-                            "the light (a point light outside their bounds, a spot's cone narrower), or narrow its "
-                            "light sets (cube maps are not drawn yet)")
+                            "reach beyond inside its cone: shadows there are not drawn correctly — narrow its cone "
+                            "(outer_angle) or its light sets, or make it a point light (six faces)")
     return matrices, warnings
 
 
 # The fit's parameters as the manifest states them (depth_pass.matrix.fit; the method: the module docstring).
 FIT = {"directional": {"projection": "orthographic", "margin": FIT_MARGIN},
-       **{t: {"projection": "perspective", "max_half_angle_deg": FIT_MAX_HALF_ANGLE} for t in ("point", "point_range")},
+       **{t: {"projection": "cube_faces", "fov_deg": 90.0, "near": "nearest caster box", "far": "farthest corner"}
+          for t in ("point", "point_range")},
        **{t: {"projection": "perspective", "max_half_angle_deg": FIT_MAX_HALF_ANGLE, "padding": FIT_PADDING}
           for t in ("spot", "uberlight")}}
 # What the fit covers: the world-space corners of each caster's axis-aligned bounding box in its own space,
@@ -365,6 +435,9 @@ def depth_pass(light, textures: dict[str, bool], values: dict, units: dict, bind
                            "function": "generator.runtime.shadow_pass.fit_shadow_matrix"}}
     if PCF_TEXEL in values:
         d["texel"] = {"parameter": PCF_TEXEL, "value": values[PCF_TEXEL]}
+    if light.type in CUBE_TYPES:  # six faces in the layers of one 2D array (link/faces.py)
+        d["matrix"]["parameters"] = list(FACE_MATRICES)
+        d["faces"] = {"layers": FACES, "order": list(FACE_NAMES), "select": "major_axis", "passes": "per_layer"}
     d["binds"] = binds
     return d
 

@@ -9,10 +9,11 @@ casters' boxes (axis-aligned: their placed bounds), and compares with the render
 shadowed. Pixels within two shadow-map texels of the analytic shadow edge are left out: a floor point is far from
 the edge when every point of the floor whose map position lies 1 or 2 texels from its own (16 directions) has its
 shadow state. Of the rest at least 99 % must agree, for the spot (within its full-intensity cone), and for the same
-scene with a point light (one ±75° map fitted to the casters) or an uberlight (within its inner superellipse) in
+scene with a point light (six 90° faces in the layers of one array) or an uberlight (within its inner superellipse) in
 its place. The outsider's would-be shadow stays lit; the frame export lists the light's casters; a spot's and an
 uberlight's cone rims map just inside their maps. A spot whose direction has no length is refused at its scene
-line (path:line:col), and a point light among its casters' bounds is a warning located at the light.
+line (path:line:col); a spot whose cone is wider than its map (±75°) is a warning located at the light, and a
+point light among its casters' bounds is none (its six faces hold every direction).
 
 Measured on lavapipe (Mesa 25), 160 × 112, map 256²: the spot 100.00 % of 4,050 judged pixels agree (432 of them
 shadowed), the point light 100.00 % of 10,915 (368), the uberlight 100.00 % of 2,000 (365); the outsider's
@@ -126,7 +127,16 @@ def _floor_pixels(pl):
 
 
 def _far_from_edge(g, light, box, matrix, size):
-    """Which floor points' shadow state (by `box`) is that of every floor point 1 and 2 map texels from theirs."""
+    """Which floor points' shadow state (by `box`) is that of every floor point 1 and 2 map texels from theirs; a
+    point light's six faces (a list of six matrices): each point by its face's map (shadow_pass.cube_face)."""
+    if np.size(matrix) == 6 * 16:
+        from generator.runtime.shadow_pass import cube_face
+
+        faces = np.apply_along_axis(cube_face, -1, g - light)
+        out = np.zeros(faces.shape, bool)
+        for k, m in enumerate(matrix):
+            out |= (faces == k) & _far_from_edge(g, light, box, m, size)
+        return out
     s = np.asarray(matrix, np.float64).reshape(4, 4).T  # column-major → row-major
     inv = np.linalg.inv(s)
     state = _shadowed(g, light, box)
@@ -203,8 +213,9 @@ def test_a_spot_with_no_direction_is_refused_at_its_scene_line(device, lib, tmp_
     assert " — give the light a direction" in str(e.value)
 
 
-def test_a_point_light_among_its_casters_is_a_warning_at_its_line(lib, tmp_path):
-    """One ±75° map cannot hold what lies beside and behind a point light: a warning, located (no GPU needed)."""
+def test_a_wide_spot_is_a_warning_at_its_line_and_a_point_light_among_its_casters_is_not(lib, tmp_path):
+    """One ±75° map cannot hold a spot's cone of ±86°: a warning, located; a point light's six faces hold what lies
+    beside and behind it: none (no GPU needed)."""
     from generator.runtime.placement import load_placement
     from generator.runtime.shadow_pass import casters, fit_lights
     from generator.scene.load import load_scene
@@ -216,11 +227,17 @@ def test_a_point_light_among_its_casters_is_a_warning_at_its_line(lib, tmp_path)
         values = {"spot": {"position": position, "color": [1.0, 1.0, 1.0]}}
         return path, fit_lights(scene, load_placement(scene), values, {"spot": casters(scene, "spot")})[1]
 
-    path, warnings = point_at("among", [0.4, 0.8, 0.3])
+    assert point_at("among", [0.4, 0.8, 0.3])[1] == [], "six faces hold every direction"
+    assert point_at("above", [0.4, 4.0, 0.3])[1] == []
+    path = _copy(tmp_path, "wide", lambda line: line.replace("outer_angle = 0.65", "outer_angle = 1.5")
+                 .replace("position = [0.4, 4.0, 0.3]", "position = [0.4, 1.0, 0.3]"))
+    scene = load_scene(path, lib)
+    values = {"spot": {**scene.lights["spot"].params}}
+    warnings = fit_lights(scene, load_placement(scene), values, {"spot": casters(scene, "spot")})[1]
     row = next(i for i, x in enumerate(path.read_text().splitlines()) if x.startswith("params = { position")) + 1
-    assert len(warnings) == 1 and warnings[0].startswith(f"{path}:{row}:12: warning: light 'spot'"), warnings
-    assert "'floor'" in warnings[0] and "'outsider'" not in warnings[0]
-    assert point_at("above", [0.4, 4.0, 0.3])[1] == [], "a point light above its casters: one map holds them"
+    col = path.read_text().splitlines()[row - 1].index("direction") + 1
+    assert len(warnings) == 1 and warnings[0].startswith(f"{path}:{row}:{col}: warning: light 'spot'"), warnings
+    assert "'floor'" in warnings[0] and "'outsider'" not in warnings[0] and "±75°" in warnings[0]
 
 
 @pytest.mark.parametrize("kind", ["spot", "uberlight"])
