@@ -203,7 +203,10 @@ def _types_section() -> str:
     return ("\n## Types\n\n" + table(["kind", "types"], rows)
             + f"\nA buffer's element struct has only {leaves} leaves (directly, in nested structs or in fixed arrays "
             "of those), so std140, std430, HLSL and WGSL layouts agree byte for byte. A `texture2d_shadow` is a "
-            "depth texture read only through its comparison sampler, by `sample_compare`.\n")
+            "depth texture read only through its comparison sampler, by `sample_compare`. `texture2d_array`, "
+            "`texturecube_array` and `texture2d_array_shadow` are arrays of layers: each sampling intrinsic takes an "
+            "`int` or `uint` layer after the coordinate, clamped to [0, layers - 1] in every target (GLSL ES 3.10, "
+            "the gl platform's `essl` dialect, has no cube arrays).\n")
 
 
 def _intrinsics_section() -> str:

@@ -15,7 +15,8 @@ What is reflected
   ``acceleration_structure``. ``count`` is 1, N for an array of descriptors, 0 for a
   runtime-sized one. Images carry ``dim`` (``1d 2d 3d cube rect buffer subpass``),
   ``arrayed``, ``depth`` (None when SPIR-V says "unknown"), ``multisampled``,
-  ``sampled_type`` and ``format`` (storage images). Buffers and storage images carry
+  ``sampled_type`` and ``format`` (storage images); ``texture_dim`` is ``dim`` with ``_array`` when
+  arrayed, the manifest's texture ``dimension``. Buffers and storage images carry
   ``readonly`` (NonWritable on the variable or on every member) and ``writeonly``
   (NonReadable likewise). Blocks carry ``size`` and ``members``.
 - Members, recursively: ``offset`` (Offset), ``type`` as GLSL spells it (``float vec3
@@ -119,6 +120,14 @@ class Resource:
     writeonly: bool | None = None
     size: int | None = None    # blocks
     members: list[Member] = field(default_factory=list)
+
+    @property
+    def texture_dim(self) -> str | None:
+        """An image's dimension as the manifest's textures spell it: ``2d``, ``cube``, ``2d_array``,
+        ``cube_array`` (``dim`` with ``_array`` when arrayed); None for other resources."""
+        if self.dim is None:
+            return None
+        return f"{self.dim}_array" if self.arrayed else self.dim
 
 
 @dataclass

@@ -210,8 +210,13 @@ class Gl(Platform):
 
 def _gl_sampler(x: dict) -> str:
     if x["compare"]:
-        return "sampler2DShadow"
-    return {"2d": "sampler2D", "cube": "samplerCube"}[x["dimension"]]
+        return {"2d": "sampler2DShadow", "2d_array": "sampler2DArrayShadow"}[x["dimension"]]
+    return {"2d": "sampler2D", "cube": "samplerCube", "2d_array": "sampler2DArray",
+            "cube_array": "samplerCubeArray"}[x["dimension"]]
+
+
+# GPUTextureViewDimension of each texture dimension
+_VIEW_DIMENSIONS = {"2d": "2d", "cube": "cube", "2d_array": "2d-array", "cube_array": "cube-array"}
 
 
 class WebGpu(Platform):
@@ -238,7 +243,7 @@ class WebGpu(Platform):
             if k in ("uniform", "storage"):
                 return {"buffer": {"type": "uniform" if k == "uniform" else "read-only-storage"}}
             if k == "image":
-                return {"texture": {"sampleType": "depth" if x["compare"] else "float", "viewDimension": x["dimension"]}}
+                return {"texture": {"sampleType": "depth" if x["compare"] else "float", "viewDimension": _VIEW_DIMENSIONS[x["dimension"]]}}
             return {"sampler": {"type": "comparison" if x["compare"] else "filtering"}}
         return {"bind_groups": [{"group": s, "binding": b, "name": n, "visibility": [self._VISIBILITY[v] for v in st],
                                  **resource(k, x)} for k, s, b, n, st, x in resource_rows(iface)],

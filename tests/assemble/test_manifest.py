@@ -63,7 +63,7 @@ def _expected_resources(stage: dict) -> list[tuple]:
 
 def _reflected_resources(entry) -> list[tuple]:
     from generator.analysis.reflect import flatten_layout
-    return sorted((r.set, r.binding, r.kind, r.dim, r.size, tuple(flatten_layout(r.members)))
+    return sorted((r.set, r.binding, r.kind, r.texture_dim, r.size, tuple(flatten_layout(r.members)))
                   for r in entry.resources)
 
 
