@@ -5,23 +5,37 @@
 Every term takes the BRDF's whole parameter list (the eval program's order), bound by name, so one call
 shape serves every term. A term whose brick has no sampler, or whose slot filler lacks the sampling entry
 the host calls (a microfacet BRDF with an NDF that has no `sample_h`), is sampled cosine-weighted: this
-module decides it, and `SamplingProgram.how` says so per term. The lobe mixture (pick a term, pdf = the
-weighted sum of the terms' pdfs) is the caller's: the terms' selection weights are host values.
+module decides it, and `SamplingProgram.how` says so per term.
+
+The one-sample mixture over the terms (the lecture's multi-layer rule) is linked here too, as the kernel
+entries every target runs (`KERNELS`):
+- `sampling_sample(L, V, N, T, B, params..., mis_w0..mis_w7) -> vec3`: L carries the uniforms u3; u3.z picks
+  term k with probability w_k, u3.xy samples it;
+- `sampling_pdf(L, V, N, T, B, params..., mis_w0..mis_w7) -> vec3`: (Σ_k w_k pdf_k(L), 0, 0).
+Their signature is the eval kernel's (link.EvalProgram, tangent frame always passed), so the eval kernel
+machinery composes, compiles and runs them unchanged. The weights are host values: `mis_w<j>` holds up to 4
+terms' unnormalized weights at n·v = j/7, linearly interpolated in n·v (eval/sampling.py computes them
+from each term's directional albedo).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from ..lang import SourceError, ir, parse_module
-from ..lang.types import INT, VEC2, VEC3, Type
+from ..lang.types import FLOAT, INT, VEC2, VEC3, VEC4, Type
 from ..library.bricks import Library
 from ..library.kinds import KINDS
-from ..spec.params import Params
+from ..spec.params import Params, ParamSpec
 from ..spec.resolve import ResolvedBrdf, resolve_brdf
+from ..spec.where import spec_where
 from .irgen import Builder
 from .program import Program, function_name
 
 FRAME_ARGS = {"sample": ("u", VEC2), "pdf": ("L", VEC3)}
+KERNELS = {"sample": "sampling_sample", "pdf": "sampling_pdf"}  # the mixture's entries (eval-kernel shaped)
+MIS_VIEWS = 8  # view cosines n.v = j / (MIS_VIEWS - 1) at which the host tabulates the selection weights
+MIS_TERMS = 4  # terms one vec4 of weights holds: the GPU mixture's limit
+MIS_PARAMS = tuple(f"mis_w{j}" for j in range(MIS_VIEWS))
 
 # The fallback of a term without a sampler: cosine-weighted hemisphere sampling (Malley's method: a uniform
 # point of the unit disk, by u = (r², φ / 2π), lifted to the hemisphere; pdf = cos θ / π; pbrt-v3 §13.6.3).
@@ -51,6 +65,8 @@ class SamplingProgram:
     specs: Params
     how: tuple[str, ...]  # per term: "<brick id>: own sampler" or "<brick id>: cosine-weighted fallback (why)"
     signature: dict[str, list[tuple[str, Type]]]  # "sample" / "pdf": the glue functions' parameters
+    rb: ResolvedBrdf | None = None
+    kernel_specs: Params | None = None  # the BRDF's parameters then the weight table: the KERNELS' parameters
 
     @property
     def terms(self) -> int:
@@ -185,7 +201,99 @@ def sampling_program(spec: str | ResolvedBrdf, lib: Library) -> SamplingProgram:
         counts = {f"{a}_count": c for x in node.tree for a, c in x.counts}
         for what, f in entries.items():
             prog.add(b.function(f"{what}_{k}", sigs[what], f.ret, _body(b, f, sigs[what], params, counts, rb)))
-    return SamplingProgram(rb.key, prog, params, tuple(how), sigs)
+    kspecs = _mixture(prog, b, sigs, len(rb.nodes), rb)
+    return SamplingProgram(rb.key, prog, params, tuple(how), sigs, rb, kspecs)
+
+
+def _mixture(prog: Program, b: Builder, sigs, terms: int, rb: ResolvedBrdf) -> Params:
+    """Add the one-sample mixture over `terms` terms and its kernel entries (module docstring); its parameters."""
+    params = rb.params
+    clash = [n for n in MIS_PARAMS if n in params]
+    where = rb.where or spec_where(rb.text)
+    if clash:
+        raise where.error(f"parameter '{clash[0]}' of {params[clash[0]].owners[0]} has the name of the sampling "
+                          "mixture's weight table", "rename the brick parameter")
+    if terms > MIS_TERMS:
+        raise where.error(f"BRDF '{rb.key}' has {terms} terms and the sampling mixture takes at most {MIS_TERMS}",
+                          "sample such a BRDF term by term (term=k)")
+    frame = sigs["sample"][1:5]
+    flat = sigs["sample"][5:]
+    table = [(n, VEC4) for n in MIS_PARAMS]
+
+    def v(name, ty=VEC3):
+        return b.var(name, ty)
+
+    def comp(e, i):
+        return ir.Swizzle(FLOAT, b.here(), e, "xyzw"[i])
+
+    def clamp01(e):
+        return b.intrinsic("clamp", FLOAT, e, b.const(0.0), b.const(1.0))
+
+    def weights_body():  # piecewise-linear in n.v through the table's nodes: a chain of mixes, no indexing
+        x = b.arith("*", clamp01(b.intrinsic("dot", FLOAT, v("N"), v("V"))), b.const(MIS_VIEWS - 1))
+        stmts = [b.decl("x", x), b.decl("w", v(MIS_PARAMS[0], VEC4))]
+        for j in range(1, MIS_VIEWS):
+            t = b.construct(VEC4, clamp01(b.arith("-", v("x", FLOAT), b.const(j - 1))))
+            stmts.append(b.assign(v("w", VEC4), b.intrinsic("mix", VEC4, v("w", VEC4), v(MIS_PARAMS[j], VEC4), t)))
+        return stmts + [b.ret(v("w", VEC4))]
+
+    weights = prog.add(b.function("mis_weights", [("V", VEC3), ("N", VEC3)] + table, VEC4, weights_body))
+    pdfs = [prog.by_name[f"pdf_{k}"] for k in range(terms)]
+    samplers = [prog.by_name[f"sample_{k}"] for k in range(terms)]
+
+    def term_args(first):
+        return [first] + [v(n, t) for n, t in frame + flat]
+
+    def total(e_of):  # w.x + w.y + ... over the terms
+        out = e_of(0)
+        for k in range(1, terms):
+            out = b.arith("+", out, e_of(k))
+        return out
+
+    def pdf_body():  # Σ w_k pdf_k(L) / Σ w_k (a term of weight 0 adds nothing, whatever its pdf there)
+        w = v("w", VEC4)
+        scaled = total(lambda k: ir.Select(FLOAT, b.here(), b.compare(">", comp(w, k), b.const(0.0)),
+                                           b.arith("*", comp(w, k), b.call(pdfs[k], term_args(v("L")))),
+                                           b.const(0.0)))
+        return [b.ret(b.arith("/", scaled, total(lambda k: comp(w, k))))]
+
+    mix_sig = [("L", VEC3)] + frame + flat + [("w", VEC4)]
+    mis_pdf = prog.add(b.function("mis_pdf", mix_sig, FLOAT, pdf_body))
+
+    def sample_body():  # u3.z scaled by Σ w picks the first term whose running sum of weights exceeds it
+        w = v("w", VEC4)
+
+        def uv():
+            return ir.Swizzle(VEC2, b.here(), v("L"), "xy")
+
+        def running(k):  # w.x + ... + w[k]
+            out = comp(w, 0)
+            for i in range(1, k + 1):
+                out = b.arith("+", out, comp(w, i))
+            return out
+
+        stmts = [b.decl("c", b.arith("*", comp(v("L"), 2), total(lambda k: comp(w, k)))),
+                 b.decl("s", b.call(samplers[-1], term_args(uv())))]
+        for k in reversed(range(terms - 1)):  # the last assignment made is the smallest k with c < running(k)
+            stmts.append(b.if_(b.compare("<", v("c", FLOAT), running(k)),
+                               [b.assign(v("s"), b.call(samplers[k], term_args(uv())))]))
+        return stmts + [b.ret(v("s"))]
+
+    mis_sample = prog.add(b.function("mis_sample", mix_sig, VEC3, sample_body))
+    entry_sig = [("L", VEC3)] + frame + flat + table
+
+    def entry_body(f, wrap):
+        def body():
+            w = b.call(weights, [v("V"), v("N")] + [v(n, VEC4) for n in MIS_PARAMS])
+            return [b.ret(wrap(b.call(f, [v(n, t) for n, t in mix_sig[:-1]] + [w])))]
+        return body
+
+    prog.add(b.function(KERNELS["sample"], entry_sig, VEC3, entry_body(mis_sample, lambda e: e)))
+    prog.add(b.function(KERNELS["pdf"], entry_sig, VEC3,
+                        entry_body(mis_pdf, lambda e: b.construct(VEC3, e, b.const(0.0), b.const(0.0)))))
+    return Params(dict(params) | {n: ParamSpec(n, VEC4, [1.0, 0.0, 0.0, 0.0], None,
+                                              "sampling mixture weights at n.v = j/7 (host values)", ("<sampling>",))
+                                  for n in MIS_PARAMS})
 
 
 def _body(b: Builder, f: ir.Function, sig, params: Params, counts: dict[str, int], rb: ResolvedBrdf):
@@ -209,3 +317,17 @@ def _body(b: Builder, f: ir.Function, sig, params: Params, counts: dict[str, int
         return stmts
     return body
 
+
+
+def kernel_programs(sp: SamplingProgram) -> dict:
+    """The mixture's KERNELS as eval programs ("sample" / "pdf" -> link.EvalProgram): the eval kernel's
+    signature and parameter block (tangent frame passed), so compose.compose_eval and runtime.eval_kernel
+    compose, compile and run them as they do a BRDF."""
+    from . import EvalProgram, _eval_interface
+
+    rb = sp.rb
+    sig = [("L", VEC3)] + sp.signature["sample"][1:5] + [(n, t) for n, _, _, t, _ in sp.kernel_specs.flat]
+    slots, count, iface = _eval_interface(sp.kernel_specs, ["L", "V", "N", "T", "B"], [], [rb])
+    return {what: EvalProgram(f"{sp.spec};sampling={what}", list(rb.nodes), sp.program, sp.kernel_specs, sig, slots,
+                              count, True, iface, entry=entry)
+            for what, entry in KERNELS.items()}
