@@ -216,84 +216,86 @@ def _mixture(prog: Program, b: Builder, sigs, terms: int, rb: ResolvedBrdf) -> P
     if terms > MIS_TERMS:
         raise where.error(f"BRDF '{rb.key}' has {terms} terms and the sampling mixture takes at most {MIS_TERMS}",
                           "sample such a BRDF term by term (term=k)")
-    frame = sigs["sample"][1:5]
-    flat = sigs["sample"][5:]
-    table = [(n, VEC4) for n in MIS_PARAMS]
-
-    def v(name, ty=VEC3):
-        return b.var(name, ty)
-
-    def comp(e, i):
-        return ir.Swizzle(FLOAT, b.here(), e, "xyzw"[i])
-
-    def clamp01(e):
-        return b.intrinsic("clamp", FLOAT, e, b.const(0.0), b.const(1.0))
-
-    def weights_body():  # piecewise-linear in n.v through the table's nodes: a chain of mixes, no indexing
-        x = b.arith("*", clamp01(b.intrinsic("dot", FLOAT, v("N"), v("V"))), b.const(MIS_VIEWS - 1))
-        stmts = [b.decl("x", x), b.decl("w", v(MIS_PARAMS[0], VEC4))]
-        for j in range(1, MIS_VIEWS):
-            t = b.construct(VEC4, clamp01(b.arith("-", v("x", FLOAT), b.const(j - 1))))
-            stmts.append(b.assign(v("w", VEC4), b.intrinsic("mix", VEC4, v("w", VEC4), v(MIS_PARAMS[j], VEC4), t)))
-        return stmts + [b.ret(v("w", VEC4))]
-
-    weights = prog.add(b.function("mis_weights", [("V", VEC3), ("N", VEC3)] + table, VEC4, weights_body))
-    pdfs = [prog.by_name[f"pdf_{k}"] for k in range(terms)]
-    samplers = [prog.by_name[f"sample_{k}"] for k in range(terms)]
-
-    def term_args(first):
-        return [first] + [v(n, t) for n, t in frame + flat]
-
-    def total(e_of):  # w.x + w.y + ... over the terms
-        out = e_of(0)
-        for k in range(1, terms):
-            out = b.arith("+", out, e_of(k))
-        return out
-
-    def pdf_body():  # Σ w_k pdf_k(L) / Σ w_k (a term of weight 0 adds nothing, whatever its pdf there)
-        w = v("w", VEC4)
-        scaled = total(lambda k: ir.Select(FLOAT, b.here(), b.compare(">", comp(w, k), b.const(0.0)),
-                                           b.arith("*", comp(w, k), b.call(pdfs[k], term_args(v("L")))),
-                                           b.const(0.0)))
-        return [b.ret(b.arith("/", scaled, total(lambda k: comp(w, k))))]
-
-    mix_sig = [("L", VEC3)] + frame + flat + [("w", VEC4)]
-    mis_pdf = prog.add(b.function("mis_pdf", mix_sig, FLOAT, pdf_body))
-
-    def sample_body():  # u3.z scaled by Σ w picks the first term whose running sum of weights exceeds it
-        w = v("w", VEC4)
-
-        def uv():
-            return ir.Swizzle(VEC2, b.here(), v("L"), "xy")
-
-        def running(k):  # w.x + ... + w[k]
-            out = comp(w, 0)
-            for i in range(1, k + 1):
-                out = b.arith("+", out, comp(w, i))
-            return out
-
-        stmts = [b.decl("c", b.arith("*", comp(v("L"), 2), total(lambda k: comp(w, k)))),
-                 b.decl("s", b.call(samplers[-1], term_args(uv())))]
-        for k in reversed(range(terms - 1)):  # the last assignment made is the smallest k with c < running(k)
-            stmts.append(b.if_(b.compare("<", v("c", FLOAT), running(k)),
-                               [b.assign(v("s"), b.call(samplers[k], term_args(uv())))]))
-        return stmts + [b.ret(v("s"))]
-
-    mis_sample = prog.add(b.function("mis_sample", mix_sig, VEC3, sample_body))
-    entry_sig = [("L", VEC3)] + frame + flat + table
-
-    def entry_body(f, wrap):
-        def body():
-            w = b.call(weights, [v("V"), v("N")] + [v(n, VEC4) for n in MIS_PARAMS])
-            return [b.ret(wrap(b.call(f, [v(n, t) for n, t in mix_sig[:-1]] + [w])))]
-        return body
-
-    prog.add(b.function(KERNELS["sample"], entry_sig, VEC3, entry_body(mis_sample, lambda e: e)))
-    prog.add(b.function(KERNELS["pdf"], entry_sig, VEC3,
-                        entry_body(mis_pdf, lambda e: b.construct(VEC3, e, b.const(0.0), b.const(0.0)))))
+    _Mixture(prog, b, sigs, terms).add()
     return Params(dict(params) | {n: ParamSpec(n, VEC4, [1.0, 0.0, 0.0, 0.0], None,
                                               "sampling mixture weights at n.v = j/7 (host values)", ("<sampling>",))
                                   for n in MIS_PARAMS})
+
+
+class _Mixture:
+    """Builds the mixture's functions as IR: mis_weights, mis_pdf, mis_sample and the two kernel entries."""
+
+    def __init__(self, prog: Program, b: Builder, sigs, terms: int):
+        self.prog, self.b, self.terms = prog, b, terms
+        self.frame, self.flat = sigs["sample"][1:5], sigs["sample"][5:]
+        self.table = [(n, VEC4) for n in MIS_PARAMS]
+        self.mix_sig = [("L", VEC3)] + self.frame + self.flat + [("w", VEC4)]
+
+    def v(self, name, ty=VEC3):
+        return self.b.var(name, ty)
+
+    def comp(self, e, i):
+        return ir.Swizzle(FLOAT, self.b.here(), e, "xyzw"[i])
+
+    def clamp01(self, e):
+        return self.b.intrinsic("clamp", FLOAT, e, self.b.const(0.0), self.b.const(1.0))
+
+    def total(self, e_of, upto=None):  # e_of(0) + ... + e_of(upto) (every term by default)
+        out = e_of(0)
+        for k in range(1, (self.terms - 1 if upto is None else upto) + 1):
+            out = self.b.arith("+", out, e_of(k))
+        return out
+
+    def term_args(self, first):
+        return [first] + [self.v(n, t) for n, t in self.frame + self.flat]
+
+    def weights_body(self):  # piecewise-linear in n.v through the table's nodes: a chain of mixes, no indexing
+        b, v = self.b, self.v
+        x = b.arith("*", self.clamp01(b.intrinsic("dot", FLOAT, v("N"), v("V"))), b.const(MIS_VIEWS - 1))
+        stmts = [b.decl("x", x), b.decl("w", v(MIS_PARAMS[0], VEC4))]
+        for j in range(1, MIS_VIEWS):
+            t = b.construct(VEC4, self.clamp01(b.arith("-", v("x", FLOAT), b.const(j - 1))))
+            stmts.append(b.assign(v("w", VEC4), b.intrinsic("mix", VEC4, v("w", VEC4), v(MIS_PARAMS[j], VEC4), t)))
+        return stmts + [b.ret(v("w", VEC4))]
+
+    def pdf_body(self):  # Σ w_k pdf_k(L) / Σ w_k (a term of weight 0 adds nothing, whatever its pdf there)
+        b, w = self.b, self.v("w", VEC4)
+        pdfs = [self.prog.by_name[f"pdf_{k}"] for k in range(self.terms)]
+        scaled = self.total(lambda k: ir.Select(FLOAT, b.here(), b.compare(">", self.comp(w, k), b.const(0.0)),
+                                                b.arith("*", self.comp(w, k), b.call(pdfs[k], self.term_args(self.v("L")))),
+                                                b.const(0.0)))
+        return [b.ret(b.arith("/", scaled, self.total(lambda k: self.comp(w, k))))]
+
+    def sample_body(self):  # u3.z scaled by Σ w picks the first term whose running sum of weights exceeds it
+        b, w = self.b, self.v("w", VEC4)
+        samplers = [self.prog.by_name[f"sample_{k}"] for k in range(self.terms)]
+
+        def uv():
+            return ir.Swizzle(VEC2, b.here(), self.v("L"), "xy")
+
+        stmts = [b.decl("c", b.arith("*", self.comp(self.v("L"), 2), self.total(lambda k: self.comp(w, k)))),
+                 b.decl("s", b.call(samplers[-1], self.term_args(uv())))]
+        for k in reversed(range(self.terms - 1)):  # the last assignment made is the smallest k with c < w.x+..+w[k]
+            stmts.append(b.if_(b.compare("<", self.v("c", FLOAT), self.total(lambda i: self.comp(w, i), k)),
+                               [b.assign(self.v("s"), b.call(samplers[k], self.term_args(uv())))]))
+        return stmts + [b.ret(self.v("s"))]
+
+    def add(self) -> None:
+        b, prog = self.b, self.prog
+        weights = prog.add(b.function("mis_weights", [("V", VEC3), ("N", VEC3)] + self.table, VEC4, self.weights_body))
+        mis_pdf = prog.add(b.function("mis_pdf", self.mix_sig, FLOAT, self.pdf_body))
+        mis_sample = prog.add(b.function("mis_sample", self.mix_sig, VEC3, self.sample_body))
+        entry_sig = [("L", VEC3)] + self.frame + self.flat + self.table
+
+        def entry_body(f, wrap):
+            def body():
+                w = b.call(weights, [self.v("V"), self.v("N")] + [self.v(n, VEC4) for n in MIS_PARAMS])
+                return [b.ret(wrap(b.call(f, [self.v(n, t) for n, t in self.mix_sig[:-1]] + [w])))]
+            return body
+
+        prog.add(b.function(KERNELS["sample"], entry_sig, VEC3, entry_body(mis_sample, lambda e: e)))
+        prog.add(b.function(KERNELS["pdf"], entry_sig, VEC3,
+                            entry_body(mis_pdf, lambda e: b.construct(VEC3, e, b.const(0.0), b.const(0.0)))))
 
 
 def _body(b: Builder, f: ir.Function, sig, params: Params, counts: dict[str, int], rb: ResolvedBrdf):

@@ -101,10 +101,11 @@ class Result:
 
 
 def chi2_test(sample, pdf, frame: Frame, n_samples: int, seed: int, n_theta: int = 16, n_phi: int = 32,
-              q: int = 8) -> Result:
-    """Histogram `sample(u)` (u uniform (n, 2)) against `pdf(L)` over the grid, q × q quadrature nodes a cell (lobes
-    narrow in φ near the horizon need more); see the module docstring."""
-    u = np.random.default_rng(seed).random((n_samples, 2))
+              q: int = 8, dims: int = 2) -> Result:
+    """Histogram `sample(u)` (u uniform (n, dims): 3 for a mixture, whose third picks the term) against `pdf(L)`
+    over the grid, q × q quadrature nodes a cell (lobes narrow in φ near the horizon need more); see the module
+    docstring."""
+    u = np.random.default_rng(seed).random((n_samples, dims))
     L = sample(u)
     up = L @ frame.N > 0.0
     theta, phi = frame.angles(L[up])

@@ -185,7 +185,7 @@ def test_pdf_at_the_samples_is_the_density_the_sampler_draws_from():
         assert np.all(np.isfinite(p)) and np.all(p[up] > 0), spec
 
 
-def _albedo_quadrature(spec, params, fr: Frame, n: int = 192) -> float:
+def _albedo_quadrature(spec, params, fr: Frame, n: int = 192, channel: int = 0) -> float:
     x, w = np.polynomial.legendre.leggauss(n)
     mu, wm = (x + 1) / 2, w / 2
     phi, wp = (x + 1) * math.pi, w * math.pi
@@ -193,7 +193,7 @@ def _albedo_quadrature(spec, params, fr: Frame, n: int = 192) -> float:
     s = np.sqrt(1 - M ** 2)
     L = fr.world((s * np.cos(P)).reshape(-1), (s * np.sin(P)).reshape(-1), M.reshape(-1))
     f = evaluate(spec, L, np.broadcast_to(fr.V, L.shape), np.broadcast_to(fr.N, L.shape),
-                 T=np.broadcast_to(fr.T, L.shape), params=params, target="numpy")[:, 0]
+                 T=np.broadcast_to(fr.T, L.shape), params=params, target="numpy")[:, channel]
     return float(np.sum(f * M.reshape(-1) * (wm[:, None] * wp[None, :]).reshape(-1)))
 
 
