@@ -166,19 +166,20 @@ class _Build:
         kept = {h: e for h in sorted(scene.permutations) if (e := self.old.get(h)) is not None
                 and e.get("input_key") == keys.permutations[h] and e.get("status") == "ok" and self.intact(e, h)}
         old_uber = self.previous.get("ubershader") or {}
-        uber_kept = (old_uber.get("input_key") == keys.ubershader and old_uber.get("status") == "ok"
+        uber_kept = (scene.ubershader and old_uber.get("input_key") == keys.ubershader and old_uber.get("status") == "ok"
                      and self.intact(old_uber, "ubershader"))
         self.uber_kept = uber_kept  # the record keeps the last build's templates for it (it is not composed)
         self.kept = set(kept)  # what the explanation of this build leaves out (inputs.py)
         todo = {h: p for h, p in scene.permutations.items() if h not in kept}
         remote = in_workers(self.ctx, len(todo))  # then the ubershader is composed where the chunks are
-        uber_unit = None if uber_kept or remote else compose_ubershader(scene, self.ctx.library, self.ctx.languages)
+        uber_unit = None if uber_kept or remote or not scene.ubershader else \
+            compose_ubershader(scene, self.ctx.library, self.ctx.languages)
         extra = []
         if isinstance(uber_unit, tuple):
             extra = source_jobs("ubershader", uber_unit[0].sources)
             res.templates.update(uber_unit[0].templates)
         compiled = compile_permutations(self.ctx, todo, extra, self._written, res.compile, res.costs, self.entries,
-                                        ubershader=remote and not uber_kept)
+                                        ubershader=remote and not uber_kept and scene.ubershader)
         res.templates.update(compiled.templates)
         res.shaders = {k: (r.cache_key, r.seconds) for k, r in compiled.results.items()}
         res.kept = len(kept)

@@ -217,6 +217,27 @@ def compose_ubershader(scene: Scene, lib, languages):
         return str(e)
 
 
+# Past this many material variants one ubershader is a shader no engine wants to wait for, and its compile grows
+# faster than the variants do: measured on this machine, the 10,000-permutation generated scene's 9,526 variants
+# made 12 MB of GLSL (38 MB of SPIR-V) whose glslc and spirv-opt were still running after 45 minutes each, where
+# the 1,000-permutation benchmark scene's take up to a minute a shader (benchmarks/results/build.md).
+UBER_VARIANTS_WARN = 1000
+
+
+def ubershader_warning(scene: Scene) -> str | None:
+    """A located warning when the scene's ubershader would stand in for more than UBER_VARIANTS_WARN material
+    variants ((BRDF, packing, output) combinations: link/uber.py Variant.key); None otherwise or when it is off."""
+    if not scene.ubershader:
+        return None
+    variants = len({(p.brdf, p.packing, p.output) for p in scene.permutations.values()})
+    if variants <= UBER_VARIANTS_WARN:
+        return None
+    line, col = scene.head_at
+    return (f"{scene.path}:{line}:{col}: the ubershader would hold {variants:,} material variants in one shader, "
+            f"whose compile grows faster than their number (more than {UBER_VARIANTS_WARN:,} is slow to compile) — "
+            "set `ubershader = false` in [scene] where no engine draws this scene's fallback, or split the scene")
+
+
 class _Counts:
     """The part of a BuildResult a Recorder's Writer methods touch: the costs (the chunk's), nothing counted."""
 

@@ -75,6 +75,7 @@ class Scene:
     extra: dict = field(default_factory=dict)  # an importer's own data: glTF's extensions and pygltflib document
     # light set name -> DynamicSet (scene/light_sets.py): the sets whose lights a loop reads from buffers
     dynamic_sets: dict[str, DynamicSet] = field(default_factory=dict)
+    ubershader: bool = True  # [scene] ubershader = false: build ships no fallback ubershader (assemble/entries.py ubershader_warning)
 
 
 def read_toml(path: Path, what: str, syntax_hint: str, limit: int = MAX_INPUT_BYTES) -> tuple[dict, "Locator"]:
@@ -127,7 +128,8 @@ def _load_toml(path: Path, lib: Library) -> Scene:
     if lib.get("output", output) is None:
         raise loc.error(loc.find("scene", "output"), f"unknown output brick '{output}'",
                         f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
-    scene = Scene(path, head.get("name", path.stem), output, precision, {}, {}, {}, [], head_at=(loc.top("scene")[0], 1))
+    scene = Scene(path, head.get("name", path.stem), output, precision, {}, {}, {}, [], head_at=(loc.top("scene")[0], 1),
+                  ubershader=head.get("ubershader", True))
 
     def at(*where) -> Where:
         return Where(shown, *loc.find(*where))

@@ -193,6 +193,8 @@ def run(args) -> int:
                 for e in lib.errors]  # what the scene reaches has loaded (resolving it raises a broken brick's error)
     from ...spec.resolve import fp16_warnings
     warnings += fp16_warnings(scene.permutations.values(), lib)  # bricks marked "fp16": "unsafe: ..."
+    from ...assemble.entries import ubershader_warning
+    warnings += [w for w in [ubershader_warning(scene)] if w]
     for w in warnings:
         print(f"warning: {w}", file=sys.stderr)
     if request is not None:
