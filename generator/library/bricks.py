@@ -31,7 +31,8 @@ BUILTIN_BRICKS = _INSTALLED_BRICKS if _INSTALLED_BRICKS.is_dir() else REPO / "br
 
 
 PARAM_TYPES = ("float", "vec2", "vec3", "vec4", "mat4")
-META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc", "fp16", "tolerance", "encodes"}
+META_KEYS = {"kind", "params", "slots", "needs", "cite", "textures", "doc", "fp16", "tolerance", "encodes",
+             "reciprocal"}
 
 
 @dataclass
@@ -69,6 +70,8 @@ class Brick:
     # the sampling entries (sample, pdf; an NDF's sample_h, pdf_h) and the helpers only they call, in file order:
     # kept out of `module` so that shading programs never link them (library/sampling.py)
     sampling: dict[str, ir.Function] = field(default_factory=dict)
+    # "no: why" where the model is not reciprocal (plausibility skips that check, saying why); "" otherwise
+    reciprocal: str = ""
 
     @property
     def fp16_unsafe(self) -> str:
@@ -308,7 +311,7 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
                           "only an output brick says what its colour encodes: remove it")
     brick = Brick(path.stem, kind, path, shown, module, params, slots, textures, cite.strip(), doc.strip(),
                   str(meta.get("fp16", "")).strip(), float(meta.get("tolerance", 0.0)),
-                  meta.get("encodes", "linear"))
+                  meta.get("encodes", "linear"), reciprocal=str(meta.get("reciprocal", "")).strip())
     _check_entries(brick, loc)
     brick.sampling = split_sampling(brick)
     return brick

@@ -30,6 +30,9 @@ BRICK_SCHEMA = {
         "cite": {"type": "string", "maxLength": 1000},
         "doc": {"type": "string"},
         "fp16": {"type": "string", "maxLength": 1000},  # "unsafe: why" makes an fp16 build warn
+        # "no: why" where the model itself is not reciprocal (f(l, v) != f(v, l)): plausibility then skips the
+        # reciprocity check and says why; a brick that says nothing is held to it (eval/plausibility.py)
+        "reciprocal": {"type": "string", "pattern": r"^no: \S", "maxLength": 1000},
         "needs": {"type": "array", "items": IDENT},
         "tolerance": {"type": "number", "minimum": 0.0, "maximum": 100.0},  # a 3-factor fit: ~36 (homomorphic_factorization)
         # an output brick's colour: linear radiance, or encoded for display (exactly sRGB, or sqrt's approximation)
@@ -122,6 +125,9 @@ def check(meta: dict, shown: str, loc, positions: dict) -> None:
         near = difflib.get_close_matches(extra, allowed, n=1)
         raise SourceError(shown, line, col, f"unknown key '{extra}' in {key}",
                           f"did you mean '{near[0]}'?" if near else f"allowed: {', '.join(allowed)}")
+    if path == ("reciprocal",) and e.validator == "pattern":
+        raise SourceError(shown, line, col, f"{key} is {e.instance!r}: only a model that is not reciprocal says so",
+                          'write "reciprocal": "no: why" (with the reason), or leave the key out')
     if e.validator == "propertyNames" or (e.validator == "pattern" and isinstance(e.instance, str)):
         name = e.instance if isinstance(e.instance, str) else ""
         line, col = positions.get((*path, name), (line, col))  # at the bad name itself

@@ -15,27 +15,12 @@ import numpy as np
 import pytest
 
 from generator.eval.evaluate import evaluate
+from generator.eval.plausibility import gauss_legendre as _gl, graded as _graded, h_quadrature
+from generator.eval.plausibility import polar_dirs as _dirs
 from generator.reference import (d_beckmann, d_ggx, lambda_beckmann, lambda_ggx, reference_brdf,
                                  smith_g_separable)
 
 Z = np.array([0.0, 0.0, 1.0])
-
-
-def _gl(a: float, b: float, n: int):
-    x, w = np.polynomial.legendre.leggauss(n)
-    return (x + 1) * (b - a) / 2 + a, w * (b - a) / 2
-
-
-def _graded(a: float, b: float, levels: int = 24, n: int = 24):
-    """Gauss-Legendre on [a, b] in panels halving towards a (for integrands peaked at a)."""
-    edges = [a + (b - a) * 2.0 ** -k for k in range(levels, -1, -1)]
-    xs, ws = zip(*(_gl(lo, hi, n) for lo, hi in zip([a] + edges[:-1], edges)))
-    return np.concatenate(xs), np.concatenate(ws)
-
-
-def _dirs(theta, phi):
-    theta, phi = np.broadcast_arrays(theta, phi)
-    return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], -1)
 
 
 def _f(spec, L, V, params):
@@ -69,17 +54,6 @@ def albedo_over_v(spec, params, theta_l, n_s=128, n_phi=256, s_max=60.0, n=10.0)
     up = V[:, 2] > 0
     f = _f(spec, np.broadcast_to(l, V[up].shape), V[up], params)
     return np.sum(f * (V[up, 2] * W.reshape(-1)[up])[:, None], axis=0)
-
-
-def h_quadrature(alpha, n_u, n_phi):
-    """Half-vector nodes with dω weights, θ_h = atan(α tan u): the microfacet lobe is resolved at any α."""
-    u, w = _gl(0.0, math.pi / 2, n_u)
-    t = np.arctan(alpha * np.tan(u))
-    dt = alpha / np.cos(u) ** 2 / (1 + (alpha * np.tan(u)) ** 2)
-    p, wp = _gl(0.0, 2 * math.pi, n_phi)
-    T, P = np.meshgrid(t, p, indexing="ij")
-    W = (w * dt * np.sin(t))[:, None] * wp[None, :]
-    return _dirs(T, P).reshape(-1, 3), W.reshape(-1)
 
 
 def albedo_microfacet(f, mu, alpha, n=160):

@@ -32,6 +32,7 @@ Guards and their costs:
 BRICK = {
     "kind": "diffuse",
     "cite": "Gotanda 2014 eq. 8 (fit of the GGX/Smith/Fresnel Lambertian-microfacet model of eq. 4)",
+    "reciprocal": "no: the fit of Gotanda 2014 eq. 8 reads n.e in F_r and V_d and n.l in L_m, asymmetrically (the eq. 4 model it fits is reciprocal)",
     "params": {
         "rho_d": {"type": "vec3", "range": [0.0, 1.0], "default": [0.5, 0.5, 0.5], "doc": "diffuse albedo (linear RGB)"},
         "alpha": {"type": "float", "range": [0.0, 1.0], "default": 0.3,

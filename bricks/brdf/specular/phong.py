@@ -15,6 +15,7 @@ directional albedo over the outgoing direction, 2 k_s/(n+2) at normal incidence,
 BRICK = {
     "kind": "specular",
     "cite": "Hoffman & Baker 2006, Phong written as a BRDF: k_s (cos alpha_r)^n / (pi cos theta_i)",
+    "reciprocal": "no: the 1/cos theta_i of the original Phong written as a BRDF reads n.l alone (Hoffman & Baker 2006; phong_reciprocal removes it)",
     "params": {
         "n": {"type": "float", "range": [1.0, 100000.0], "default": 32.0, "doc": "Phong cosine power"},
         "k_s": {"type": "vec3", "range": [0.0, 1.0], "default": [0.5, 0.5, 0.5],

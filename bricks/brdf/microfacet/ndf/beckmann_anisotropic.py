@@ -15,6 +15,7 @@ relative error on the hemisphere, 2.1e-4 on the stress set.
 """
 BRICK = {
     "kind": "ndf",
+    "fp16": "unsafe: COS2_MIN 1e-8 is 0 in half and c2 * c2 underflows at small n.h, as beckmann's: 0/0 = NaN on the default hemisphere",
     "cite": "Heitz 2014 eq. 82; Ward 1992 eq. 5a; Walter et al. 2007 eq. 25 (isotropic case)",
     "params": {
         "alpha_u": {"type": "float", "range": [0.0, 1.0], "default": 0.2,
