@@ -332,10 +332,66 @@ static bool blur_block(engine *e, const draw_item *it, const block_ref *b, unsig
     return true;
 }
 
+/* One pair's lights into `data` (a buffer of `count` elements of `stride` bytes) from element `at`: each light's
+ * parameters (the manifest's lights.<name>.params) at the layout's offsets, as float32, after its `id` as int32 at
+ * offset 0 when the pair has one (a switch loop's buffer: its ids.x). */
+static bool fill_pair(const engine *e, const cJSON *pair, const char *where, const char *bname, int stride,
+                      unsigned char *data, int at)
+{
+    const json_src *src = &e->m->src;
+    const cJSON *layout = j_arr(src, pair, "layout", where), *lights = j_arr(src, pair, "lights", where);
+    const cJSON *id = j_opt(pair, "id");
+    int32_t ids[4] = {0, 0, 0, 0};
+    if (!layout || !lights)
+        return false;
+    if (id && !j_int(src, pair, "id", where, 0, 1 << 16, &ids[0]))
+        return false;
+    bool ok = true;
+    int k = at;
+    const cJSON *ln;
+    cJSON_ArrayForEach(ln, lights) {
+        const cJSON *light = cJSON_IsString(ln) ? j_opt(e->m->lights, ln->valuestring) : NULL;
+        const cJSON *params = j_opt(light, "params"), *slot;
+        if (!params)
+            return j_fail(src, where, "light %d of %s is not in lights", k - at, bname);
+        if (id)
+            memcpy(data + (size_t)k * (size_t)stride, ids, sizeof ids);
+        cJSON_ArrayForEach(slot, layout) {
+            const cJSON *name = j_opt(slot, "name");
+            int offset, bytes;
+            if (!cJSON_IsString(name) || !j_int(src, slot, "offset", where, 0, stride - 4, &offset)
+                || !j_int(src, slot, "size", where, 4, stride, &bytes) || offset + bytes > stride || offset % 4
+                || bytes % 4 || bytes > 64 || (id && offset < (int)sizeof ids))  /* whole floats, at most a mat4 */
+                return j_fail(src, where, "a layout entry of %s this engine cannot place", bname);
+            const cJSON *v = j_opt(params, name->valuestring);
+            int n = bytes / 4;
+            double values[16] = {0};
+            bool numbers = cJSON_IsArray(v) && cJSON_GetArraySize(v) == n;
+            for (int c = 0; numbers && c < n; c++)
+                numbers = cJSON_IsNumber(cJSON_GetArrayItem(v, c));
+            if (cJSON_IsNumber(v))
+                for (int c = 0; c < n; c++)
+                    values[c] = v->valuedouble;  /* a scalar fills a vector's components, as the generator packs */
+            else if (numbers)
+                for (int c = 0; c < n; c++)
+                    values[c] = cJSON_GetArrayItem(v, c)->valuedouble;
+            else
+                return j_fail(src, where, "light %s has no %d-float value %s", ln->valuestring, n, name->valuestring);
+            for (int c = 0; c < n; c++) {
+                float f = (float)values[c];
+                memcpy(data + (size_t)k * (size_t)stride + (size_t)offset + 4 * (size_t)c, &f, 4);
+            }
+        }
+        k++;
+    }
+    return ok;
+}
+
 /* A dynamic light set's storage buffer `b` (LightBuffer<i>), filled as the manifest's dynamic_light_sets says:
- * the pair whose block it is lists its lights in order; element k (stride bytes) holds lights[k]'s parameters
- * (the manifest's lights.<name>.params) at the layout's offsets, as float32. Bound whole: the shader's light
- * count is its size / stride; a pair with no light gets 4 bytes (a count of 0; a buffer cannot be empty). */
+ * the pairs whose block it is (one, or with loop "switch" every pair of the set) list their lights in order;
+ * a pair's element k (stride bytes) is at element first + k (first absent: 0) and holds lights[k]'s parameters.
+ * Bound whole: the shader's light count is its size / stride; no light gets 4 bytes (a count of 0; a buffer
+ * cannot be empty). */
 static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkBuffer *out)
 {
     const json_src *src = &e->m->src;
@@ -349,10 +405,13 @@ static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkB
         return j_fail(src, where, "%s reads storage block %s, and light set %s is not a dynamic one",
                       it->pipe->prog->name, b->name, o->light_set);
     const cJSON *pairs = j_arr(src, set, "pairs", where);
-    cJSON_ArrayForEach(x, pairs) {
-        const cJSON *name = j_opt(x, "block");
-        if (cJSON_IsString(name) && strcmp(name->valuestring, b->name) == 0)
-            pair = x;
+    int count = 0;
+    cJSON_ArrayForEach(x, pairs) {  /* the first pair of the block keys the cache; all of them count */
+        const cJSON *name = j_opt(x, "block"), *lights = j_opt(x, "lights");
+        if (cJSON_IsString(name) && strcmp(name->valuestring, b->name) == 0) {
+            pair = pair ? pair : x;
+            count += cJSON_IsArray(lights) ? cJSON_GetArraySize(lights) : 0;
+        }
     }
     if (!pair)
         return j_fail(src, where, "no pair's block is %s", b->name);
@@ -362,11 +421,8 @@ static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkB
             return true;
         }
     int stride, cap;
-    const cJSON *layout = j_arr(src, pair, "layout", where), *lights = j_arr(src, pair, "lights", where);
-    if (!layout || !lights || !j_int(src, pair, "stride", where, 16, 1 << 16, &stride)
-        || !j_int(src, set, "max", where, 1, 1 << 16, &cap))
+    if (!j_int(src, pair, "stride", where, 16, 1 << 16, &stride) || !j_int(src, set, "max", where, 1, 1 << 16, &cap))
         return false;
-    int count = cJSON_GetArraySize(lights);
     if (count > cap)
         return j_fail(src, where, "%d lights, more than its max %d", count, cap);
     size_t size = count ? (size_t)count * (size_t)stride : 4;
@@ -374,49 +430,19 @@ static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkB
     if (!data)
         return fail("out of memory");
     bool ok = true;
-    int k = 0;
-    const cJSON *ln;
-    cJSON_ArrayForEach(ln, lights) {
-        const cJSON *light = cJSON_IsString(ln) ? j_opt(e->m->lights, ln->valuestring) : NULL;
-        const cJSON *params = j_opt(light, "params"), *slot;
-        if (!params) {
-            ok = j_fail(src, where, "light %d of %s is not in lights", k, b->name);
-            break;
-        }
-        cJSON_ArrayForEach(slot, layout) {
-            const cJSON *name = j_opt(slot, "name");
-            int offset, bytes;
-            if (!cJSON_IsString(name) || !j_int(src, slot, "offset", where, 0, stride - 4, &offset)
-                || !j_int(src, slot, "size", where, 4, stride, &bytes) || offset + bytes > stride || offset % 4
-                || bytes % 4 || bytes > 64) {  /* at most a mat4 (16 floats), whole floats */
-                ok = ok && j_fail(src, where, "a layout entry of %s this engine cannot place", b->name);
-                break;
-            }
-            const cJSON *v = j_opt(params, name->valuestring);
-            int n = bytes / 4;
-            double values[16] = {0};
-            bool numbers = cJSON_IsArray(v) && cJSON_GetArraySize(v) == n;
-            for (int c = 0; numbers && c < n; c++)
-                numbers = cJSON_IsNumber(cJSON_GetArrayItem(v, c));
-            if (cJSON_IsNumber(v))
-                for (int c = 0; c < n; c++)
-                    values[c] = v->valuedouble;  /* a scalar fills a vector's components, as the generator packs */
-            else if (numbers)
-                for (int c = 0; c < n; c++)
-                    values[c] = cJSON_GetArrayItem(v, c)->valuedouble;
-            else {
-                ok = j_fail(src, where, "light %s has no %d-float value %s", ln->valuestring, n, name->valuestring);
-                break;
-            }
-            for (int c = 0; c < n; c++) {
-                float f = (float)values[c];
-                memcpy(data + (size_t)k * (size_t)stride + (size_t)offset + 4 * (size_t)c, &f, 4);
-            }
-        }
-        if (!ok)
-            break;
-        k++;
+    cJSON_ArrayForEach(x, pairs) {
+        const cJSON *name = j_opt(x, "block"), *lights = j_opt(x, "lights");
+        if (!ok || !cJSON_IsString(name) || strcmp(name->valuestring, b->name) != 0)
+            continue;
+        int first = 0, own;
+        int n = cJSON_IsArray(lights) ? cJSON_GetArraySize(lights) : 0;
+        ok = j_int(src, x, "stride", where, 16, 1 << 16, &own)
+             && (!j_opt(x, "first") || j_int(src, x, "first", where, 0, count, &first));
+        if (ok && (own != stride || first + n > count))
+            ok = j_fail(src, where, "the pairs of %s disagree on its stride or overlap", b->name);
+        ok = ok && fill_pair(e, x, where, b->name, stride, data, first);
     }
+    const cJSON *layout = j_opt(pair, "layout");
     if (ok && e->nblocks == e->capblocks) {
         int more_cap = e->capblocks ? 2 * e->capblocks : 32;
         block_entry *more = realloc(e->blocks, (size_t)more_cap * sizeof *more);

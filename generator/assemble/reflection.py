@@ -11,7 +11,7 @@ Each platform spells the Interface in its own binding model (platforms.py: each 
 """
 from __future__ import annotations
 
-from ..link.values import light_buffer_block, light_values, material_values
+from ..link.values import is_switch, light_buffer_of, light_values, material_values
 from ..scene.light_sets import light_indices
 from ..scene.load import Scene
 
@@ -58,6 +58,13 @@ FILL = ("per pair, the set's lights of that type and shadow filter, in the set's
         "the bound range / stride (no light: bind a range below the stride, e.g. 4 bytes)")
 
 
+FILL_SWITCH = ("one buffer for every pair (each pair's block is the same): pair after pair in the pairs' order, "
+               "from element first, the set's lights of that pair in the set's order; element k at k x stride holds "
+               "ids (int32 x4: the pair's id, 0, 0, 0) at offset 0, then each parameter at its offset (little-endian "
+               "float32), zeros elsewhere; bind the first count x stride bytes of a buffer of max x stride, count "
+               "all pairs' lights (no light: bind a range below the stride, e.g. 4 bytes)")
+
+
 def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platforms) -> dict:
     """Per dynamic light set: its capacity and, per pair of its model, the storage buffer an engine fills.
 
@@ -74,15 +81,19 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
 
         def lights_of(i, members=members, dyn=dyn):  # the set's lights of pair i, in its order
             return [n for n in members if dyn.pair_of(scene.lights[n]) == i]
+        def first_of(i, dyn=dyn, lights_of=lights_of):  # a switch buffer: where pair i's lights start
+            return sum(len(lights_of(k)) for k in range(i)) if dyn.loop == "switch" else None
         if c is None:  # its blocks as the last build described them; its capacity and lights as the scene says now
             if name in old:
                 out[name] = {**old[name], "max": dyn.max, "fill": FILL, "pairs": [
-                    {**p, "lights": lights_of(p["light_index"])} for p in old[name]["pairs"]]}
+                    {**p, "lights": lights_of(p["light_index"]),
+                     **({"first": first_of(p["light_index"])} if "first" in p else {})} for p in old[name]["pairs"]]}
             continue
         pairs = []
         for i, pair in enumerate(dyn.model):
-            block = c.interface.block(light_buffer_block(i))
+            block = light_buffer_of(c.interface, i)
             stride = block.members[0]["array_stride"]
+            switch = {"id": i, "first": first_of(i)} if is_switch(block) else {}
             bindings = {}
             for p in platforms:
                 rows = PLATFORM_TABLE[p].reflection(c.interface)
@@ -92,7 +103,8 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
             pairs.append({"pair": pair.canonical(), "light_index": i, "block": block.name, "set": block.set,
                           "binding": block.binding, "bindings": bindings, "stride": stride,
                           "layout": [{k: v for k, v in sl.as_dict().items() if k in ("name", "type", "offset", "size")}
-                                     for sl in block.slots],
-                          "lights": lights_of(i)})
-        out[name] = {"max": dyn.max, "pairs": pairs, "fill": FILL}
+                                     for sl in block.slots if sl.light == i],
+                          "lights": lights_of(i), **switch})
+        out[name] = {"max": dyn.max, "pairs": pairs, "fill": FILL_SWITCH if dyn.loop == "switch" else FILL,
+                     **({"loop": dyn.loop} if dyn.loop != "types" else {})}
     return out

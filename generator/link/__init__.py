@@ -197,11 +197,17 @@ def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
         gl.set, gl.binding = 0, binding  # after the light textures
         binding += 1
         elem = gl.ty.elem
-        n = elem.fields[0][1].size  # LightData<i> { vec4 data[n]; }, the light's parameters packed (layout)
-        fields = [{"name": "data", "type": f"vec4[{n}]", "offset": 0, "size": 16 * n, "array_stride": 16}]
+        # LightData<i> { vec4 data[n]; }, the light's parameters packed (layout); a switch loop's element has
+        # ivec4 ids before them (glue._switch_buffer)
+        fields, at = [], 0
+        for fname, fty in elem.fields:
+            n = fty.size if fty.kind == "array" else 1
+            fields.append({"name": fname, "type": f"vec4[{n}]" if fty.kind == "array" else str(fty), "offset": at,
+                           "size": 16 * n, **({"array_stride": 16} if fty.kind == "array" else {})})
+            at += 16 * n
         blocks.append(Block(f"LightBuffer{elem.name[len('LightData'):]}", gl.set, gl.binding, "storage",
                             [{"name": "data", "type": f"{elem.name}[]", "offset": 0, "size": 0,
-                              "array_stride": 16 * n, "members": fields}], slots))
+                              "array_stride": at, "members": fields}], slots))
     params = {"material": {p: s for _, p, _, _, s in g.material}}
     for i, lt in enumerate(r.lights):
         params[f"light{i}"] = face_params(lt)  # a point light's six face matrices too (link/faces.py)

@@ -16,14 +16,14 @@ import dataclasses
 from dataclasses import dataclass, field
 
 from ..lang import SourceError, ir
-from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct
+from ..lang.types import FLOAT, INT, MAT4, UINT, VEC3, VEC4, Type, array, storage_buffer, struct, vector
 from ..library.inputs import BY_NAME, FRAME, SHADING, SURFACE, TANGENT_FRAME, closure, expression
 from ..spec.params import Params
 from ..spec.permutation import Node
 from ..spec.resolve import LightPart, Resolved, ResolvedBrdf
 from ..spec.surface import EMISSIVE_MAP
 from .faces import FACE_MATRICES, face_params, faced, faced_call
-from .interface import Slot, Texture, layout, texture_type
+from .interface import VEC4_BYTES, Slot, Texture, layout, texture_type
 from .irgen import Builder
 from .program import Program
 
@@ -213,21 +213,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         for n, k, _, ty, _ in bg.params.flat:
             if k not in provided:
                 bind.params[f"m_{n}"] = ty
-        for i, lt in enumerate(r.lights):
-            pre = f"l{i}_"
-            ln, sh, dyn = lt.node, lt.shadow, lt.dynamic
-            values = _light_buffer(prog, b, i, lt, dynamic_lights, buffer_slots) if dyn else None
-            Li = f"L{i}"
-            body_i = [b.decl(Li, bind.call(prog, ln, "light_dir", pre, "light", i, locals_, values))]
-            cos = b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var(Li, VEC3))
-            body_i.append(b.decl(f"NdotL{i}", cos))
-            c = b.decl(f"c{i}", bind.call(prog, ln, "light_radiance", pre, "light", i, locals_, values))
-            if faced(lt.brick.id, lt.textures):  # six faces: the face's matrix and layer (link/faces.py)
-                mats = [values[n] if values else bind.param(pre + n, MAT4) for n in FACE_MATRICES]
-                s = faced_call(b, bind, prog, sh, i, b.var(f"L{i}", VEC3), mats, lambda fn, a, sh=sh, pre=pre, i=i, v=values:
-                               bind.call(prog, sh, "", pre, "light", i, locals_, {**(v or {}), **a}, fn))
-            else:
-                s = [b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_, values))]
+        def f_r(Li):  # the BRDF for light direction Li
             brdf_args = []
             for n, t in bg.signature:
                 if n == "L":
@@ -244,18 +230,66 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
                     brdf_args.append(bind_texture(bind, n, t, r.brdf))
                 else:
                     brdf_args.append(b.var(f"m_{n}", t, "param"))
-            f_r = b.call(bg.lit, brdf_args)
-            term = b.arith("*", b.arith("*", b.arith("*", b.named_const("PI"), f_r), b.var(f"c{i}", VEC3)),
-                           b.arith("*", b.var(f"NdotL{i}", FLOAT), b.var(f"s{i}", FLOAT)))
-            add = b.assign(b.var("Lo", VEC3), term, "+")
-            body_i.append(b.if_(b.compare(">", b.var(f"NdotL{i}", FLOAT), b.const(0.0)), [c, *s, add]))
-            if dyn:
-                g = dynamic_lights[-1]
-                bound = b.intrinsic("buffer_length", UINT, ir.Var(g.ty, b.here(), g.name, "global"))
-                stmts.append(ir.For(b.loc(), f"k{i}", 0, body_i, bound))
-            else:
-                stmts.extend(body_i)
+            return b.call(bg.lit, brdf_args)
+
+        def term(j):  # Lo += π f_r c (n·l) visibility, for light (or switch loop) j's locals
+            t = b.arith("*", b.arith("*", b.arith("*", b.named_const("PI"), f_r(f"L{j}")), b.var(f"c{j}", VEC3)),
+                        b.arith("*", b.var(f"NdotL{j}", FLOAT), b.var(f"s{j}", FLOAT)))
+            return b.assign(b.var("Lo", VEC3), t, "+")
+
+        def lit_if(j, stmts_):  # if (NdotL<j> > 0) { stmts_; Lo += ... }
+            return b.if_(b.compare(">", b.var(f"NdotL{j}", FLOAT), b.const(0.0)), stmts_ + [term(j)])
+
+        def ndotl(j):
+            return b.decl(f"NdotL{j}", b.intrinsic("dot", FLOAT, b.var("N", VEC3), b.var(f"L{j}", VEC3)))
+
+        def loop(j, body_j):  # for k<j> in range(the buffer's length)
+            g = dynamic_lights[-1]
+            bound = b.intrinsic("buffer_length", UINT, ir.Var(g.ty, b.here(), g.name, "global"))
+            return ir.For(b.loc(), f"k{j}", 0, body_j, bound)
+
+        def switch_loop(j, pairs):
+            """One loop over one buffer of every light of `pairs` ((light index, LightPart)), switching on the
+            pair: L first, then (lit) the radiance and visibility; one BRDF evaluation per light."""
+            entry, values = _switch_buffer(prog, b, j, pairs, dynamic_lights, buffer_slots)
+
+            def cases(make):  # switch (le<j>.ids.x) { case i: make(i) }
+                sel = ir.Swizzle(INT, b.here(), ir.Member(IVEC4, b.here(), b.var(f"le{j}", entry.ty), "ids"), "x")
+                return ir.Switch(b.loc(), sel, [((i,), make(i, lt)) for i, lt in pairs], [])
+
+            def call(i, node, fname):
+                return bind.call(prog, node, fname, f"l{i}_", "light", i, locals_, values[i])
+            body_j = [b.decl(f"le{j}", entry), b.decl(f"L{j}", b.construct(VEC3, b.const(0.0))),
+                      cases(lambda i, lt: [b.assign(b.var(f"L{j}", VEC3), call(i, lt.node, "light_dir"))]),
+                      ndotl(j)]
+            lit = [b.decl(f"c{j}", b.construct(VEC3, b.const(0.0))), b.decl(f"s{j}", b.const(1.0)),
+                   cases(lambda i, lt: [b.assign(b.var(f"c{j}", VEC3), call(i, lt.node, "light_radiance")),
+                                        b.assign(b.var(f"s{j}", FLOAT),
+                                                 call(i, lt.shadow, lt.shadow.brick.entries[0].name))])]
+            body_j.append(lit_if(j, lit))
+            return loop(j, body_j)
+
+        switched = [(i, lt) for i, lt in enumerate(r.lights) if r.perm.lights[i].switch]
+        for i, lt in enumerate(r.lights):
+            pre = f"l{i}_"
             lights.append(pre)
+            if switched and i == switched[0][0]:
+                stmts.append(switch_loop(i, switched))
+            if r.perm.lights[i].switch:
+                continue
+            ln, sh, dyn = lt.node, lt.shadow, lt.dynamic
+            values = _light_buffer(prog, b, i, lt, dynamic_lights, buffer_slots) if dyn else None
+            body_i = [b.decl(f"L{i}", bind.call(prog, ln, "light_dir", pre, "light", i, locals_, values)), ndotl(i)]
+            c = b.decl(f"c{i}", bind.call(prog, ln, "light_radiance", pre, "light", i, locals_, values))
+            if faced(lt.brick.id, lt.textures):  # six faces: the face's matrix and layer (link/faces.py)
+                mats = [values[n] if values else bind.param(pre + n, MAT4) for n in FACE_MATRICES]
+                s = faced_call(b, bind, prog, sh, i, b.var(f"L{i}", VEC3), mats, lambda fn, a, sh=sh, pre=pre, i=i, v=values:
+                               bind.call(prog, sh, "", pre, "light", i, locals_, {**(v or {}), **a}, fn))
+            else:
+                s = [b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_, values))]
+            body_i.append(lit_if(i, [c, *s]))
+            stmts.extend([loop(i, body_i)] if dyn else body_i)
+
         stmts.extend(emission(b, bind, r.surface))
         shaded = bind.call(prog, out_node, "output", "o_", "material", None, {}, args={"color": b.var("Lo", VEC3)})
         stmts.extend(surface_output(b, bind, r, shaded))
@@ -288,6 +322,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights, buffer_slots)
 
 
+IVEC4 = vector("int", 4)
 VERTEX_COLOR = "vertex_color"  # shade()'s parameter: COLOR_0, interpolated (the templates' local of that name)
 UV_LOCAL = "uv_t"  # shade()'s local: the texture coordinates after the packing's uv filler
 
@@ -412,13 +447,7 @@ def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list,
     GLSL std430, HLSL structured buffers and WGSL storage agree byte for byte.
     """
     params = lt.params
-    owners = [(n.brick, x) for n in [lt.node, *lt.shadow.tree] for x in n.brick.textures]
-    if owners:
-        brick, tex = owners[0]
-        loc = brick.module.meta_loc
-        raise SourceError(brick.display_path, loc.line, loc.col, f"a loop over a buffer of '{lt.brick.id}' lights cannot "
-                          f"bind texture '{tex}' of {brick.kind} '{brick.id}' per light",
-                          "use a shadow filter without a texture (shadow none) for buffer lights")
+    _untextured(lt)
     slots, n = layout([(k, k, None, p.ty, p, i) for k, p in params.items()])
     data_ty = array(VEC4, max(n, 1))
     elem = struct(f"LightData{i}", (("data", data_ty),))
@@ -428,6 +457,44 @@ def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list,
     slots_out.append(slots)
     item = ir.Index(elem, b.here(), ir.Var(g.ty, b.here(), g.name, "global"), ir.Var(UINT, b.here(), f"k{i}"))
     return {s.name: read_slot(b, item, data_ty, s) for s in slots}
+
+
+def _untextured(lt: LightPart) -> None:
+    """Refuse a buffer light whose brick or shadow filter binds a texture (a located error at the brick)."""
+    owners = [(n.brick, x) for n in [lt.node, *lt.shadow.tree] for x in n.brick.textures]
+    if owners:
+        brick, tex = owners[0]
+        loc = brick.module.meta_loc
+        raise SourceError(brick.display_path, loc.line, loc.col, f"a loop over a buffer of '{lt.brick.id}' lights cannot "
+                          f"bind texture '{tex}' of {brick.kind} '{brick.id}' per light",
+                          "use a shadow filter without a texture (shadow none) for buffer lights")
+
+
+SWITCH_IDS = VEC4_BYTES  # a switch buffer's element: ids (ivec4, ids.x the light index), then data at this offset
+
+
+def _switch_buffer(prog: Program, b: Builder, j: int, pairs: list, out: list,
+                   slots_out: list) -> tuple[ir.Expr, dict[int, dict[str, ir.Expr]]]:
+    """The one storage buffer of a switch loop (named for its first light j) and, per light index i of `pairs`,
+    the expressions reading its parameters from element k<j>.
+
+    The element LightData<j> is the ubershader's LightEntry: `ivec4 ids` (ids.x: the light index, the switch's
+    case) then `vec4 data[K]`, each pair's parameters packed from data[0] as interface.layout packs them, K the
+    most any pair needs. Its slots (slots_out) are the pairs' slots together, each with its light index, at byte
+    offsets in the element (after the ids)."""
+    laid = []
+    for i, lt in pairs:
+        _untextured(lt)
+        laid.append((i, *layout([(k, k, None, p.ty, p, i) for k, p in lt.params.items()])))
+    data_ty = array(VEC4, max([1] + [n for _, _, n in laid]))
+    elem = struct(f"LightData{j}", (("ids", IVEC4), ("data", data_ty)))
+    g = ir.Global(f"light_buffer{j}", storage_buffer(elem))
+    prog.structs.append(elem)
+    out.append(g)
+    slots_out.append([dataclasses.replace(x, base=SWITCH_IDS) for _, slots, _ in laid for x in slots])
+    entry = ir.Index(elem, b.here(), ir.Var(g.ty, b.here(), g.name, "global"), ir.Var(UINT, b.here(), f"k{j}"))
+    le = b.var(f"le{j}", elem)
+    return entry, {i: {x.name: read_slot(b, le, data_ty, x) for x in slots} for i, slots, _ in laid}
 
 
 def read_slot(b: Builder, entry: ir.Expr, data_ty: Type, slot: Slot) -> ir.Expr:

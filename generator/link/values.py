@@ -7,6 +7,8 @@ ubershader's LightEntry / MaterialEntry storage buffers (link/uber.py).
 """
 from __future__ import annotations
 
+import struct
+
 from ..scene.load import Scene
 from .interface import pack, put
 
@@ -64,19 +66,42 @@ def light_buffer_block(i: int) -> str:
 
 def light_buffers(scene: Scene, names: list[str], dyn, c) -> dict[str, bytes]:
     """Per pair of a dynamic set's model, its storage block's name and bytes: the lights `names` of that pair, in
-    their order, each element laid out as the block's parameters say (a static set's values, so both draw alike)."""
+    their order, each element laid out as the block's parameters say (a static set's values, so both draw alike).
+    A switch loop's one block (every pair's block) holds the pairs one after another, in the model's order, each
+    element its ids (ids.x the pair's light index, int32) then its values (link/glue.py _switch_buffer)."""
     out = {}
     for i, pair in enumerate(dyn.model):
-        block = c.interface.block(light_buffer_block(i))
+        block = light_buffer_of(c.interface, i)
         stride = block.members[0]["array_stride"]
         specs = c.interface.params.get(f"light{i}", {})
+        slots = [s for s in block.slots if s.light == i]
+        head = switch_ids(i) if is_switch(block) else b""
         data = b""
         for ln in names:
             if dyn.pair_of(scene.lights[ln]) == i:
                 v = light_values(scene, ln, specs)
-                data += pack(block.slots, {s.name: _element(v[s.param], s) for s in block.slots}, stride // 16)
-        out[block.name] = data
+                data += head + pack(slots, {s.name: _element(v[s.param], s) for s in slots}, (stride - len(head)) // 16)
+        out[block.name] = out.get(block.name, b"") + data
     return out
+
+
+def is_switch(block) -> bool:
+    """Whether a light buffer's element starts with a switch loop's ids (link/glue.py _switch_buffer)."""
+    return block.members[0]["members"][0]["name"] == "ids"
+
+
+def switch_ids(i: int) -> bytes:
+    """A switch buffer element's ids: (light index i, 0, 0, 0) as int32."""
+    return struct.pack("<4i", i, 0, 0, 0)
+
+
+def light_buffer_of(iface, i: int):
+    """The storage block that reads the key's dynamic light i: its own LightBuffer<i>, or the one block of the
+    key's switch loop (a key has at most one: every `**` light is in it), named for the loop's first light."""
+    own = iface.block(light_buffer_block(i))
+    if own is not None:
+        return own
+    return next((blk for blk in iface.blocks if blk.name.startswith(LIGHT_BUFFER) and is_switch(blk)), None)
 
 
 def _element(value, slot):

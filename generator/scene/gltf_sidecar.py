@@ -36,7 +36,8 @@ SIDECAR_SCHEMA = {
                            "params": {"type": "object"}}}},
         "light_set": {"type": "object", "additionalProperties": False,
                       "properties": {"dynamic": {"type": "boolean"}, "max": {"type": "integer"},
-                                     "model": {"type": "array", "items": {"type": "string"}, "maxItems": 256}}},
+                                     "model": {"type": "array", "items": {"type": "string"}, "maxItems": 256},
+                                     "loop": {"type": "string"}}},
     },
 }
 

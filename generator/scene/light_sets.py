@@ -8,15 +8,20 @@
     lights = ["lamp0", "lamp1"]       # the lights it holds (any number up to max)
     max = 64                          # the capacity of its buffers (what an engine allocates); default 256
     model = ["point/none"]            # optional: the pairs a light of it may be; default: its lights' pairs
+    loop = "types"                    # optional: "types" (default), one loop per pair over its own buffer;
+                                      # "switch", one loop over one buffer of every light, switching on the pair
 
 The permutation key of an object lit by a dynamic set carries the set's model (sorted dynamic LightKeys,
-`lights=*point/none,*spot/none`), not its lights: any number of lights of those pairs is one shader per material.
+`lights=*point/none,*spot/none`; with loop = "switch" `lights=**point/none,**spot/none`), not its lights: any
+number of lights of those pairs is one shader per material. Why "types" is the default: docs/design/link.md,
+"Which light loop" (measured by benchmarks/lights.py).
 Why a model may name pairs no light has yet: an engine adding lights at run time needs the shader that reads
 them. A shadow filter that samples a texture cannot be looped over yet (one shadow map per element needs texture
 arrays), so such a pair is refused here, at the set, before any shader is linked.
 """
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 
 from ..library.bricks import Library
@@ -26,6 +31,7 @@ from .locate import Locator
 MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed SPIR-V's 255 function arguments
 DEFAULT_MAX = 256  # a dynamic set's buffer capacity when the scene gives none
 MAX_DYNAMIC = 1 << 16  # a dynamic set's largest capacity: what an engine allocates per pair must stay sane
+LOOPS = ("types", "switch")  # a dynamic set's light loop; the first is the default
 
 
 @dataclass(frozen=True)
@@ -34,11 +40,12 @@ class DynamicSet:
 
     name: str
     model: tuple  # (LightKey(dynamic=True), ...) sorted by canonical text
-    max: int  # the capacity of each pair's buffer, in lights
+    max: int  # the capacity of each pair's buffer (loop "switch": of its one buffer), in lights
+    loop: str = LOOPS[0]  # "types": a loop per pair; "switch": one loop, a switch on the pair (LOOPS)
 
     def pair_of(self, light) -> int:
         """The index in the model (the permutation's light index) of a scene Light."""
-        return self.model.index(LightKey(light.type, light.shadow, True))
+        return self.model.index(LightKey(light.type, light.shadow, True, self.loop == "switch"))
 
 
 def set_keys(scene, name: str) -> tuple:
@@ -123,13 +130,15 @@ def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library, header: tupl
         if not model:
             raise loc.error(loc.find(*header), f"dynamic light set '{name}' has no lights and no model",
                             'give the pairs its lights may be: model = ["point/none"]')
+    loop = _loop(loc, at, name, t)
+    model = tuple(LightKey(k.light, k.shadow, True, loop == "switch") for k in model)
     model = tuple(sorted(model, key=LightKey.canonical))
     for n in members:
         light = scene.lights[n]
-        if LightKey(light.type, light.shadow, True) not in model:
+        if LightKey(light.type, light.shadow, True, loop == "switch") not in model:
             raise loc.error(at("lights" if "lights" in listed else "model"),
                             f"light '{n}' ({light.type}/{light.shadow}) is not in the model of dynamic light set "
-                            f"'{name}' ({', '.join(k.canonical()[1:] for k in model)})",
+                            f"'{name}' ({', '.join(f'{k.light}/{k.shadow}' for k in model)})",
                             f"add \"{light.type}/{light.shadow}\" to its model, or move '{n}' to another set")
     where = at("model") if "model" in t else at("lights")
     for k in model:
@@ -144,8 +153,19 @@ def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library, header: tupl
     if cap < len(members):
         raise loc.error(at("max"), f"light set '{name}' holds {len(members)} lights, more than its max = {cap}",
                         f"raise max to at least {len(members)}")
-    scene.dynamic_sets[name] = DynamicSet(name, model, cap)
+    scene.dynamic_sets[name] = DynamicSet(name, model, cap, loop)
     return members
+
+
+def _loop(loc: Locator, at, name: str, t: dict) -> str:
+    """The set's `loop`, one of LOOPS (a located error with the closest one otherwise)."""
+    loop = t.get("loop", LOOPS[0])
+    if loop not in LOOPS:
+        near = difflib.get_close_matches(str(loop), LOOPS, n=1)
+        raise loc.error(at("loop"), f"light set '{name}': loop is {loop!r}, not one of {', '.join(LOOPS)}",
+                        (f"did you mean loop = \"{near[0]}\"? " if near else "")
+                        + "\"types\" loops over each pair's buffer, \"switch\" over one buffer, switching on the pair")
+    return loop
 
 
 def _model_entry(loc: Locator, where, name: str, entry: str, lib: Library) -> LightKey:

@@ -41,7 +41,7 @@ SCENE_SCHEMA = {
     "additionalProperties": False,
     "properties": {
         "scene": {"type": "object", "additionalProperties": False,
-                  "properties": {"name": NAME, "output": SPEC, "precision": NAME, "ubershader": {"type": "boolean"}}},
+                  "properties": {"name": NAME, "output": SPEC, "precision": NAME}},
         "materials": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["brdf"],
             "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS,
@@ -59,7 +59,8 @@ SCENE_SCHEMA = {
             "type": ["array", "object"], "items": NAME, "maxItems": 4096,
             "additionalProperties": False, "required": ["dynamic"],
             "properties": {"dynamic": {"type": "boolean"}, "lights": {"type": "array", "items": NAME, "maxItems": 1 << 16},
-                           "max": {"type": "integer"}, "model": {"type": "array", "items": SPEC, "maxItems": 256}}}},
+                           "max": {"type": "integer"}, "model": {"type": "array", "items": SPEC, "maxItems": 256},
+                           "loop": {"type": "string"}}}},
         "objects": {"type": "array", "items": {
             "type": "object", "additionalProperties": False, "required": ["material", "lights"],
             "properties": {"name": NAME, "material": NAME, "lights": NAME}}},

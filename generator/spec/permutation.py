@@ -221,9 +221,10 @@ class LightKey:
     light: str  # light brick id
     shadow: str  # canonical shadow spec
     dynamic: bool = False  # a loop over a storage buffer of lights with a runtime count
+    switch: bool = False  # (dynamic) read by the key's one loop over one buffer, switching on the pair (`**`)
 
     def canonical(self) -> str:
-        return f"{'*' if self.dynamic else ''}{self.light}/{self.shadow}"
+        return f"{'**' if self.switch else '*' if self.dynamic else ''}{self.light}/{self.shadow}"
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ The tolerance: the renderer compiles its own GLSL while the engine loads the bui
 pack, so a float may round differently in the last place, which can move a channel by one step of 8 bits; two
 steps or more is a real difference (a wrong binding, block, matrix or state moves whole regions, as the tests
 below that edit one field show). Measured on lavapipe (Mesa 25), 128 × 80: every channel equal (largest difference
-0) on all seven scenes (the dynamic light set's too).
+0) on all eight scenes (the dynamic light set's, in both loop forms, too).
 """
 from __future__ import annotations
 
@@ -137,6 +137,15 @@ def _written(path: Path, text: str) -> Path:
     return path
 
 
+def _switched(tmp: Path) -> Path:
+    """tests/scenes/dynamic_lights.toml with its dynamic set's loop = "switch", its placement beside it."""
+    src = REPO / "tests" / "scenes" / "dynamic_lights.toml"
+    text = src.read_text().replace("[light_sets.crowd]\ndynamic = true\n", '[light_sets.crowd]\ndynamic = true\nloop = "switch"\n')
+    assert 'loop = "switch"' in text
+    shutil.copy(src.with_name("dynamic_lights.placement.toml"), tmp / "dynamic_switch.placement.toml")
+    return _written(tmp / "dynamic_switch.toml", text)
+
+
 SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "textured": lambda tmp: REPO / "scenes" / "textured.toml",
           "gltf": lambda tmp: gltf_scene(tmp / "textured.gltf"),
@@ -147,6 +156,8 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "spot_shadow": lambda tmp: REPO / "tests" / "scenes" / "spot_shadow.toml",
           # a dynamic light set: 16 points and 2 spots in two storage buffers (manifest dynamic_light_sets)
           "dynamic": lambda tmp: REPO / "tests" / "scenes" / "dynamic_lights.toml",
+          # the same lights in one storage buffer, one loop switching on the pair (loop = "switch": ids, first)
+          "dynamic_switch": lambda tmp: _switched(tmp),
           # a masked, two blended (drawn back to front, as the export's draw_order says) and a double-sided object
           "surface_state": lambda tmp: REPO / "tests" / "scenes" / "surface_state.toml"}
 
