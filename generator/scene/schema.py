@@ -41,7 +41,7 @@ SCENE_SCHEMA = {
     "additionalProperties": False,
     "properties": {
         "scene": {"type": "object", "additionalProperties": False,
-                  "properties": {"name": NAME, "output": SPEC, "precision": NAME}},
+                  "properties": {"name": NAME, "output": SPEC, "precision": NAME, "ubershader": {"type": "boolean"}}},
         "materials": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["brdf"],
             "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS,
