@@ -248,6 +248,7 @@ class Errors:
     dirac: int = 0
     ill_conditioned: int = 0
     ref_inf: int = 0
+    ref_nan: int = 0  # values where the bricks' own float64 formula is NaN (precision mode only: add(nan_ref_ok))
     max_abs: float = 0.0
     mean_abs: float = 0.0
     max_rel: float = 0.0
@@ -260,8 +261,10 @@ class Errors:
     broken_by_param: dict = field(default_factory=dict)
 
     def add(self, got: np.ndarray, ref: np.ndarray, labels: list[str], params: dict,
-            comparable: np.ndarray | None = None) -> None:
-        """Fold one batch ((n, 3) arrays) into the statistics; `comparable`: (n,) well-conditioned samples."""
+            comparable: np.ndarray | None = None, nan_ref_ok: bool = False) -> None:
+        """Fold one batch ((n, 3) arrays) into the statistics; `comparable`: (n,) well-conditioned samples.
+        nan_ref_ok: `ref` is the bricks' own formula at float64, not an independent reference: its NaNs are
+        the formula's (plausibility counts them), left out and counted in ref_nan."""
         self.nan += int(np.count_nonzero(np.isnan(got)))
         self.inf += int(np.count_nonzero(np.isinf(got)))
         nonfinite = ~np.isfinite(got).all(axis=1)
@@ -270,6 +273,10 @@ class Errors:
             self._tally(params, labels, nonfinite)
             return
         nan_ref = np.isnan(ref)
+        was_nan = nan_ref if nan_ref_ok else np.zeros_like(nan_ref)
+        if was_nan.any():
+            ref = np.where(was_nan, np.inf, ref)  # left out below, as an infinite reference is
+            nan_ref = np.zeros_like(nan_ref)
         if nan_ref.any():
             i = int(np.argmax(nan_ref.any(axis=1)))
             raise ValueError(f"the float64 reference is NaN in {int(nan_ref.sum())} values (first: "
@@ -278,7 +285,8 @@ class Errors:
         keep = np.ones(len(got), bool) if comparable is None else comparable
         self.ill_conditioned += 3 * int(np.count_nonzero(~keep))
         inf_ref = keep[:, None] & np.isinf(ref)
-        self.ref_inf += int(np.count_nonzero(inf_ref))
+        self.ref_inf += int(np.count_nonzero(inf_ref & ~was_nan))
+        self.ref_nan += int(np.count_nonzero(inf_ref & was_nan))
         m = keep[:, None] & np.isfinite(got) & ~inf_ref
         if not m.any():
             self._tally(params, labels, nonfinite)
@@ -452,44 +460,53 @@ def rounded_inputs(s: SampleSet, dtype: str) -> list[np.ndarray]:
 
 
 def measure(spec: str, targets, dtypes, lib, hemisphere_k: int = 12, params: dict | None = None,
-            session=None) -> dict:
+            session=None, own: bool = False) -> dict:
     """Errors of every (target, dtype) against the reference for one spec: {set: {"target/dtype": Errors}}.
 
     params: a material's parameter values (`accuracy SCENE`): the hemisphere and the stress geometries
     are evaluated at them, instead of at the defaults and the parameter sweeps. session: the EvalSession the
-    GPU targets run on (None: one for this measure alone).
+    GPU targets run on (None: one for this measure alone). own: the spec has no independent reference
+    (missing_references()): every target is measured against the NumPy target of the bricks' own formula at
+    float64 instead, a precision error (which that run itself is left out of).
     """
     from .evaluate import own_session
 
     if not any(t in GPU_TARGETS for t in targets):
-        return _measure(spec, targets, dtypes, lib, hemisphere_k, params, session)
-    with own_session(session) as own:
-        return _measure(spec, targets, dtypes, lib, hemisphere_k, params, own)
+        return _measure(spec, targets, dtypes, lib, hemisphere_k, params, session, own)
+    with own_session(session) as s:
+        return _measure(spec, targets, dtypes, lib, hemisphere_k, params, s, own)
 
 
-def _measure(spec: str, targets, dtypes, lib, hemisphere_k: int, params: dict | None, session) -> dict:
+def _own_formula(spec, L, V, N, T, params, lib):
+    from .evaluate import evaluate
+    with np.errstate(all="ignore"):
+        return evaluate(spec, L, V, N, T, params, target="numpy", dtype="float64", lib=lib)
+
+
+def _measure(spec: str, targets, dtypes, lib, hemisphere_k: int, params: dict | None, session, own: bool) -> dict:
     from .evaluate import evaluate, gpu_kernel
     from ..reference import reference_brdf
 
+    reference_of = _own_formula if own else (lambda *a, lib: reference_brdf(*a, lib=lib))
     declared = declared_params(spec, lib)
     sets = {"hemisphere": [hemisphere(hemisphere_k, params=params)], "stress": stress_sets(declared, params)}
-    todo = runs(targets, dtypes, session)
+    todo = [(t, d) for t, d in runs(targets, dtypes, session) if not (own and (t, d) == ("numpy", "float64"))]
     out: dict = {}
     for set_name, batches in sets.items():
         stats = {f"{t}/{d}": Errors() for t, d in todo}
         for s in batches:
-            exact = reference_brdf(spec, s.L, s.V, s.N, s.T, s.params, lib=lib)
+            exact = reference_of(spec, s.L, s.V, s.N, s.T, s.params, lib=lib)
             refs: dict = {}
             for t, d in todo:
                 given = rounded_inputs(s, d)
                 if d not in refs:
-                    ref = reference_brdf(spec, *given, s.params, lib=lib)
+                    ref = reference_of(spec, *given, s.params, lib=lib)
                     with np.errstate(invalid="ignore"):
                         moved = np.abs(ref - exact) > ILL_CONDITIONED * np.maximum(np.abs(exact), REL_FLOOR)
                     refs[d] = ref, ~moved.any(axis=1)
                 with np.errstate(all="ignore"):  # float16 overflows (n = 1e5) are what we count
                     got = evaluate(spec, *given, s.params, target=t, dtype=d, lib=lib, session=session)
-                stats[f"{t}/{d}"].add(got, refs[d][0], s.labels, s.params, refs[d][1])
+                stats[f"{t}/{d}"].add(got, refs[d][0], s.labels, s.params, refs[d][1], nan_ref_ok=own)
         out[set_name] = stats
     for t, d in sorted({(t, d) for t, d in todo if t in GPU_TARGETS}):  # float32 and float16
         gpu_kernel(spec, t, lib, session, precision="fp16" if d == "float16" else "fp32").release()  # buffers
@@ -501,47 +518,79 @@ DEFAULT_TOL = 1e-3  # float32 hemisphere max relative error a spec may have and 
 
 
 def run(specs, targets, dtypes, lib, hemisphere_k: int = 12, tol: float = DEFAULT_TOL,
-        materials: dict | None = None, session=None) -> dict:
+        materials: dict | None = None, session=None, user: dict | None = None) -> dict:
     """The accuracy report of several specs as a JSON-ready dict, with a verdict per spec (see verdicts()).
 
     materials: {label: (spec, params)} — an entry of `specs` that is a label there is measured as
     that BRDF at those parameter values (a scene's material: `accuracy SCENE`); its results carry
     the label as "spec" and the BRDF as "brdf". session: the EvalSession the GPU targets run on (None:
-    one for this run alone, when a GPU target is asked for).
+    one for this run alone, when a GPU target is asked for). user: {"kind/id": file} of the references
+    registered from files the user named (user_references.py), reported as such.
+
+    A spec whose bricks lack a float64 reference is never an error: it gets the plausibility checks
+    (eval/plausibility.py) and the precision error of every target against its own formula at float64.
     """
     from .evaluate import own_session
 
     if not any(t in GPU_TARGETS for t in targets):
-        return _run(specs, targets, dtypes, lib, hemisphere_k, tol, materials or {}, session)
+        return _run(specs, targets, dtypes, lib, hemisphere_k, tol, materials or {}, session, user or {})
     with own_session(session) as own:
-        return _run(specs, targets, dtypes, lib, hemisphere_k, tol, materials or {}, own)
+        return _run(specs, targets, dtypes, lib, hemisphere_k, tol, materials or {}, own, user or {})
 
 
-def _run(specs, targets, dtypes, lib, hemisphere_k: int, tol: float, materials: dict, session) -> dict:
+def reference_source(spec: str, lib, user: dict | None = None) -> dict:
+    """What a spec is measured against: {"kind": "builtin" | "user" | "none", "files": [...], "missing": [...]}
+    ("none": some brick of it, "kind/id" in missing, has no float64 reference)."""
+    from ..reference import REFERENCES
+    from ..spec.resolve import resolve_brdf
+    bricks = [n.brick for top in resolve_brdf(spec, lib).nodes for n in top.tree]
+    keys = list(dict.fromkeys(f"{b.kind}/{b.id}" for b in bricks))
+    missing = [k for k in keys if k.partition("/")[2] not in REFERENCES.get(k.partition("/")[0], {})]
+    files = sorted({(user or {})[k] for k in keys if k in (user or {})})
+    kind = "none" if missing else "user" if files else "builtin"
+    return {"kind": kind, "files": files, "missing": missing}
+
+
+AGAINST = {"builtin": "float64 reference", "user": "user's float64 reference",
+           "none": "precision error (no independent reference)"}
+
+
+def _run(specs, targets, dtypes, lib, hemisphere_k: int, tol: float, materials: dict, session, user: dict) -> dict:
     from tqdm import tqdm
 
+    from . import plausibility
     from ..io import show_progress
-    results = []
+    results, sources, plausible = [], {}, {}
     for label in tqdm(specs, disable=not show_progress(), unit="spec", leave=False):
         spec, params = materials.get(label, (label, None))
         extra = {"brdf": spec, "params": _plain(params)} if label in materials else {}
-        for set_name, stats in measure(spec, targets, dtypes, lib, hemisphere_k, params, session).items():
+        sources[label] = src = reference_source(spec, lib, user)
+        own = src["kind"] == "none"
+        if own:
+            plausible[label] = plausibility.check(spec, lib, params) | {"spec": label}
+        for set_name, stats in measure(spec, targets, dtypes, lib, hemisphere_k, params, session, own).items():
             for key, e in stats.items():
                 t, d = key.split("/")
-                results.append({"spec": label, **extra, "set": set_name, "target": t, "dtype": d, **asdict(e)})
+                results.append({"spec": label, **extra, "set": set_name, "target": t, "dtype": d,
+                                "against": AGAINST[src["kind"]], **asdict(e)})
     bad = [r for r in results if r["dtype"] == "float32" and (r["nan"] or r["inf"])]
     return {"rel_floor": REL_FLOOR, "specs": list(specs),
             "runs": [f"{t}/{d}" for t, d in runs(targets, dtypes, session)],
             "results": results, "float32_finite": not bad, "tolerance": tol,
-            "verdicts": verdicts(results, specs, tol, lib), "skipped": skipped_runs(targets, dtypes, session)}
+            "verdicts": verdicts(results, specs, tol, lib, sources, plausible),
+            "plausibility": list(plausible.values()), "user_references": dict(user),
+            "skipped": skipped_runs(targets, dtypes, session)}
 
 
-def verdicts(results: list[dict], specs, tol: float, lib=None) -> list[dict]:
+def verdicts(results: list[dict], specs, tol: float, lib=None, sources: dict | None = None,
+             plausible: dict | None = None) -> list[dict]:
     """Per spec: pass when float32 gives no NaN or Inf anywhere and its hemisphere max relative error is at most
     tol (or the tolerance its bricks declare for their approximation: spec_tolerance) on every target; with the worst hemisphere error (and where) and the worst stress case (and which).
     Where no float32 ran (--dtypes float64), float64 is judged instead; float16 alone is reported, never
-    judged (pass stays True)."""
+    judged (pass stays True). sources: {spec: reference_source()}; plausible: {spec: plausibility.check()} of the
+    specs without an independent reference, whose checks must pass too (the failed ones are listed)."""
     out = []
+    sources, plausible = sources or {}, plausible or {}
     for spec in specs:
         mine = [r for r in results if r["spec"] == spec]
         f32 = ([r for r in mine if r["dtype"] == "float32"] or [r for r in mine if r["dtype"] == "float64"])
@@ -551,8 +600,13 @@ def verdicts(results: list[dict], specs, tol: float, lib=None) -> list[dict]:
         case = stress["worst"] if stress and stress["worst"] else None
         brdf = mine[0].get("brdf", spec) if mine else spec
         own = spec_tolerance(brdf, lib, tol)
-        out.append({"spec": spec, "pass": not nonfinite and (hemi is None or hemi["max_rel"] <= own),
-                    "tolerance": own,
+        src = sources.get(spec, {"kind": "builtin", "files": [], "missing": []})
+        plaus = plausible.get(spec)
+        failed = [c["check"] for c in plaus["checks"] if not c["pass"]] if plaus else []
+        out.append({"spec": spec, "pass": not nonfinite and (hemi is None or hemi["max_rel"] <= own) and not failed,
+                    "tolerance": own, "against": AGAINST[src["kind"]], "reference": src,
+                    "plausibility": None if plaus is None else ("pass" if not failed else "fail"),
+                    "plausibility_failed": failed,
                     "dtypes": sorted({r["dtype"] for r in f32}),
                     "float32_nan_inf": nonfinite,
                     "hemisphere_max_rel": hemi["max_rel"] if hemi else None,
@@ -683,8 +737,11 @@ def markdown(report: dict, detail: bool = False) -> str:
                   "a brick declares for its approximation (a baked table, a fit: shown beside its verdict). The stress "
                   "set's worst "
                   "case is shown, not judged: it holds grazing angles, α → 0 and huge exponents on purpose.", "",
+                  "Measured against: the BRDF's float64 reference (generator/reference/, or a file given with "
+                  "`--reference`); where a brick has none, the NumPy target of the bricks' own formula at float64, "
+                  "a precision error (no independent reference), with the plausibility checks below.", "",
                   "| spec | verdict | float32 hemisphere max rel (target) | float32 NaN/Inf | stress max rel (target, "
-                  "case) |", "|---|---|---|---|---|"]
+                  "case) | measured against |", "|---|---|---|---|---|---|"]
         for v in report["verdicts"]:
             hemi = (f"{_fmt(v['hemisphere_max_rel'])} ({v['hemisphere_target']})"
                     if v["hemisphere_max_rel"] is not None else "–")
@@ -692,9 +749,17 @@ def markdown(report: dict, detail: bool = False) -> str:
                       if v["stress_max_rel"] is not None else "–")
             own = v.get("tolerance", report["tolerance"])  # a brick's declared approximation tolerance
             verdict = ("pass" if v["pass"] else "**FAIL**") + (f" (at {own:g})" if own != report["tolerance"] else "")
+            src = v.get("reference") or {}
+            against = v.get("against", AGAINST["builtin"]) + (f" ({', '.join(src['files'])})" if src.get("files")
+                                                               else "")
+            if v.get("plausibility_failed"):
+                verdict += f" (plausibility: {', '.join(v['plausibility_failed'])})"
             lines.append(f"| `{v['spec']}` | {verdict} | {hemi} | "
-                         f"{v['float32_nan_inf']} | {stress} |")
+                         f"{v['float32_nan_inf']} | {stress} | {against} |")
         lines.append("")
+    if report.get("plausibility"):
+        from .plausibility import markdown as plausibility_table
+        lines += plausibility_table(report["plausibility"])
     fp16 = [v for v in report.get("verdicts", []) if v.get("fp16_pass") is not None]
     if fp16:
         lines += ["## fp16 per spec (reported, not judged)", "",

@@ -252,7 +252,7 @@ def test_command_errors(tmp_path, capsys):
     (tmp_path / "no_reference.py").write_text(NAN_PROBE.replace("NaN for grazing views", "without reference"))
     cases = [
         (["accuracy", "no_reference", "--bricks", str(tmp_path), "--targets", "numpy"],
-         "diffuse brick 'no_reference' has no float64 reference"),
+         "spec string 'no_reference':1:1: BRDF 'no_reference': plausibility check 'float32 finite' fails"),
         (["accuracy", "lambrt", "--targets", "numpy"], "unknown diffuse/specular brick 'lambrt'"),
         (["accuracy", "lambert", "--targets", "numpy,metal"], "unknown target 'metal'"),
         (["accuracy", "lambert", "--targets", "glsl", "--dtypes", "float64"], "GPU targets run float32"),

@@ -1,7 +1,7 @@
 """`shadermatrix accuracy`: error of every target and dtype against the float64 references.
 
     shadermatrix accuracy [SPEC ... | SCENE] [--targets numpy,glsl,hlsl,wgsl] [--dtypes float64,float32,float16]
-                          [--format md|json] [--out FILE] [--samples K] [--fail-above TOL]
+                          [--format md|json] [--out FILE] [--samples K] [--fail-above TOL] [--reference FILE.py ...]
 
 Without SPECs: every BRDF brick (each diffuse term, each specular term with
 each slot filler at least once; --all-combinations: every combination). With
@@ -11,8 +11,13 @@ material's factor, the value the texture is multiplied by). Without --targets: n
 WGSL; without a lavapipe device that is an error (exit 3), never a silent
 numpy-only report: pass --targets numpy to run without one. Two sample sets per spec: a
 stratified hemisphere (K⁴ samples) and the stress set (see generator/eval/accuracy.py).
+A spec or material whose bricks have no float64 reference is measured all the same: the plausibility
+checks (generator/eval/plausibility.py) and every target's precision error against the NumPy target of
+its own formula at float64; --reference FILE.py runs a file of the user's that registers independent
+references (user code, run only when named: generator/eval/user_references.py).
 Exit status 1 when any float32 evaluation gives NaN or Inf (or, with
---fail-above, a float32 hemisphere error exceeds TOL), or on bad input.
+--fail-above, a float32 hemisphere error exceeds TOL), a plausibility check fails (located at the
+material's scene line), or on bad input.
 """
 from __future__ import annotations
 
@@ -52,6 +57,9 @@ def add_arguments(p) -> None:
                    help="Markdown: every target's errors per sample set and the stress set by parameter value, "
                         "below the verdicts")
     p.add_argument("--bricks", action="append", metavar="DIR", help="an extra brick directory (repeatable)")
+    p.add_argument("--reference", action="append", metavar="FILE.py",
+                   help="a Python file registering float64 references for engine bricks with @reference(kind, id) "
+                        "(repeatable; user code: it is run, and only when named here)")
 
 
 def _list(value: str, allowed: tuple, what: str) -> list[str]:
@@ -81,6 +89,33 @@ def scene_materials(path: Path, lib) -> dict:
     return out
 
 
+def material_locations(path: Path, materials: dict) -> dict[str, str]:
+    """{label: "path:line:col"} of each material's `brdf =` in a TOML scene (a glTF scene: its path, 1:1)."""
+    if path.suffix.lower() != ".toml":
+        return {label: f"{path}:1:1" for label in materials}
+    from ...scene.load import read_toml
+    _data, loc = read_toml(path, "scene", "fix the scene file's syntax")
+    return {label: "{}:{}:{}".format(path, *loc.find(f"materials.{label.partition(': ')[0]}", "brdf"))
+            for label in materials}
+
+
+def plausibility_errors(report: dict, where: dict[str, str], materials: dict | None) -> list[str]:
+    """One line per failed plausibility check: at the material's scene line (a spec: its string), what failed."""
+    out = []
+    for r in report.get("plausibility", []):
+        label = r["spec"]
+        at = where.get(label, f"spec string '{label}':1:1")
+        what = (f"material '{label.partition(': ')[0]}' ({label.partition(': ')[2]})" if materials and label in materials
+                else f"BRDF '{label}'")
+        for c in (c for c in r["checks"] if not c["pass"]):
+            todo = ('declare "reciprocal": "no: why" in the BRICK of a brick that is not reciprocal by design, or fix '
+                    "its formula" if c["check"] == "reciprocity" else
+                    'declare "fp16": "unsafe: why" in the BRICK, or guard the formula in half'
+                    if c["check"] == "float16 finite" else "fix the brick's formula or the material's parameters")
+            out.append(f"{at}: {what}: plausibility check '{c['check']}' fails: {c['detail']} — {todo}")
+    return out
+
+
 def run(args) -> int:
     from ...runtime.eval_kernel import EvalSession
 
@@ -90,6 +125,7 @@ def run(args) -> int:
 
 def _run(args, session) -> int:
     from ...eval import accuracy
+    from ...eval.user_references import user_references
     from ...library.bricks import load_library
     from ...io import atomic_write
     from ...eval.evaluate import EvalError
@@ -110,7 +146,7 @@ def _run(args, session) -> int:
                 raise VulkanUnavailable("no lavapipe Vulkan device for the GPU targets (`shadermatrix doctor` says "
                                         "why; `make setup` installs it) — or pass --targets numpy to run without")
         lib = load_library(args.bricks or ())
-        materials = None
+        materials, where = None, {}
         if args.all_combinations and args.specs:
             raise UsageError("--all-combinations chooses the specs itself — give it without SPECs or a scene")
         scenes = [s for s in args.specs if _is_scene(s)]
@@ -121,6 +157,7 @@ def _run(args, session) -> int:
                 raise UsageError("give either BRDF specs or one scene file, not both — "
                                  f"e.g. shadermatrix accuracy {scenes[0]}")
             materials = scene_materials(Path(args.specs[0]), lib)
+            where = material_locations(Path(args.specs[0]), materials)
             specs = list(materials)
         else:
             specs = args.specs or accuracy.default_specs(lib, full=args.all_combinations)
@@ -128,8 +165,9 @@ def _run(args, session) -> int:
             raise UsageError(f"no target runs any of the dtypes {', '.join(dtypes)} — "
                              "GPU targets run float32 and float16; add float32 or the numpy target")
         tol = accuracy.DEFAULT_TOL if args.fail_above is None else args.fail_above
-        report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples, tol=tol, materials=materials,
-                              session=session)
+        with user_references(args.reference) as user:
+            report = accuracy.run(specs, targets, dtypes, lib, hemisphere_k=args.samples, tol=tol,
+                                  materials=materials, session=session, user=user)
     except (EvalError, SpecError, ReferenceMissing) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
@@ -152,6 +190,14 @@ def _run(args, session) -> int:
             why = "--fail-above" if own == tol else "the brick's declared tolerance, or --fail-above if larger"
             print(f"error: {v['spec']} {v['hemisphere_target']}/{'/'.join(v['dtypes'])}: hemisphere max relative "
                   f"error {v['hemisphere_max_rel']:.3g} exceeds the tolerance {own:g} ({why})", file=sys.stderr)
+    implausible = plausibility_errors(report, where, materials)
+    for line in implausible:
+        print(f"error: {line}", file=sys.stderr)
+    for v in report["verdicts"]:
+        if v.get("reference", {}).get("kind") == "none":
+            print(f"note: {v['spec']}: no float64 reference for {', '.join(v['reference']['missing'])} — plausibility "
+                  "checks and the precision error against its own formula instead (--reference FILE.py adds one)",
+                  file=sys.stderr)
     skipped = report.get("skipped", [])
     for sk in (x for x in skipped if not x["run"].endswith("/float64")):  # float64 on a GPU: never, by design
         print(f"note: not run: {sk['run']} — {sk['why']}", file=sys.stderr)
