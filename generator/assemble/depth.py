@@ -60,7 +60,7 @@ def write_depth_passes(build) -> None:
     textures_of = {h: e["interface"]["frag"].get("textures", []) for h, e in ok.items()}
     for ln, textures in shadowed.items():
         light = manifest["lights"][ln]
-        binds = bindings(ln, textures, _Objects(scene, resolved).objects, textures_of)
+        binds = bindings(ln, textures, _Objects(scene, resolved).objects, textures_of, scene)
         light["depth_pass"] = depth_pass(scene.lights[ln], textures, light["params"],
                                          pass_units(plan, MOMENTS in textures), binds, SHADOW_SIZE, conventions)
 

@@ -17,7 +17,7 @@ from ..spec.params import Params
 from ..spec.permutation import Node, Permutation
 from ..spec.resolve import Resolved, ResolvedBrdf, resolve, resolve_brdf
 from ..spec.where import KeyProblem, spec_where, within
-from .faces import face_params
+from .faces import buffer_params, face_params
 from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue, switch_params, switch_textures
 from .interface import (FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
                         vec4_array_block)
@@ -210,7 +210,7 @@ def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
                               "array_stride": at, "members": fields}], slots))
     params = {"material": {p: s for _, p, _, _, s in g.material}}
     for i, lt in enumerate(r.lights):
-        params[f"light{i}"] = face_params(lt)  # a point light's six face matrices too (link/faces.py)
+        params[f"light{i}"] = (buffer_params if lt.dynamic else face_params)(lt)  # six faces, a first layer (link/faces.py)
     stages = {"comp": "main"} if kernel else {"vert": "main", "frag": "main"}
     iface = Interface(stages, g.brdf.reads, g.surface, blocks, g.textures,
                       [Location(0, "out_color", "vec4")], params=params)

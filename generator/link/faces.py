@@ -25,13 +25,14 @@ from __future__ import annotations
 from ..lang import SourceError, ir
 from ..lang.sampling import with_layer
 from ..lang.types import BOOL, FLOAT, INT, MAT4, VEC3, arrayed_texture, texture_type
+from ..scene.light_sets import CUBE_TYPES, MAX_SHADOW_LAYERS, shadow_layers  # noqa: F401 (re-exported)
 from ..spec.params import ParamSpec, Params
 
-CUBE_TYPES = ("point", "point_range")  # the light bricks whose shadow is six faces
 FACES = 6
 FACE_NAMES = ("+X", "-X", "+Y", "-Y", "+Z", "-Z")  # layer k is face k (Vulkan's cube-face order)
 FACE_MATRICES = ("shadow_matrix",) + tuple(f"shadow_matrix_{k}" for k in range(1, FACES))
 SHADOW_LAYER = "shadow_layer"  # the arrayed filter's added parameter: the layer its samples read
+FIRST_LAYER = "shadow_first_layer"  # a buffer light's value: its first layer in its pair's array (a float)
 _SAMPLES = ("sample", "sample_level", "sample_compare")
 
 
@@ -49,6 +50,23 @@ def face_params(lt) -> Params:
     extra = {n: ParamSpec(n, base.ty, base.default, base.range, f"face {k} ({FACE_NAMES[k]}) of {base.doc}",
                           base.owners) for k, n in enumerate(FACE_MATRICES) if k}
     return Params({**dict(lt.params), **extra})
+
+
+def buffer_params(lt) -> Params:
+    """A dynamic (buffer) LightPart's parameters, as its element holds them: face_params, and for a shadowed pair
+    FIRST_LAYER, the light's first layer in the pair's one array (a whole number; the build writes its ordinal in
+    the pair × its layers)."""
+    params = face_params(lt)
+    if not lt.textures:
+        return params
+    spec = ParamSpec(FIRST_LAYER, FLOAT, 0.0, (0.0, float(MAX_SHADOW_LAYERS - 1)),
+                     "the light's first layer in its pair's shadow-map array", ("generator/link/faces.py",))
+    return Params({**dict(params), FIRST_LAYER: spec})
+
+
+def first_layer(b, value: ir.Expr) -> ir.Expr:
+    """int(<value>): a FIRST_LAYER value as a layer."""
+    return ir.Construct(INT, b.here(), [b.copy(value)])
 
 
 def arrayed_entry(prog, node) -> ir.Function:
@@ -107,10 +125,12 @@ def face_select(b, r: ir.Expr, face: str) -> list[ir.Stmt]:
             b.if_(z_major, [b.assign(fv, side("z", 4))], [b.if_(y_major, [b.assign(b.copy(fv), side("y", 2))])])]
 
 
-def faced_call(b, bind, prog, node, i: int, L: ir.Expr, matrices: list[ir.Expr], call) -> list[ir.Stmt]:
+def faced_call(b, bind, prog, node, i: int, L: ir.Expr, matrices: list[ir.Expr], call,
+               first: ir.Expr | None = None) -> list[ir.Stmt]:
     """Statements declaring `face<i>`, `shadow_m<i>` (that face's matrix of `matrices`, FACE_MATRICES' values)
-    and ending with `s<i>` = the arrayed filter called with them; `call(fn, args)` makes the call the way the
-    glue binds the filter's other parameters."""
+    and ending with `s<i>` = the arrayed filter called with them (layer: first + the face, `first` an int
+    expression or None for 0); `call(fn, args)` makes the call the way the glue binds the filter's other
+    parameters."""
     face, m = f"face{i}", f"shadow_m{i}"
     stmts = face_select(b, ir.Unary(VEC3, b.here(), "-", b.copy(L)), face)
     stmts.append(b.decl(m, b.copy(matrices[0])))
@@ -118,7 +138,8 @@ def faced_call(b, bind, prog, node, i: int, L: ir.Expr, matrices: list[ir.Expr],
         stmts.append(b.if_(b.compare("==", b.var(face, INT), _int(b, k)),
                            [b.assign(b.var(m, MAT4), b.copy(matrices[k]))]))
     fn = arrayed_entry(prog, node)
-    stmts.append(b.decl(f"s{i}", call(fn, {"shadow_matrix": b.var(m, MAT4), SHADOW_LAYER: b.var(face, INT)})))
+    layer = b.var(face, INT) if first is None else ir.Binary(INT, b.here(), "+", first, b.var(face, INT))
+    stmts.append(b.decl(f"s{i}", call(fn, {"shadow_matrix": b.var(m, MAT4), SHADOW_LAYER: layer})))
     return stmts
 
 

@@ -22,7 +22,8 @@ from ..spec.params import Params
 from ..spec.permutation import Node
 from ..spec.resolve import LightPart, Resolved, ResolvedBrdf
 from ..spec.surface import EMISSIVE_MAP
-from .faces import FACE_MATRICES, face_params, faced, faced_call
+from .faces import (FACE_MATRICES, FIRST_LAYER, SHADOW_LAYER, arrayed_entry, buffer_params, face_params, faced,
+                    faced_call, first_layer)
 from .interface import VEC4_BYTES, Slot, Texture, layout, texture_type
 from .irgen import Builder
 from .program import Program
@@ -281,10 +282,15 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             values = _light_buffer(prog, b, i, lt, dynamic_lights, buffer_slots) if dyn else None
             body_i = [b.decl(f"L{i}", bind.call(prog, ln, "light_dir", pre, "light", i, locals_, values)), ndotl(i)]
             c = b.decl(f"c{i}", bind.call(prog, ln, "light_radiance", pre, "light", i, locals_, values))
+            # a buffer light's layer in its pair's array starts at its element's first layer (link/faces.py)
+            first = first_layer(b, values[FIRST_LAYER]) if dyn and lt.textures else None
             if faced(lt.brick.id, lt.textures):  # six faces: the face's matrix and layer (link/faces.py)
                 mats = [values[n] if values else bind.param(pre + n, MAT4) for n in FACE_MATRICES]
                 s = faced_call(b, bind, prog, sh, i, b.var(f"L{i}", VEC3), mats, lambda fn, a, sh=sh, pre=pre, i=i, v=values:
-                               bind.call(prog, sh, "", pre, "light", i, locals_, {**(v or {}), **a}, fn))
+                               bind.call(prog, sh, "", pre, "light", i, locals_, {**(v or {}), **a}, fn), first)
+            elif first is not None:  # a buffer spot or directional light: its one layer
+                s = [b.decl(f"s{i}", bind.call(prog, sh, "", pre, "light", i, locals_, {**values, SHADOW_LAYER: first},
+                                               arrayed_entry(prog, sh)))]
             else:
                 s = [b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_, values))]
             body_i.append(lit_if(i, [c, *s]))
@@ -446,8 +452,8 @@ def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list,
     Lights block packs them (interface.layout): the layout rule of types.buffer_layout_error, so
     GLSL std430, HLSL structured buffers and WGSL storage agree byte for byte.
     """
-    params = lt.params
-    _untextured(lt)
+    params = buffer_params(lt)  # a shadowed pair's face matrices and first layer too (link/faces.py)
+    _untextured(lt, shadow=True)
     slots, n = layout([(k, k, None, p.ty, p, i) for k, p in params.items()])
     data_ty = array(VEC4, max(n, 1))
     elem = struct(f"LightData{i}", (("data", data_ty),))
@@ -459,9 +465,10 @@ def _light_buffer(prog: Program, b: Builder, i: int, lt: LightPart, out: list,
     return {s.name: read_slot(b, item, data_ty, s) for s in slots}
 
 
-def _untextured(lt: LightPart) -> None:
-    """Refuse a buffer light whose brick or shadow filter binds a texture (a located error at the brick)."""
-    owners = [(n.brick, x) for n in [lt.node, *lt.shadow.tree] for x in n.brick.textures]
+def _untextured(lt: LightPart, shadow: bool = False) -> None:
+    """Refuse a buffer light whose brick or (unless `shadow`: a loop that reads a pair's shadow array) shadow filter
+    binds a texture (a located error at the brick)."""
+    owners = [(n.brick, x) for n in [lt.node, *([] if shadow else lt.shadow.tree)] for x in n.brick.textures]
     if owners:
         brick, tex = owners[0]
         loc = brick.module.meta_loc

@@ -127,11 +127,13 @@ class Uber:
         """What a light entry of a point light's six faces holds (only when some filter reads them)."""
         if not self.faced_shadows:
             return {}
-        return {"ids": "ivec4 (light type, shadow, shadow map, 1 for a point light's six faces, else 0)",
+        return {"ids": "ivec4 (light type, shadow, shadow map, faces + 2 x first layer: faces 1 for a point light's "
+                       "six, first its first layer in the map's array; 0 for a static light's one map)",
                 "faced_shadows": list(self.faced_shadows),
-                "faces": "a faced filter's shadow maps are 2D arrays: a point light's six faces (ids.w = 1; "
-                         "shadow_matrix face 0's, shadow_matrix_1 ... _5 in its entry as light_layouts say), "
-                         "any other light's one map as layer 0"}
+                "faces": "a faced filter's shadow maps are 2D arrays: a point light's six faces (shadow_matrix face "
+                         "0's, shadow_matrix_1 ... _5 in its entry as light_layouts say), a dynamic set's pair's "
+                         "lights each its layers of one array (one shadow map slot), any other light's one map "
+                         "as layer 0"}
 
 
 def _zero(b: Builder, ty: Type) -> ir.Expr:
@@ -167,7 +169,8 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     shadows: list[str] = []
     lights, shadow_of = {}, {}  # light type -> its LightPart's params; shadow spec -> the filter's node, params
     shadowed = 0
-    faced_shadows: set[str] = set()  # the filters some point light reads six faces with (link/faces.py)
+    faced_shadows: set[str] = set()  # the filters whose maps are 2D arrays: six faces, or a buffer pair's lights
+    cube_shadows: set[str] = set()  # those some point light reads six faces with (link/faces.py)
     alpha_variants: set[int] = set()  # the variants a masked or blended permutation uses
     modes, double_sided, emits = {"opaque"}, False, {"none"}
     for r in [p if isinstance(p, Resolved) else resolve(p, lib) for p in perms]:
@@ -190,6 +193,9 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
                 shadow_of[lk.shadow] = (lt.shadow, lt.shadow_params)
             if faced(lk.light, lt.textures):  # its filter's maps are arrays: a point light's six faces
                 faced_shadows.add(lk.shadow)
+                cube_shadows.add(lk.shadow)
+            if lk.dynamic and lt.textures:  # or a buffer pair's lights, each its layers of one array
+                faced_shadows.add(lk.shadow)
         shadowed = max(shadowed, sum(1 for lt in r.lights if lt.textures))
     prog, b = Program(lib_memo=lib.memo), Builder()
     bind = _Binder(b)
@@ -200,7 +206,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     snodes = {s: shadow_of[s][0] for s in shadows}
     A = max([1] + [_vec4s(lights[t][1]) for t in light_types])
     S = max([0] + [_vec4s(shadow_of[s][1]) for s in shadows])
-    F = 4 * (FACES - 1) if faced_shadows else 0  # the faces' matrices 1 … 5 after every filter's parameters
+    F = 4 * (FACES - 1) if cube_shadows else 0  # the faces' matrices 1 … 5 after every filter's parameters
     K = A + max(S, 1) + F
     mat_data, light_data = array(VEC4, M), array(VEC4, K)
     MaterialEntry = struct("MaterialEntry", (("ids", IVEC4), ("data", mat_data)))
@@ -223,7 +229,7 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     for t in lnodes:
         for s in snodes:
             own = _packed(lights[t][1]) + _packed(shadow_of[s][1], A)
-            if t in CUBE_TYPES and s in faced_shadows:
+            if t in CUBE_TYPES and s in cube_shadows:
                 own += _face_slots(shadow_of[s][1], A + max(S, 1))
             layouts[(t, s)] = {x.name: x for x in own}
 
@@ -335,19 +341,26 @@ def _face_slots(shadow_params, start: int) -> list[Slot]:
 
 
 def _faced_case(b, prog, bind, sn, sel, le, light_data, slots, args, call) -> list:
-    """The statements of filter `sn`'s case for arrays: face 0 and `shadow_matrix`, or where ids.w is 1 (a point
-    light's six faces) the face of -L and its matrix from the entry (`slots`: faces 1 … 5's), then `call(fn,
-    targs)` with the face as layer (link/faces.py)."""
+    """The statements of filter `sn`'s case for arrays: ids.w = faces + 2 × first (faces 1 for a point light's six,
+    first its first layer: a buffer pair's lights share one array); layer first + face, face 0 and `shadow_matrix`,
+    or with faces the face of -L and its matrix from the entry (`slots`: faces 1 … 5's, None where no point light
+    reads this filter); then `call(fn, targs)` (link/faces.py)."""
+    two = ir.Const(INT, b.here(), 2)
+    first = ir.Binary(INT, b.here(), "/", sel("w"), two)
+    if slots is None:
+        return [call(arrayed_entry(prog, sn), {**args, SHADOW_LAYER: first})]
     m = b.var("shadow_m", MAT4)
     pick = face_select(b, ir.Unary(VEC3, b.here(), "-", b.var("L", VEC3)), "cube_face")
     pick.append(b.assign(b.var("face", INT), b.var("cube_face", INT)))
     for k, n in enumerate(FACE_MATRICES[1:], 1):
         pick.append(b.if_(b.compare("==", b.var("face", INT), ir.Const(INT, b.here(), k)),
                           [b.assign(b.copy(m), read_slot(b, le, light_data, slots[n]))]))
+    faces = ir.Binary(INT, b.here(), "%", sel("w"), b.copy(two))
     return [b.decl("face", ir.Const(INT, b.here(), 0)), b.decl("shadow_m", b.copy(args["shadow_matrix"])),
-            b.if_(b.compare("==", sel("w"), ir.Const(INT, b.here(), 1)), pick),
+            b.if_(b.compare("==", faces, ir.Const(INT, b.here(), 1)), pick),
             call(arrayed_entry(prog, sn), {**args, "shadow_matrix": b.var("shadow_m", MAT4),
-                                           SHADOW_LAYER: b.var("face", INT)})]
+                                           SHADOW_LAYER: ir.Binary(INT, b.here(), "+", b.copy(first),
+                                                                   b.var("face", INT))})]
 
 
 def _texture_types(node) -> dict[str, Type]:
@@ -404,7 +417,8 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
         arrays = s in faced_shadows  # every map of this filter is a 2D array (one layer, or a point light's six)
         if arrays:
             textype = {t: arrayed_texture(ty) for t, ty in textype.items()}
-            faces_at = layouts[(next(t for t in lnodes if t in CUBE_TYPES), s)]
+            cube = next((t for t in lnodes if t in CUBE_TYPES), None)
+            faces_at = layouts[(cube, s)] if cube is not None and FACE_MATRICES[1] in layouts[(cube, s)] else None
         for j in range(max(shadowed, 1)):
             targs = dict(args)
             for tex in texnames:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import struct
 
 from ..scene.load import Scene
+from .faces import FIRST_LAYER, shadow_layers
 from .interface import pack, put
 
 
@@ -64,11 +65,13 @@ def light_buffer_block(i: int) -> str:
     return f"{LIGHT_BUFFER}{i}"
 
 
-def light_buffers(scene: Scene, names: list[str], dyn, c) -> dict[str, bytes]:
+def light_buffers(scene: Scene, names: list[str], dyn, c, overrides: dict | None = None) -> dict[str, bytes]:
     """Per pair of a dynamic set's model, its storage block's name and bytes: the lights `names` of that pair, in
     their order, each element laid out as the block's parameters say (a static set's values, so both draw alike).
     A switch loop's one block (every pair's block) holds the pairs one after another, in the model's order, each
-    element its ids (ids.x the pair's light index, int32) then its values (link/glue.py _switch_buffer)."""
+    element its ids (ids.x the pair's light index, int32) then its values (link/glue.py _switch_buffer).
+    A shadowed pair's light k has its first layer k × its layers (link/faces.py); overrides: {light: {param:
+    value}} over the scene's values (the renderer's fitted shadow matrices)."""
     out = {}
     for i, pair in enumerate(dyn.model):
         block = light_buffer_of(c.interface, i)
@@ -76,10 +79,12 @@ def light_buffers(scene: Scene, names: list[str], dyn, c) -> dict[str, bytes]:
         specs = c.interface.params.get(f"light{i}", {})
         slots = [s for s in block.slots if s.light == i]
         head = switch_ids(i) if is_switch(block) else b""
-        data = b""
+        data, ordinal = b"", 0
         for ln in names:
             if dyn.pair_of(scene.lights[ln]) == i:
-                v = light_values(scene, ln, specs)
+                v = {**light_values(scene, ln, specs), **(overrides or {}).get(ln, {})}
+                if FIRST_LAYER in specs:  # its layers in the pair's shadow array follow the pair's earlier lights'
+                    v[FIRST_LAYER], ordinal = float(ordinal * shadow_layers(pair.light)), ordinal + 1
                 data += head + pack(slots, {s.name: _element(v[s.param], s) for s in slots}, (stride - len(head)) // 16)
         out[block.name] = out.get(block.name, b"") + data
     return out

@@ -71,7 +71,7 @@ from pathlib import Path
 import numpy as np
 
 from .placement import load_placement, make_mesh
-from ..link.faces import FACE_MATRICES, faced
+from ..link.faces import FACE_MATRICES, faced, shadow_layers
 from .shadow_pass import MOMENTS, PCF_TEXEL, SHADOW_SIZE, face_values, moments_map, shadow_textures  # noqa: F401
 
 MODES = ("specialized", "ubershader", "hybrid")
@@ -200,6 +200,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from . import shader_cache
     from ..compose.depth import compose_depth_units
     from ..link import link_permutation
+    from ..link.values import light_buffers as pair_buffers
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
     from .material_textures import BuildOutputs, MaterialTextures
     from .pipeline_state import COLOR_FORMATS, clear_color, color_attachment, render_state
@@ -348,7 +349,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
 
         # Depth passes: every object drawn from each shadowed light by the generated depth units, as its
         # depth_pass description says (runtime/depth_passes.py).
-        shadow_maps, moments = {}, {}
+        shadow_maps, moments, face_maps = {}, {}, {}
         if shadowed:
             passes = DepthPasses(device, spv, {n: c.interface for n, c in depth_units.items()}, owned, cache)
             casters = []
@@ -375,6 +376,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     shadow_maps[ln] = drawn.depth
                 if drawn.moments is not None:
                     moments[ln] = drawn.moments
+                # each layer's own map, for a buffer light's pair array (pair_array)
+                face_maps[ln] = [d.blurred.image if d.blurred is not None else d.depth for d in drawn.faces or [drawn]]
                 report.shadow_maps[ln] = {"size": desc["size"], "gpu_ms": drawn.gpu_ms,
                                           "sampled": drawn.depth.sampled if drawn.depth is not None else "moments",
                                           "pipeline_ms": drawn.pipeline_ms, "depth_units": drawn.units,
@@ -409,15 +412,26 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         for set_name, names in scene.light_sets.items():
             ids, rows, shadow_slot = [], [], 0
             slot_lights[set_name] = []  # ubershader shadow-map slot j -> the light whose map it is
+            dyn, pair_slot, layer_of = scene.dynamic_sets.get(set_name), {}, {}
             for ln in names:
                 L = scene.lights[ln]
                 data = light_entry(u, L.type, L.shadow, light_vals[ln])
                 textured = bool(sampled[L.shadow])
-                ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), shadow_slot if textured else 0,
-                            int(faced(L.type, sampled[L.shadow]))))  # ids.w: a point light's six faces
-                if textured:
+                slot, first = shadow_slot, 0
+                if textured and dyn is not None:  # a buffer pair's lights share its array: one slot, their layers
+                    pair = dyn.pair_of(L)
+                    if pair not in pair_slot:
+                        pair_slot[pair] = shadow_slot
+                        slot_lights[set_name].append(("pair", pair))
+                        shadow_slot += 1
+                    slot, first = pair_slot[pair], layer_of.get(pair, 0)
+                    layer_of[pair] = first + shadow_layers(L.type)
+                elif textured:
                     slot_lights[set_name].append(ln)
-                shadow_slot += textured
+                    shadow_slot += 1
+                # ids.w: faces (1: a point light's six) + 2 × its first layer (link/uber.py)
+                ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), slot if textured else 0,
+                            int(faced(L.type, sampled[L.shadow])) + 2 * first))
                 rows.append(data)
             if rows:
                 light_buffers[set_name] = buf(entry_bytes(np.array(ids), np.stack(rows)), S)
@@ -435,6 +449,26 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             if t.compare:  # a depth image for a comparison sampler: the depth pass's own, or a lit (1.0) one
                 return depth_compared(shadow_maps.get(light_name), light_name)
             return shadow_maps[light_name] if light_name in shadow_maps else textures[t.param]
+
+        pair_arrays = {}  # (dynamic set, pair index, texture) -> its lights' maps, in the layers of one array
+
+        def pair_array(set_name, i, t):
+            """The shadow array of pair i of dynamic set `set_name` that texture t reads: its lights' layers (one, or
+            a point light's six), in the set's order of them (link/values.py writes each one's first layer so)."""
+            from .depth_images import LayeredImage
+
+            key = (set_name, i, t.param)
+            dyn = scene.dynamic_sets[set_name]
+            if t.param not in sampled.get(dyn.model[i].shadow, {}):  # an ubershader slot's texture of another filter
+                return stand_in(t)
+            if key not in pair_arrays:
+                names = [ln for ln in scene.light_sets[set_name] if dyn.pair_of(scene.lights[ln]) == i]
+                layers = [m for ln in names for m in face_maps.get(ln, [])]
+                if t.compare and layers:
+                    depth_compared(layers[0], names[0])  # refused where the device cannot compare D32 depth
+                pair_arrays[key] = LayeredImage(device, layers) if layers else stand_in(t)
+                owned.append(pair_arrays[key])
+            return pair_arrays[key]
 
         def stand_in(t):
             """A light texture no light's depth pass provides: the lit stand-in (a lit depth image if compared)."""
@@ -493,11 +527,19 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                                                                   matrices, texels), U)
             if c.interface.block("Material"):
                 spec[(1, 0)] = buf(bytes.fromhex(up["Material"]), U)
+            dyn = scene.dynamic_sets.get(obj["light_set"])
+            if dyn is not None and shadowed:  # the fitted matrices of its shadowed lights, in their elements
+                fitted = {ln: {**face_values(matrices[ln]), **({PCF_TEXEL: texels[ln]} if ln in texels else {})}
+                          for ln in obj["lights"] if ln in matrices}
+                up = {**up, "light_buffers": {n: d.hex() for n, d in
+                                              pair_buffers(scene, obj["lights"], dyn, c, fitted).items()}}
             for name, data in up.get("light_buffers", {}).items():  # a dynamic set: each pair's lights (link/values.py)
                 blk = c.interface.block(name)  # no light of the pair: a range below the stride, a count of 0
                 spec[(blk.set, blk.binding)] = buf(bytes.fromhex(data) or bytes(4), S)
             for t in c.interface.textures:
-                if t.group == "light":
+                if t.group == "light" and dyn is not None:  # a buffer light's pair: one array of its lights' maps
+                    res, smp = pair_array(obj["light_set"], t.light, t), sampler_of(t)
+                elif t.group == "light":
                     res, smp = light_texture(t, obj["lights"][t.light]), sampler_of(t)
                 else:
                     mtex.check_binding(obj["material"], t)
@@ -512,7 +554,12 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for t in uber.interface.textures:  # the draw's material's textures and samplers, as the specialized path's
                 if t.group == "light":
                     slots = slot_lights[obj["light_set"]]
-                    res = as_layers(t, light_texture(t, slots[t.light])) if t.light < len(slots) else stand_in(t)
+                    if t.light >= len(slots):
+                        res = stand_in(t)
+                    elif isinstance(slots[t.light], tuple):  # a dynamic set's pair: its one array
+                        res = pair_array(obj["light_set"], slots[t.light][1], t)
+                    else:
+                        res = as_layers(t, light_texture(t, slots[t.light]))
                     smp = sampler_of(t)
                 else:
                     mtex.check_binding(obj["material"], t, ubershader=True)

@@ -51,6 +51,11 @@ the same way gets the same matrix), per light brick:
   each widened by FIT_PADDING and at most tan(FIT_MAX_HALF_ANGLE); an `up` parallel to the axis (the brick's
   unshaped light) takes the widest.
 
+Lights in a buffer (a dynamic set's shadowed pair) are fitted and drawn as the static ones, each its own map or
+six faces; their pair reads one 2D array of them, light k's layers from k × its layers (its element's
+`shadow_first_layer`, link/values.py), the manifest's binds saying where (:func:`bindings`: `array`, with the
+array's capacity, max × layers, and its bytes).
+
 Near and far of every perspective fit: from the bounds' depths along the view axis, far = the farthest × 1.02 +
 1e-3, near = max(the nearest × 0.98, far × 1e-3). The bounds are the world-space corners of every caster's
 axis-aligned bounding box in its own space, transformed by its model matrix (runtime/placement.py,
@@ -393,6 +398,17 @@ BOUNDS = "object_box_corners"
 CASTERS = "light_sets"
 
 
+def _pair_layers(scene, dyn, light_name: str, pair: int, reads: str, size: int) -> dict:
+    """Where a dynamic set's light lies in its pair's shadow array (link/values.py writes its first layer so)."""
+    from ..link.faces import shadow_layers
+
+    names = [ln for ln in scene.light_sets[dyn.name] if dyn.pair_of(scene.lights[ln]) == pair]
+    per = shadow_layers(scene.lights[light_name].type)
+    capacity = dyn.max * per
+    return {"first_layer": names.index(light_name) * per, "layers": per, "capacity_layers": capacity,
+            "capacity_bytes": capacity * size * size * (16 if reads == "moments" else 4)}
+
+
 def platform_premultiply(depth_range: str, ndc_y: str, framebuffer_origin: str) -> list[list[float]]:
     """The matrix (row-major) a platform's depth pass puts before shadow_matrix in its Frame.view_proj, from its
     conventions (the module docstring): so that the pass writes the texel and depth the brick reads."""
@@ -442,20 +458,28 @@ def depth_pass(light, textures: dict[str, bool], values: dict, units: dict, bind
     return d
 
 
-def bindings(light_name: str, textures: dict[str, bool], objects, interfaces: dict) -> list[dict]:
+def bindings(light_name: str, textures: dict[str, bool], objects, interfaces: dict, scene=None,
+             size: int = SHADOW_SIZE) -> list[dict]:
     """Where a shadowed light's result binds: per permutation that reads it (an object's light set holds the light
     at index i), the texture of light i its filter samples, with its set, binding and sampler binding (the build
     adds ``sampler_state``, the row of the manifest's samplers it is read with: assemble/texture_outputs.py).
-    interfaces: {permutation hash: its textures as the manifest's Interface lists them (Texture.as_dict)}."""
+    interfaces: {permutation hash: its textures as the manifest's Interface lists them (Texture.as_dict)}.
+    A light of a dynamic set (`scene` says which) binds in its pair's one array (light_index: the pair's): its rows
+    add `array` ({first_layer, layers: its own; capacity: the set's max × its layers, and the bytes that array
+    takes at `size`})."""
     rows, seen = [], set()
     for o in objects:
         if light_name not in o["lights"] or (o["permutation"], light_name) in seen:
             continue
         seen.add((o["permutation"], light_name))
-        i = o["lights"].index(light_name)
+        dyn = getattr(scene, "dynamic_sets", {}).get(o.get("light_set"))
+        i = dyn.pair_of(scene.lights[light_name]) if dyn is not None else o["lights"].index(light_name)
         for t in interfaces.get(o["permutation"], []):
             if t.get("light") == i and t["name"] in textures:
                 reads = "moments" if t["name"] == MOMENTS else "depth"
-                rows.append({"permutation": o["permutation"], "light_index": i, "texture": t["name"], "set": t["set"],
-                             "binding": t["binding"], "sampler_binding": t["sampler_binding"], "image": reads})
+                row = {"permutation": o["permutation"], "light_index": i, "texture": t["name"], "set": t["set"],
+                       "binding": t["binding"], "sampler_binding": t["sampler_binding"], "image": reads}
+                if dyn is not None:
+                    row["array"] = _pair_layers(scene, dyn, light_name, i, reads, size)
+                rows.append(row)
     return sorted(rows, key=lambda r: (r["permutation"], r["texture"]))

@@ -16,8 +16,10 @@ The permutation key of an object lit by a dynamic set carries the set's model (s
 number of lights of those pairs is one shader per material. Why "types" is the default: docs/design/link.md,
 "Which light loop" (measured by benchmarks/lights.py).
 Why a model may name pairs no light has yet: an engine adding lights at run time needs the shader that reads
-them. A shadow filter that samples a texture cannot be looped over yet (one shadow map per element needs texture
-arrays), so such a pair is refused here, at the set, before any shader is linked.
+them. A pair whose shadow filter samples a texture reads one 2D array per (pair, filter texture): each light of it
+one layer (six for a point light's faces), its first layer in its element; the array holds max × that many layers,
+max × layers × size² × 4 bytes of depth (16 for vsm's moments), so max × layers above MAX_SHADOW_LAYERS is refused
+here, at the set's max, as are a shadowed pair of a switch loop and a light brick that samples a texture itself.
 """
 from __future__ import annotations
 
@@ -32,6 +34,8 @@ MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed
 DEFAULT_MAX = 256  # a dynamic set's buffer capacity when the scene gives none
 MAX_DYNAMIC = 1 << 16  # a dynamic set's largest capacity: what an engine allocates per pair must stay sane
 LOOPS = ("types", "switch")  # a dynamic set's light loop; the first is the default
+CUBE_TYPES = ("point", "point_range")  # the light bricks whose shadow is six faces (link/faces.py)
+MAX_SHADOW_LAYERS = 2048  # Vulkan's guaranteed minimum maxImageArrayLayers: the most layers of a pair's shadow array
 
 
 @dataclass(frozen=True)
@@ -141,20 +145,43 @@ def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library, header: tupl
                             f"'{name}' ({', '.join(f'{k.light}/{k.shadow}' for k in model)})",
                             f"add \"{light.type}/{light.shadow}\" to its model, or move '{n}' to another set")
     where = at("model") if "model" in t else at("lights")
-    for k in model:
-        sampled = _texture_of(lib, k)
-        if sampled:
-            raise loc.error(where, f"light set '{name}': lights in a buffer cannot have a shadow map yet "
-                            f"({k.light}/{k.shadow} samples '{sampled}')", "use shadow none, or a static set")
     cap = t.get("max", DEFAULT_MAX)
     if not 1 <= cap <= MAX_DYNAMIC:
         raise loc.error(at("max"), f"light set '{name}': max is {cap}, not between 1 and {MAX_DYNAMIC}",
                         f"give the capacity its buffers are allocated for, e.g. max = {DEFAULT_MAX}")
+    for k in model:
+        _shadow_capacity(loc, at("max") if "max" in t else where, name, k, cap, lib)
     if cap < len(members):
         raise loc.error(at("max"), f"light set '{name}' holds {len(members)} lights, more than its max = {cap}",
                         f"raise max to at least {len(members)}")
     scene.dynamic_sets[name] = DynamicSet(name, model, cap, loop)
     return members
+
+
+def shadow_layers(light_type: str) -> int:
+    """The shadow-map array layers one buffer light of `light_type` takes: six faces for a point light, else one."""
+    return 6 if light_type in CUBE_TYPES else 1
+
+
+def _shadow_capacity(loc: Locator, where, name: str, k: LightKey, cap: int, lib: Library) -> None:
+    """Refuse a pair whose lights a buffer cannot shadow: a light brick that samples a texture, a shadowed pair of a
+    switch loop, or one whose array (cap × its layers) would exceed MAX_SHADOW_LAYERS."""
+    sampled = _texture_of(lib, k)
+    if not sampled:
+        return
+    light = lib.get("light", k.light)
+    if light is not None and light.textures:
+        raise loc.error(where, f"light set '{name}': a light in a buffer cannot bind its brick's texture "
+                        f"({k.light} samples '{sampled}')", "use a static set for it")
+    if k.switch:
+        raise loc.error(where, f"light set '{name}': a switch loop cannot shadow its lights yet ({k.light}/{k.shadow} "
+                        f"samples '{sampled}')", 'use loop = "types" for shadowed lights, or shadow none')
+    layers = cap * shadow_layers(k.light)
+    if layers > MAX_SHADOW_LAYERS:
+        most = MAX_SHADOW_LAYERS // shadow_layers(k.light)
+        raise loc.error(where, f"light set '{name}': {k.light}/{k.shadow} lights take {layers} shadow-map layers at "
+                        f"max = {cap} ({shadow_layers(k.light)} each), more than the {MAX_SHADOW_LAYERS} every Vulkan "
+                        "device allows in one array (maxImageArrayLayers)", f"lower max to at most {most}")
 
 
 def _loop(loc: Locator, at, name: str, t: dict) -> str:

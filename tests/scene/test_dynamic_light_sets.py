@@ -60,8 +60,10 @@ CASES = [  # (id, table, extra lights, line of the error, words of the message)
     ("unknown-quoted-key", _crowd(2) + '"p1" = 0\n', "", 14, "unknown key 'p1' in light set 'crowd'"),
     ("typo-in-a-key", _crowd(2, "maximum = 8\n"), "", 14, "unknown key 'maximum' in light set 'crowd'",
      "did you mean 'max'?"),
-    ("pcf-is-sampled", "[light_sets.crowd]\ndynamic = true\nlights = []\nmodel = [\"point/pcf\"]\n", "", 8,
-     "lights in a buffer cannot have a shadow map yet", "use shadow none, or a static set"),
+    ("pcf-past-2048-layers", "[light_sets.crowd]\ndynamic = true\nlights = []\nmodel = [\"point/pcf\"]\nmax = 400\n",
+     "", 9, "point/pcf lights take 2400 shadow-map layers at max = 400", "lower max to at most 341"),
+    ("pcf-in-a-switch-loop", "[light_sets.crowd]\ndynamic = true\nlights = []\nmodel = [\"point/pcf\"]\n"
+     "loop = \"switch\"\n", "", 8, "a switch loop cannot shadow its lights yet", 'use loop = "types"'),
     ("malformed-model-entry", _crowd(2, 'model = ["point"]\n'), "", 14, "model entry 'point' is not TYPE/SHADOW"),
     ("unknown-type-in-model", _crowd(2, 'model = ["lamp/none"]\n'), "", 14, "unknown light type 'lamp'"),
     ("empty-model", "[light_sets.crowd]\ndynamic = true\nlights = []\nmodel = []\n", "", 14,
@@ -88,13 +90,12 @@ def test_a_wrong_dynamic_set_is_one_located_error(case, tmp_path):
     assert "\n" not in msg
 
 
-def test_a_shadowed_light_in_a_dynamic_set_is_refused_at_the_set(tmp_path):
+def test_a_shadowed_light_in_a_dynamic_set_is_accepted(tmp_path):
+    """Its pair reads one shadow array (tests/runtime/test_dynamic_shadows.py draws it)."""
     lamp = '[lights.lamp]\ntype = "spot"\nshadow = "shadow_map"\n'
     table = '[light_sets.crowd]\ndynamic = true\nlights = ["lamp"]\n'
-    with pytest.raises(SourceError) as e:
-        _load(tmp_path, _scene(0, table, lamp))
-    msg = str(e.value)
-    assert ":10:" in msg and "spot/shadow_map samples 'shadow_map'" in msg, msg
+    _, scene = _load(tmp_path, _scene(0, table, lamp))
+    assert [k.canonical() for k in scene.dynamic_sets["crowd"].model] == ["*spot/shadow_map"]
 
 
 def test_a_static_set_past_32_lights_points_at_dynamic_sets(tmp_path):
@@ -135,8 +136,8 @@ def test_a_gltf_lights_file_gives_shadows_and_a_dynamic_set(tmp_path):
     ('[lights.sun]\nshadows = "pcf"\n', 2, ["unknown key 'shadows' in [lights.sun]", "did you mean 'shadow'?"]),
     ('[light_set]\ndynamic = true\nmaxx = 4\n', 3, ["unknown key 'maxx' in [light_set]", "did you mean 'max'?"]),
     ('[light_set]\ndynamic = true\nmodel = ["point/none"]\n', 3, ["light 'sun' (directional/none) is not in the model"]),
-    ('[lights.sun]\nshadow = "pcf"\n[light_set]\ndynamic = true\n', 3,
-     ["lights in a buffer cannot have a shadow map yet"]),
+    ('[lights.sun]\nshadow = "pcf"\n[light_set]\ndynamic = true\nmax = 4000\n', 5,
+     ["directional/pcf lights take 4000 shadow-map layers", "lower max to at most 2048"]),
     ('[light_set]\nmax = 4\n', 2, ["'max' is for a dynamic light set"]),
     ('[light_set]\ndynamic = true\nmax = 2\n', 3, ["holds 3 lights, more than its max = 2"]),
 ])
