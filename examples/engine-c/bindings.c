@@ -39,7 +39,12 @@ static bool light_texture(engine *e, const draw_item *it, const texture_ref *t, 
         if (set != t->set || binding != t->binding || sampler_binding != t->sampler_binding)
             return j_fail(&m->src, where, "set %d binding %d/%d; the permutation's interface binds %s at %d %d/%d",
                           set, binding, sampler_binding, t->name, t->set, t->binding, t->sampler_binding);
-        if (strcmp(image, "depth") == 0 && !lp->moments)
+        if (t->array != (lp->face == 0))
+            return j_fail(&m->src, where, "%s is %s, and light %s has %s", t->name, t->array ? "a 2d_array" : "2D",
+                          lp->name, lp->face == 0 ? "six faces" : "one map");
+        if (lp->face == 0 && strcmp(image, lp->moments ? "moments" : "depth") == 0)
+            *view = lp->array.view;  /* a point light's six faces, one layer each */
+        else if (strcmp(image, "depth") == 0 && !lp->moments)
             *view = lp->depth.view;
         else if (strcmp(image, "moments") == 0 && lp->moments)
             *view = lp->targets[lp->nblur].view;

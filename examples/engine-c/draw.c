@@ -256,6 +256,7 @@ static bool record_and_submit(engine *e)
             vkCmdEndRenderPass(cmd);
         }
     }
+    record_face_copies(e, cmd);  /* a point light's faces into the layers its permutations read */
     VkClearValue clears[2];
     memcpy(clears[0].color.float32, e->f->clear_color, sizeof clears[0].color.float32);
     clears[1].depthStencil = (VkClearDepthStencilValue){e->f->clear_depth, 0};

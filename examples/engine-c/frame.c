@@ -161,6 +161,23 @@ static bool load_lights(frame *f)
                 return false;
             x->has_texel = true;
         }
+        const cJSON *faces = j_opt(l, "face_matrices");
+        if (faces) {  /* a point light's six faces (layer k face k), each one map's matrix */
+            if (!cJSON_IsArray(faces) || cJSON_GetArraySize(faces) != 6)
+                return j_fail(src, at, "face_matrices is not six matrices");
+            for (int k = 0; k < 6; k++) {
+                const cJSON *fm = cJSON_GetArrayItem(faces, k);
+                if (cJSON_GetArraySize(fm) != 16)
+                    return j_fail(src, at, "face_matrices[%d] is not 16 numbers", k);
+                for (int i = 0; i < 16; i++) {
+                    const cJSON *v = cJSON_GetArrayItem(fm, i);
+                    if (!cJSON_IsNumber(v))
+                        return j_fail(src, at, "face_matrices[%d][%d] is not a number", k, i);
+                    x->faces[k][i] = v->valuedouble;
+                }
+            }
+            x->nfaces = 6;
+        }
         const cJSON *casters = j_opt(l, "casters"), *c;
         if (casters) {  /* the objects of its light sets (absent in an older export: every object casts) */
             if (!cJSON_IsArray(casters))

@@ -79,11 +79,13 @@ static bool add_textures(const manifest *m, program *p, const cJSON *list, VkSha
         const char *dim = j_str(src, t, "dimension", at);
         if (!dim)
             return false;
-        if (strcmp(dim, "2d") != 0)
-            return j_fail(src, at, "texture %s is %s; this engine binds 2D textures only", r.name, dim);
         r.light = -1;
         if (j_opt(t, "light") && !j_int(src, t, "light", at, 0, 255, &r.light))
             return false;
+        r.array = strcmp(dim, "2d_array") == 0 && r.light >= 0;  /* a point light's six shadow faces */
+        if (strcmp(dim, "2d") != 0 && !r.array)
+            return j_fail(src, at, "texture %s is %s; this engine binds 2D textures (and a light's 2d_array of "
+                          "shadow faces) only", r.name, dim);
         int k;
         for (k = 0; k < p->ntextures; k++)
             if (p->textures[k].set == r.set && p->textures[k].binding == r.binding)

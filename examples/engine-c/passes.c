@@ -148,7 +148,7 @@ static bool light_view_proj(engine *e, const char *where, const cJSON *matrix, l
             p[r][c] = x->valuedouble;
         }
     }
-    const double *s = lp->fl->shadow_matrix;
+    const double *s = lp->face >= 0 ? lp->fl->faces[lp->face] : lp->fl->shadow_matrix;
     for (int r = 0; r < 4; r++)
         for (int c = 0; c < 4; c++) {
             double v = 0.0;
@@ -181,8 +181,8 @@ static bool blur_targets(engine *e, light_pass *lp, VkFormat format, const cJSON
         return false;
     for (int k = 0; k < lp->nblur; k++)
         if (!gpu_image_new(e->g, format, lp->width, lp->height, 1,
-                           VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
-                           &lp->targets[k + 1])
+                           VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT
+                           | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &lp->targets[k + 1])
             || !make_framebuffer(e->g, lp->blur_pass, &lp->targets[k + 1].view, 1, lp->width, lp->height,
                                  &lp->blur_framebuffers[k]))
             return false;
@@ -268,21 +268,26 @@ static bool moments_target(engine *e, const cJSON *dp, const char *where, light_
         && blur_targets(e, lp, cformat, moments, where);
 }
 
-static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass *lp)
+static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass *lp, int face)
 {
     gpu *g = e->g;
     char where[128];
     snprintf(where, sizeof where, "lights.%s.depth_pass", name);
     lp->name = name;
     lp->desc = dp;
+    lp->face = face;
     if (!(lp->fl = frame_light(e->f, name)))
         return fail("%s: lights: no %s, which the build shadows (%s) — export the frame of this build", e->f->file,
                     name, where);
+    if (face >= 0 && lp->fl->nfaces != 6)
+        return fail("%s: lights.%s has no face_matrices, and the build draws its six faces (%s.faces) — export the "
+                    "frame of this build", e->f->file, name, where);
     if (!read_depth_state(e, dp, where, lp))
         return false;
     /* A map the shaders sample (kind depth) is kept and filtered as the sampler row says (bilinear): the device
      * must sample and linearly filter D32_SFLOAT (lavapipe in Mesa 25 does; the renderer refuses otherwise). */
-    VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | (lp->moments ? 0 : VK_IMAGE_USAGE_SAMPLED_BIT);
+    VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | (lp->moments ? 0 : VK_IMAGE_USAGE_SAMPLED_BIT)
+                            | (face >= 0 && !lp->moments ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0);
     VkFormatFeatureFlags need = VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT
         | (lp->moments ? 0 : VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
     if (!gpu_format_has(g, VK_FORMAT_D32_SFLOAT, need))
@@ -304,17 +309,84 @@ bool light_passes(engine *e)
 {
     const cJSON *l;
     int n = 0;
-    cJSON_ArrayForEach(l, e->m->lights)
-        n += cJSON_IsObject(j_opt(l, "depth_pass"));
+    cJSON_ArrayForEach(l, e->m->lights) {
+        const cJSON *dp = j_opt(l, "depth_pass");
+        n += cJSON_IsObject(dp) ? (j_opt(dp, "faces") ? 6 : 1) : 0;
+    }
     e->passes = calloc((size_t)n + 1, sizeof *e->passes);
     if (!e->passes)
         return fail("out of memory");
     cJSON_ArrayForEach(l, e->m->lights) {
         const cJSON *dp = j_opt(l, "depth_pass");
-        if (cJSON_IsObject(dp) && !setup_pass(e, l->string, dp, &e->passes[e->npasses++]))
+        if (!cJSON_IsObject(dp))
+            continue;
+        if (!j_opt(dp, "faces")) {
+            if (!setup_pass(e, l->string, dp, &e->passes[e->npasses++], -1))
+                return false;
+            continue;
+        }
+        /* a point light's six faces: one pass each (face k's matrix), copied into the layers of one array */
+        light_pass *first = &e->passes[e->npasses];
+        for (int k = 0; k < 6; k++)
+            if (!setup_pass(e, l->string, dp, &e->passes[e->npasses++], k))
+                return false;
+        if (!face_array(e, first))
             return false;
     }
     return true;
+}
+
+/* The image a pass's result is sampled through: its depth, or its last blur target. */
+static const gpu_image *pass_result(const light_pass *lp)
+{
+    return lp->moments ? &lp->targets[lp->nblur] : &lp->depth;
+}
+
+/* Face 0's pass holds the 2D array of six layers that its light's permutations read. */
+bool face_array(engine *e, light_pass *first)
+{
+    const gpu_image *src = pass_result(first);
+    VkImageAspectFlags aspect = first->moments ? VK_IMAGE_ASPECT_COLOR_BIT : VK_IMAGE_ASPECT_DEPTH_BIT;
+    return gpu_image_array_new(e->g, src->format, first->width, first->height, 6,
+                               VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, aspect, &first->array);
+}
+
+/* After every pass: each face's result copied into its layer of face 0's array, left SHADER_READ_ONLY. */
+void record_face_copies(const engine *e, VkCommandBuffer cmd)
+{
+    for (int l = 0; l + 5 < e->npasses; l++) {
+        const light_pass *lp = &e->passes[l];
+        if (lp->face != 0)
+            continue;
+        VkImageAspectFlags aspect = lp->moments ? VK_IMAGE_ASPECT_COLOR_BIT : VK_IMAGE_ASPECT_DEPTH_BIT;
+        VkImageMemoryBarrier pre[7], post[7];
+        for (int k = 0; k < 7; k++) {
+            VkImage img = k < 6 ? pass_result(&e->passes[l + k])->image : lp->array.image;
+            VkImageSubresourceRange range = {aspect, 0, 1, 0, k < 6 ? 1 : 6};
+            VkImageLayout held = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+            VkImageLayout moved = k < 6 ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+            pre[k] = (VkImageMemoryBarrier){VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER, NULL,
+                                            k < 6 ? VK_ACCESS_SHADER_READ_BIT : 0,
+                                            k < 6 ? VK_ACCESS_TRANSFER_READ_BIT : VK_ACCESS_TRANSFER_WRITE_BIT,
+                                            k < 6 ? held : VK_IMAGE_LAYOUT_UNDEFINED, moved,
+                                            VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, img, range};
+            post[k] = (VkImageMemoryBarrier){VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER, NULL,
+                                             k < 6 ? VK_ACCESS_TRANSFER_READ_BIT : VK_ACCESS_TRANSFER_WRITE_BIT,
+                                             VK_ACCESS_SHADER_READ_BIT, moved, held,
+                                             VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, img, range};
+        }
+        VkPipelineStageFlags before = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT
+                                    | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+        vkCmdPipelineBarrier(cmd, before, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 7, pre);
+        for (int k = 0; k < 6; k++) {
+            VkImageCopy region = {{aspect, 0, 0, 1}, {0, 0, 0}, {aspect, 0, (uint32_t)k, 1}, {0, 0, 0},
+                                  {lp->width, lp->height, 1}};
+            vkCmdCopyImage(cmd, pass_result(&e->passes[l + k])->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           lp->array.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        }
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, NULL,
+                             0, NULL, 7, post);
+    }
 }
 
 bool light_pass_of(const engine *e, const char *light, const light_pass **out)

@@ -34,7 +34,9 @@ typedef struct light_pass {
     VkRenderPass render_pass;
     VkFramebuffer framebuffer;
     VkClearValue clears[2];
-    double view_proj[16];      /* premultiply.vulkan × shadow_matrix, column-major */
+    double view_proj[16];      /* premultiply.vulkan × shadow_matrix (or its face's), column-major */
+    int face;                  /* a point light's face this pass draws (one pass per face), or -1 */
+    gpu_image array;           /* on face 0's pass: the six faces' layers, copied in after the passes (what binds) */
     pipeline_state state;      /* the casters' fixed-function state */
     /* kind moments: the moments target, then one target per blur pass; the last is what binds */
     gpu_image targets[1 + MAX_BLUR];
@@ -120,6 +122,8 @@ bool color_state(const engine *e, const program *p, pipeline_state *st);
 
 /* passes.c: the light passes, and helpers every pass uses */
 bool light_passes(engine *e);
+bool face_array(engine *e, light_pass *first);
+void record_face_copies(const engine *e, VkCommandBuffer cmd);
 bool make_render_pass(gpu *g, VkFormat color, VkImageLayout color_final, VkFormat depth, bool keep_depth,
                       VkImageLayout depth_final, VkRenderPass *out);
 bool make_framebuffer(gpu *g, VkRenderPass pass, const VkImageView *views, uint32_t n, uint32_t w, uint32_t h,

@@ -301,6 +301,11 @@ static bool upload_block(engine *e, const draw_item *it, const block_ref *b, uns
         if (strcmp(name->valuestring, "shadow_matrix") == 0 && !put_floats(e, data, b, p, "shadow_matrix",
                                                                           fl->shadow_matrix, 16))
             return false;
+        /* a point light's faces 1 … 5 (face 0's is shadow_matrix) */
+        int face = 0;
+        if (fl->nfaces == 6 && sscanf(name->valuestring, "shadow_matrix_%d", &face) == 1 && face >= 1 && face <= 5
+            && !put_floats(e, data, b, p, name->valuestring, fl->faces[face], 16))
+            return false;
         if (strcmp(name->valuestring, "pcf_texel") == 0 && fl->has_texel
             && !put_floats(e, data, b, p, "pcf_texel", &fl->pcf_texel, 1))
             return false;

@@ -32,6 +32,7 @@ typedef struct block_ref {
 typedef struct texture_ref {
     const char *name;
     int set, binding, sampler_binding, light;
+    bool array;                /* a light's 2d_array: its six faces' layers */
     VkShaderStageFlags stages;
 } texture_ref;
 
@@ -107,6 +108,8 @@ typedef struct fobject {
 typedef struct flight {
     const char *name;
     double shadow_matrix[16];  /* column-major: world to the light's clip space */
+    int nfaces;                /* 6 for a point light's faces (face_matrices), else 0 */
+    double faces[6][16];       /* face k's matrix, drawn into layer k of its map */
     bool has_texel;
     double pcf_texel;
     int size[2];

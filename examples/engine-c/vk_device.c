@@ -313,8 +313,23 @@ bool gpu_buffer_new(gpu *g, VkDeviceSize size, VkBufferUsageFlags usage, const v
     return true;
 }
 
+static bool image_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uint32_t levels, uint32_t layers,
+                      VkImageViewType type, VkImageUsageFlags usage, VkImageAspectFlags aspect, gpu_image *out);
+
 bool gpu_image_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uint32_t levels, VkImageUsageFlags usage,
                    VkImageAspectFlags aspect, gpu_image *out)
+{
+    return image_new(g, format, width, height, levels, 1, VK_IMAGE_VIEW_TYPE_2D, usage, aspect, out);
+}
+
+bool gpu_image_array_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uint32_t layers,
+                         VkImageUsageFlags usage, VkImageAspectFlags aspect, gpu_image *out)
+{
+    return image_new(g, format, width, height, 1, layers, VK_IMAGE_VIEW_TYPE_2D_ARRAY, usage, aspect, out);
+}
+
+static bool image_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uint32_t levels, uint32_t layers,
+                      VkImageViewType type, VkImageUsageFlags usage, VkImageAspectFlags aspect, gpu_image *out)
 {
     memset(out, 0, sizeof *out);
     VkImageCreateInfo info = {.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
@@ -322,7 +337,7 @@ bool gpu_image_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uin
     info.format = format;
     info.extent = (VkExtent3D){width, height, 1};
     info.mipLevels = levels;
-    info.arrayLayers = 1;
+    info.arrayLayers = layers;
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
     info.usage = usage;
@@ -343,9 +358,9 @@ bool gpu_image_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uin
         return vk_failed("vkBindImageMemory", r);
     VkImageViewCreateInfo view = {.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     view.image = out->image;
-    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.viewType = type;
     view.format = format;
-    view.subresourceRange = (VkImageSubresourceRange){aspect, 0, levels, 0, 1};
+    view.subresourceRange = (VkImageSubresourceRange){aspect, 0, levels, 0, layers};
     if ((r = vkCreateImageView(g->device, &view, NULL, &out->view)) != VK_SUCCESS)
         return vk_failed("vkCreateImageView", r);
     out->format = format;

@@ -75,6 +75,9 @@ bool gpu_buffer_new(gpu *g, VkDeviceSize size, VkBufferUsageFlags usage, const v
 /* A 2D image of `levels` levels with a view of `aspect`; optimal tiling, device memory. */
 bool gpu_image_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uint32_t levels, VkImageUsageFlags usage,
                    VkImageAspectFlags aspect, gpu_image *out);
+/* One level of `layers` layers, viewed as a 2D array (a point light's six shadow faces). */
+bool gpu_image_array_new(gpu *g, VkFormat format, uint32_t width, uint32_t height, uint32_t layers,
+                         VkImageUsageFlags usage, VkImageAspectFlags aspect, gpu_image *out);
 /* Whether the device's optimal tiling has every bit of `need` for `format`. */
 bool gpu_format_has(gpu *g, VkFormat format, VkFormatFeatureFlags need);
 /* Starts recording into the one command buffer; gpu_submit_wait submits it and waits for the fence. */

@@ -6,7 +6,8 @@ The tolerance: the renderer compiles its own GLSL while the engine loads the bui
 pack, so a float may round differently in the last place, which can move a channel by one step of 8 bits; two
 steps or more is a real difference (a wrong binding, block, matrix or state moves whole regions, as the tests
 below that edit one field show). Measured on lavapipe (Mesa 25), 128 × 80: every channel equal (largest difference
-0) on all eight scenes (the dynamic light set's, in both loop forms, too).
+0) on all ten scenes (the dynamic light set's, in both loop forms, and a point light's six faces with pcf and
+with vsm, too).
 """
 from __future__ import annotations
 
@@ -137,6 +138,15 @@ def _written(path: Path, text: str) -> Path:
     return path
 
 
+def _point_vsm(tmp: Path) -> Path:
+    """tests/scenes/point_ring.toml with its light's filter vsm (no pcf parameters), its placement beside it."""
+    src = REPO / "tests" / "scenes" / "point_ring.toml"
+    text = src.read_text().replace('shadow = "pcf"', 'shadow = "vsm"').replace(", shadow_bias = 0.002, pcf_taps = 1.0", "")
+    assert 'shadow = "vsm"' in text and "pcf_taps" not in text
+    shutil.copy(src.with_name("point_ring.placement.toml"), tmp / "point_vsm.placement.toml")
+    return _written(tmp / "point_vsm.toml", text)
+
+
 def _switched(tmp: Path) -> Path:
     """tests/scenes/dynamic_lights.toml with its dynamic set's loop = "switch", its placement beside it."""
     src = REPO / "tests" / "scenes" / "dynamic_lights.toml"
@@ -154,6 +164,10 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "tables": lambda tmp: _written(tmp / "tables.toml", TABLES),
           # a spot light's perspective map with pcf, and an object outside its light set that casts nothing
           "spot_shadow": lambda tmp: REPO / "tests" / "scenes" / "spot_shadow.toml",
+          # a point light's six faces (pcf): six depth passes copied into the layers of one 2D array
+          "point_shadow": lambda tmp: REPO / "tests" / "scenes" / "point_ring.toml",
+          # the same with vsm: each face's moments blurred, then copied into its layer
+          "point_vsm": lambda tmp: _point_vsm(tmp),
           # a dynamic light set: 16 points and 2 spots in two storage buffers (manifest dynamic_light_sets)
           "dynamic": lambda tmp: REPO / "tests" / "scenes" / "dynamic_lights.toml",
           # the same lights in one storage buffer, one loop switching on the pair (loop = "switch": ids, first)
