@@ -18,6 +18,7 @@ from ..spec.permutation import Node, Permutation
 from ..spec.resolve import Resolved, ResolvedBrdf, resolve, resolve_brdf
 from ..spec.where import KeyProblem, spec_where, within
 from .faces import buffer_params, face_params
+from .tiles import TILES_BLOCK
 from .glue import BrdfGlue, ShadeGlue, brdf_glue, brdf_switch, shade_glue, switch_params, switch_textures
 from .interface import (FRAME_BLOCK, OBJECT_BLOCK, Block, Interface, Location, Slot, Texture, assign_bindings, layout,
                         vec4_array_block)
@@ -180,6 +181,9 @@ def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
     if kernel and r.surface.vertex_color:
         raise KeyProblem("vertex_color", f"a shade kernel has no vertex colours, and {r.key} reads COLOR_0",
                          "run vertex-colour permutations as fragment shaders")
+    if kernel and g.light_tiles is not None:
+        raise KeyProblem("lights", f"a shade kernel has no pixel coordinate, and {r.key} reads a screen tile's lights",
+                         "run tiled light sets as fragment shaders")
     assign_bindings(g.textures, {"light": 2, "material": 1})
     mat_slots, mat_count, light_slots, light_count = _pack_values(g, len(r.surface_params))
     if kernel:
@@ -208,6 +212,10 @@ def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
         blocks.append(Block(f"LightBuffer{elem.name[len('LightData'):]}", gl.set, gl.binding, "storage",
                             [{"name": "data", "type": f"{elem.name}[]", "offset": 0, "size": 0,
                               "array_stride": at, "members": fields}], slots))
+    if g.light_tiles is not None:  # a tiled set's index lists (link/tiles.py), after its light buffers
+        g.light_tiles.set, g.light_tiles.binding = 0, binding
+        blocks.append(Block(TILES_BLOCK, 0, binding, "storage", [{"name": "w", "type": "uvec4[]", "offset": 0,
+                                                                   "size": 0, "array_stride": 16}]))
     params = {"material": {p: s for _, p, _, _, s in g.material}}
     for i, lt in enumerate(r.lights):
         params[f"light{i}"] = (buffer_params if lt.dynamic else face_params)(lt)  # six faces, a first layer (link/faces.py)

@@ -27,6 +27,7 @@ from .faces import (FACE_MATRICES, FIRST_LAYER, SHADOW_LAYER, arrayed_entry, buf
 from .interface import VEC4_BYTES, Slot, Texture, layout, texture_type
 from .irgen import Builder
 from .program import Program
+from .tiles import FRAG_COORD, VEC2, tile_record, tiled_loop, tiles_global
 
 
 def _texture_decl(nodes, name: str) -> dict:
@@ -134,6 +135,7 @@ class ShadeGlue:
     brdf: BrdfGlue
     light_buffers: list[ir.Global] = field(default_factory=list)  # per dynamic light: its storage buffer
     light_buffer_slots: list[list[Slot]] = field(default_factory=list)  # and where its element holds each value
+    light_tiles: ir.Global | None = None  # a tiled dynamic set's LightTiles buffer (link/tiles.py)
 
 
 class _Binder:
@@ -198,6 +200,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     buffer_slots: list[list[Slot]] = []
     provided: dict[str, ir.Expr] = {}
     lights = []
+    tiled = [tiles_global(prog)] if any(k.tiles for k in r.perm.lights) else []
 
     def body():
         stmts = uv_transform(prog, b, bind, r.packing)
@@ -271,6 +274,8 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             return loop(j, body_j)
 
         switched = [(i, lt) for i, lt in enumerate(r.lights) if r.perm.lights[i].switch]
+        if tiled:  # the fragment's tile, once for every pair's loop
+            stmts.extend(tile_record(b, tiled[0], len(r.lights)))
         for i, lt in enumerate(r.lights):
             pre = f"l{i}_"
             lights.append(pre)
@@ -294,7 +299,10 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             else:
                 s = [b.decl(f"s{i}", bind.call(prog, sh, sh.brick.entries[0].name, pre, "light", i, locals_, values))]
             body_i.append(lit_if(i, [c, *s]))
-            stmts.extend([loop(i, body_i)] if dyn else body_i)
+            if r.perm.lights[i].tiles:
+                stmts.extend(tiled_loop(b, tiled[0], i, body_i))
+            else:
+                stmts.extend([loop(i, body_i)] if dyn else body_i)
 
         stmts.extend(emission(b, bind, r.surface))
         shaded = bind.call(prog, out_node, "output", "o_", "material", None, {}, args={"color": b.var("Lo", VEC3)})
@@ -304,9 +312,10 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     # The body is built first: it decides which parameters shade() takes.
     stmts = body()
     surface = ["P", "N"] + (["T", "B"] if bg.tangent or bind.surface & {"T", "B"} else []) \
-        + (["uv"] if "uv" in bind.surface else []) + (["color"] if r.surface.vertex_color else [])
+        + (["uv"] if "uv" in bind.surface else []) + (["color"] if r.surface.vertex_color else []) \
+        + ([FRAG_COORD] if tiled else [])
     sig = [("P", VEC3), ("Ng", VEC3), ("V", VEC3)] + [(x, SURFACE[x]) for x in surface if x in ("T", "B", "uv")] \
-        + ([(VERTEX_COLOR, VEC4)] if r.surface.vertex_color else [])
+        + ([(VERTEX_COLOR, VEC4)] if r.surface.vertex_color else []) + ([(FRAG_COORD, VEC2)] if tiled else [])
     material = [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in bg.params.flat
                 if k not in provided or f"m_{n}" in bind.params]
     material += [(f"m_{n}", k, e, ty, p) for n, k, e, ty, p in r.packing_params.flat]
@@ -324,8 +333,9 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     def shade_body():
         return stmts
     prog.add(b.function("shade", sig, VEC4, shade_body))
-    prog.globals.extend(dynamic_lights)
-    return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights, buffer_slots)
+    prog.globals.extend(dynamic_lights + tiled)
+    return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights, buffer_slots,
+                     tiled[0] if tiled else None)
 
 
 IVEC4 = vector("int", 4)

@@ -201,6 +201,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     from ..compose.depth import compose_depth_units
     from ..link import link_permutation
     from ..link.values import light_buffers as pair_buffers
+    from ..link.tiles import TILES_BLOCK
+    from . import light_tiles
     from .depth_passes import Caster, DepthPasses, mask_interface, mask_resources
     from .material_textures import BuildOutputs, MaterialTextures
     from .pipeline_state import COLOR_FORMATS, clear_color, color_attachment, render_state
@@ -513,6 +515,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             return compared["lit"]
 
         frame_buf = buf(gx.frame_bytes(vp, eye), U)
+        tile_bufs = {}  # light set -> its LightTiles buffer (the camera is the render's one)
         for i, obj in enumerate(scene.objects):
             h = obj["permutation"]
             c = composed[h]
@@ -536,6 +539,12 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for name, data in up.get("light_buffers", {}).items():  # a dynamic set: each pair's lights (link/values.py)
                 blk = c.interface.block(name)  # no light of the pair: a range below the stride, a count of 0
                 spec[(blk.set, blk.binding)] = buf(bytes.fromhex(data) or bytes(4), S)
+            tb = c.interface.block(TILES_BLOCK)
+            if tb is not None:  # a tiled set: its lights culled against the screen's tiles (runtime/light_tiles.py)
+                if obj["light_set"] not in tile_bufs:
+                    lists = light_tiles.cull(lib, scene, obj["lights"], dyn, vp, (W, H))
+                    tile_bufs[obj["light_set"]] = buf(light_tiles.tile_words(lists, (W, H)).tobytes(), S)
+                spec[(tb.set, tb.binding)] = tile_bufs[obj["light_set"]]
             for t in c.interface.textures:
                 if t.group == "light" and dyn is not None:  # a buffer light's pair: one array of its lights' maps
                     res, smp = pair_array(obj["light_set"], t.light, t), sampler_of(t)

@@ -40,7 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from ..library.bricks import Library
-from ..spec.permutation import LightKey, Permutation
+from ..spec.permutation import Permutation
 from .gltf_extensions import ACCEPTED_EXTENSIONS, SHADING_EXTENSIONS, check_extensions
 from .gltf_lights import LIGHTS, MAX_LIGHTS_PER_SET, SPOT_NO_RANGE, LightSets
 from .gltf_materials import BRDF, GltfMaterial, Materials, textures_need_uv
@@ -157,7 +157,8 @@ class _Objects:
         if at.light_set not in self.scene.dynamic_sets:
             return self.lights.ptrs[at.lights[k]]
         pair = at.keys[k]
-        first = next((n for n in at.lights if LightKey(self.scene.lights[n].type, self.scene.lights[n].shadow, True)
+        dyn = self.scene.dynamic_sets[at.light_set]
+        first = next((n for n in at.lights if dyn.key(self.scene.lights[n].type, self.scene.lights[n].shadow)
                       == pair), None)
         return self.lights.ptrs[first] if first else LIGHTS
 

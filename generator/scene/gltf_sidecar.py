@@ -12,6 +12,7 @@ reads it, so every command (build, render, matrix, check, costs) sees the same l
     dynamic = true             # default false: static, its lights unrolled (at most 32)
     max = 64                   # as a TOML scene's dynamic set (scene/light_sets.py)
     model = ["point/none"]
+    culling = "tiles"          # optional, as a TOML scene's dynamic set: loops read a screen tile's light list
 
 Why a file beside the scene, not a glTF extension: the .gltf stays what a DCC tool exported, and the placement
 file (SCENE.placement.toml, for rendering) already sits there the same way. Every key is checked: an unknown key
@@ -37,7 +38,7 @@ SIDECAR_SCHEMA = {
         "light_set": {"type": "object", "additionalProperties": False,
                       "properties": {"dynamic": {"type": "boolean"}, "max": {"type": "integer"},
                                      "model": {"type": "array", "items": {"type": "string"}, "maxItems": 256},
-                                     "loop": {"type": "string"}}},
+                                     "loop": {"type": "string"}, "culling": {"type": "string"}}},
     },
 }
 

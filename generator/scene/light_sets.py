@@ -10,10 +10,14 @@
     model = ["point/none"]            # optional: the pairs a light of it may be; default: its lights' pairs
     loop = "types"                    # optional: "types" (default), one loop per pair over its own buffer;
                                       # "switch", one loop over one buffer of every light, switching on the pair
+    culling = "tiles"                 # optional: "none" (default), each loop reads every light of its buffer;
+                                      # "tiles", each loop reads its fragment's screen tile's list of indices
+                                      # into the buffer (the LightTiles buffer an engine's light culling fills)
 
 The permutation key of an object lit by a dynamic set carries the set's model (sorted dynamic LightKeys,
 `lights=*point/none,*spot/none`; with loop = "switch" `lights=**point/none,**spot/none`), not its lights: any
-number of lights of those pairs is one shader per material. Why "types" is the default: docs/design/link.md,
+number of lights of those pairs is one shader per material; culling = "tiles" marks each pair `@tiles`
+(`lights=*point/none@tiles`): another shader, whose loops read the tile's index list (link/glue.py _tile_loop). Why "types" is the default: docs/design/link.md,
 "Which light loop" (measured by benchmarks/lights.py).
 Why a model may name pairs no light has yet: an engine adding lights at run time needs the shader that reads
 them. A pair whose shadow filter samples a texture reads one 2D array per (pair, filter texture): each light of it
@@ -34,6 +38,7 @@ MAX_LIGHTS_PER_SET = 32  # measured: 40 shadowed point lights compile, 64 exceed
 DEFAULT_MAX = 256  # a dynamic set's buffer capacity when the scene gives none
 MAX_DYNAMIC = 1 << 16  # a dynamic set's largest capacity: what an engine allocates per pair must stay sane
 LOOPS = ("types", "switch")  # a dynamic set's light loop; the first is the default
+CULLINGS = ("none", "tiles")  # what a dynamic set's loops read: every light of a buffer (the default), or a tile's
 CUBE_TYPES = ("point", "point_range")  # the light bricks whose shadow is six faces (link/faces.py)
 MAX_SHADOW_LAYERS = 2048  # Vulkan's guaranteed minimum maxImageArrayLayers: the most layers of a pair's shadow array
 
@@ -46,10 +51,15 @@ class DynamicSet:
     model: tuple  # (LightKey(dynamic=True), ...) sorted by canonical text
     max: int  # the capacity of each pair's buffer (loop "switch": of its one buffer), in lights
     loop: str = LOOPS[0]  # "types": a loop per pair; "switch": one loop, a switch on the pair (LOOPS)
+    culling: str = CULLINGS[0]  # "tiles": each loop reads the fragment's tile's index list (CULLINGS)
 
     def pair_of(self, light) -> int:
         """The index in the model (the permutation's light index) of a scene Light."""
-        return self.model.index(LightKey(light.type, light.shadow, True, self.loop == "switch"))
+        return self.model.index(self.key(light.type, light.shadow))
+
+    def key(self, light_type: str, shadow: str) -> LightKey:
+        """The model's LightKey of pair light_type/shadow, marked as the set's loop and culling mark it."""
+        return LightKey(light_type, shadow, True, self.loop == "switch", self.culling == "tiles")
 
 
 def set_keys(scene, name: str) -> tuple:
@@ -134,12 +144,18 @@ def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library, header: tupl
         if not model:
             raise loc.error(loc.find(*header), f"dynamic light set '{name}' has no lights and no model",
                             'give the pairs its lights may be: model = ["point/none"]')
-    loop = _loop(loc, at, name, t)
-    model = tuple(LightKey(k.light, k.shadow, True, loop == "switch") for k in model)
-    model = tuple(sorted(model, key=LightKey.canonical))
+    loop = _choice(loc, at, name, t, "loop", LOOPS, "\"types\" loops over each pair's buffer, \"switch\" over one "
+                   "buffer, switching on the pair")
+    culling = _choice(loc, at, name, t, "culling", CULLINGS, "\"none\" reads every light of a pair's buffer, "
+                      "\"tiles\" the fragment's screen tile's list (LightTiles, filled by the engine's culling)")
+    if culling == "tiles" and loop == "switch":
+        raise loc.error(at("culling"), f"light set '{name}': culling = \"tiles\" reads one index list per pair, and "
+                        "a switch loop has one loop for every pair", 'use loop = "types" with culling = "tiles"')
+    proto = DynamicSet(name, (), 1, loop, culling)
+    model = tuple(sorted((proto.key(k.light, k.shadow) for k in model), key=LightKey.canonical))
     for n in members:
         light = scene.lights[n]
-        if LightKey(light.type, light.shadow, True, loop == "switch") not in model:
+        if proto.key(light.type, light.shadow) not in model:
             raise loc.error(at("lights" if "lights" in listed else "model"),
                             f"light '{n}' ({light.type}/{light.shadow}) is not in the model of dynamic light set "
                             f"'{name}' ({', '.join(f'{k.light}/{k.shadow}' for k in model)})",
@@ -154,7 +170,7 @@ def _dynamic(loc: Locator, name: str, t: dict, scene, lib: Library, header: tupl
     if cap < len(members):
         raise loc.error(at("max"), f"light set '{name}' holds {len(members)} lights, more than its max = {cap}",
                         f"raise max to at least {len(members)}")
-    scene.dynamic_sets[name] = DynamicSet(name, model, cap, loop)
+    scene.dynamic_sets[name] = DynamicSet(name, model, cap, loop, culling)
     return members
 
 
@@ -184,15 +200,14 @@ def _shadow_capacity(loc: Locator, where, name: str, k: LightKey, cap: int, lib:
                         "device allows in one array (maxImageArrayLayers)", f"lower max to at most {most}")
 
 
-def _loop(loc: Locator, at, name: str, t: dict) -> str:
-    """The set's `loop`, one of LOOPS (a located error with the closest one otherwise)."""
-    loop = t.get("loop", LOOPS[0])
-    if loop not in LOOPS:
-        near = difflib.get_close_matches(str(loop), LOOPS, n=1)
-        raise loc.error(at("loop"), f"light set '{name}': loop is {loop!r}, not one of {', '.join(LOOPS)}",
-                        (f"did you mean loop = \"{near[0]}\"? " if near else "")
-                        + "\"types\" loops over each pair's buffer, \"switch\" over one buffer, switching on the pair")
-    return loop
+def _choice(loc: Locator, at, name: str, t: dict, key: str, choices: tuple, what: str) -> str:
+    """The set's `key`, one of choices, the first by default (a located error with the closest one otherwise)."""
+    value = t.get(key, choices[0])
+    if value not in choices:
+        near = difflib.get_close_matches(str(value), choices, n=1)
+        raise loc.error(at(key), f"light set '{name}': {key} is {value!r}, not one of {', '.join(choices)}",
+                        (f"did you mean {key} = \"{near[0]}\"? " if near else "") + what)
+    return value
 
 
 def _model_entry(loc: Locator, where, name: str, entry: str, lib: Library) -> LightKey:

@@ -60,7 +60,7 @@ SCENE_SCHEMA = {
             "additionalProperties": False, "required": ["dynamic"],
             "properties": {"dynamic": {"type": "boolean"}, "lights": {"type": "array", "items": NAME, "maxItems": 1 << 16},
                            "max": {"type": "integer"}, "model": {"type": "array", "items": SPEC, "maxItems": 256},
-                           "loop": {"type": "string"}}}},
+                           "loop": {"type": "string"}, "culling": {"type": "string"}}}},
         "objects": {"type": "array", "items": {
             "type": "object", "additionalProperties": False, "required": ["material", "lights"],
             "properties": {"name": NAME, "material": NAME, "lights": NAME}}},

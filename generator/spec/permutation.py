@@ -222,9 +222,11 @@ class LightKey:
     shadow: str  # canonical shadow spec
     dynamic: bool = False  # a loop over a storage buffer of lights with a runtime count
     switch: bool = False  # (dynamic) read by the key's one loop over one buffer, switching on the pair (`**`)
+    tiles: bool = False  # (dynamic) the loop reads the fragment's screen tile's index list (`*point/none@tiles`)
 
     def canonical(self) -> str:
-        return f"{'**' if self.switch else '*' if self.dynamic else ''}{self.light}/{self.shadow}"
+        tail = "@tiles" if self.tiles else ""  # absent: the key's text unchanged
+        return f"{'**' if self.switch else '*' if self.dynamic else ''}{self.light}/{self.shadow}{tail}"
 
 
 @dataclass(frozen=True)
