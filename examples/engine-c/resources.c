@@ -392,6 +392,69 @@ static bool fill_pair(const engine *e, const cJSON *pair, const char *where, con
     return ok;
 }
 
+/* Keeps `size` bytes of `data` as the GPU buffer of block `name` per `key` (e->blocks, freed with the engine). */
+static bool keep_buffer(engine *e, const char *name, const void *key, const cJSON *layout, const void *data,
+                        size_t size, VkBuffer *out)
+{
+    if (e->nblocks == e->capblocks) {
+        int more_cap = e->capblocks ? 2 * e->capblocks : 32;
+        block_entry *more = realloc(e->blocks, (size_t)more_cap * sizeof *more);
+        if (!more)
+            return fail("out of memory");
+        e->blocks = more, e->capblocks = more_cap;
+    }
+    block_entry *entry = &e->blocks[e->nblocks];
+    if (!gpu_buffer_new(e->g, (VkDeviceSize)size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, data, &entry->buffer))
+        return false;
+    entry->name = name, entry->key = key, entry->layout = layout;
+    e->nblocks++;
+    *out = entry->buffer.buffer;
+    return true;
+}
+
+/* A tiled dynamic set's LightTiles buffer, as dynamic_light_sets[set].tiles.fill says, with the simplest culling
+ * there is: one tile (tiles_x = tiles_y = 1, a tile larger than any framebuffer) whose list for pair i is every
+ * element of pair i's buffer. Culling only skips lights that add nothing, so this draws what render's culled
+ * tiles draw. Words: tiles_x, tiles_y, tile_size, pairs; (offset, count) per pair; the lists. */
+static bool tile_buffer(engine *e, const cJSON *set, const cJSON *tiles, const char *where, const block_ref *b,
+                        VkBuffer *out)
+{
+    const json_src *src = &e->m->src;
+    for (int i = 0; i < e->nblocks; i++)
+        if (e->blocks[i].key == tiles && strcmp(e->blocks[i].name, b->name) == 0) {
+            *out = e->blocks[i].buffer.buffer;
+            return true;
+        }
+    const cJSON *pairs = j_arr(src, set, "pairs", where), *x;
+    int npairs = cJSON_GetArraySize(pairs), total = 0, header, record;
+    if (!j_int(src, tiles, "header_words", where, 4, 4, &header) || !j_int(src, tiles, "record_words", where, 2, 2,
+                                                                           &record))
+        return false;
+    cJSON_ArrayForEach(x, pairs) {
+        const cJSON *lights = j_opt(x, "lights");
+        total += cJSON_IsArray(lights) ? cJSON_GetArraySize(lights) : 0;
+    }
+    size_t words = (size_t)(header + record * npairs + total);
+    words += (4 - words % 4) % 4;  /* whole uvec4 elements */
+    uint32_t *w = calloc(words, 4);
+    if (!w)
+        return fail("out of memory");
+    w[0] = 1, w[1] = 1, w[2] = 1u << 16, w[3] = (uint32_t)npairs;
+    uint32_t at = (uint32_t)(header + record * npairs);
+    int i = 0;
+    cJSON_ArrayForEach(x, pairs) {  /* pairs in the key's order: pair i's record is record i of the one tile */
+        const cJSON *lights = j_opt(x, "lights");
+        uint32_t n = cJSON_IsArray(lights) ? (uint32_t)cJSON_GetArraySize(lights) : 0;
+        w[header + record * i] = at, w[header + record * i + 1] = n;
+        for (uint32_t k = 0; k < n; k++)
+            w[at + k] = k;
+        at += n, i++;
+    }
+    bool ok = keep_buffer(e, b->name, tiles, NULL, w, words * 4, out);
+    free(w);
+    return ok;
+}
+
 /* A dynamic light set's storage buffer `b` (LightBuffer<i>), filled as the manifest's dynamic_light_sets says:
  * the pairs whose block it is (one, or with loop "switch" every pair of the set) list their lights in order;
  * a pair's element k (stride bytes) is at element first + k (first absent: 0) and holds lights[k]'s parameters.
@@ -409,6 +472,9 @@ static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkB
     if (!set)
         return j_fail(src, where, "%s reads storage block %s, and light set %s is not a dynamic one",
                       it->pipe->prog->name, b->name, o->light_set);
+    const cJSON *tiles = j_opt(set, "tiles"), *tblock = tiles ? j_opt(tiles, "block") : NULL;
+    if (cJSON_IsString(tblock) && strcmp(tblock->valuestring, b->name) == 0)
+        return tile_buffer(e, set, tiles, where, b, out);
     const cJSON *pairs = j_arr(src, set, "pairs", where);
     int count = 0;
     cJSON_ArrayForEach(x, pairs) {  /* the first pair of the block keys the cache; all of them count */
@@ -447,23 +513,9 @@ static bool light_buffer(engine *e, const draw_item *it, const block_ref *b, VkB
             ok = j_fail(src, where, "the pairs of %s disagree on its stride or overlap", b->name);
         ok = ok && fill_pair(e, x, where, b->name, stride, data, first);
     }
-    const cJSON *layout = j_opt(pair, "layout");
-    if (ok && e->nblocks == e->capblocks) {
-        int more_cap = e->capblocks ? 2 * e->capblocks : 32;
-        block_entry *more = realloc(e->blocks, (size_t)more_cap * sizeof *more);
-        ok = more ? (e->blocks = more, e->capblocks = more_cap, true) : fail("out of memory");
-    }
-    block_entry *entry = ok ? &e->blocks[e->nblocks] : NULL;
-    ok = ok && gpu_buffer_new(e->g, (VkDeviceSize)size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, data, &entry->buffer);
+    ok = ok && keep_buffer(e, b->name, pair, j_opt(pair, "layout"), data, size, out);
     free(data);
-    if (!ok)
-        return false;
-    entry->name = b->name;
-    entry->key = pair;
-    entry->layout = layout;
-    e->nblocks++;
-    *out = entry->buffer.buffer;
-    return true;
+    return ok;
 }
 
 bool block_buffer(engine *e, const draw_item *it, const block_ref *b, VkBuffer *out)

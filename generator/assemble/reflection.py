@@ -65,6 +65,28 @@ FILL_SWITCH = ("one buffer for every pair (each pair's block is the same): pair 
                "all pairs' lights (no light: bind a range below the stride, e.g. 4 bytes)")
 
 
+FILL_TILES = ("every frame, from the engine's light culling: a flat array of uint32 words, words 0-3 tiles_x, "
+              "tiles_y, tile_size (pixels, the engine's choice) and pairs (the key's pair count); then per tile t = x + "
+              "y x tiles_x (x = floor(pixel x / tile_size), y likewise, from the framebuffer origin the API gives "
+              "the fragment's coordinate: top left in Vulkan, D3D and WebGPU, bottom left in OpenGL) and per pair i, "
+              "at word 4 + 2 (t x pairs + i), its list's offset (a word index into this buffer) and count; then the "
+              "lists, each word an element of pair i's buffer. A light may be in more tiles than it reaches, never "
+              "fewer (every light in every tile, tiles_x = tiles_y = 1, draws what the untiled loop draws)")
+
+
+def _tiles(c, platforms) -> dict:
+    """The LightTiles block of a tiled set's permutation: where it binds, per platform too (link/tiles.py)."""
+    from ..link.tiles import TILES_BLOCK
+    from .platforms import PLATFORM_TABLE
+    block = c.interface.block(TILES_BLOCK)
+    bindings = {p: next({k: v for k, v in row.items() if k not in ("name", "stages", "visibility")}
+                        for rows_ in PLATFORM_TABLE[p].reflection(c.interface).values() if isinstance(rows_, list)
+                        for row in rows_ if isinstance(row, dict) and row.get("name") == TILES_BLOCK)
+                for p in platforms}
+    return {"block": TILES_BLOCK, "set": block.set, "binding": block.binding, "bindings": bindings,
+            "header_words": 4, "record_words": 2, "fill": FILL_TILES}
+
+
 def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platforms) -> dict:
     """Per dynamic light set: its capacity and, per pair of its model, the storage buffer an engine fills.
 
@@ -106,5 +128,6 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
                                      for sl in block.slots if sl.light == i],
                           "lights": lights_of(i), **switch})
         out[name] = {"max": dyn.max, "pairs": pairs, "fill": FILL_SWITCH if dyn.loop == "switch" else FILL,
-                     **({"loop": dyn.loop} if dyn.loop != "types" else {})}
+                     **({"loop": dyn.loop} if dyn.loop != "types" else {}),
+                     **({"culling": dyn.culling, "tiles": _tiles(c, platforms)} if dyn.culling == "tiles" else {})}
     return out

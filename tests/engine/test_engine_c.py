@@ -6,7 +6,7 @@ The tolerance: the renderer compiles its own GLSL while the engine loads the bui
 pack, so a float may round differently in the last place, which can move a channel by one step of 8 bits; two
 steps or more is a real difference (a wrong binding, block, matrix or state moves whole regions, as the tests
 below that edit one field show). Measured on lavapipe (Mesa 25), 128 × 80: every channel equal (largest difference
-0) on all ten scenes (the dynamic light set's, in both loop forms, and a point light's six faces with pcf and
+0) on all eleven scenes (the dynamic light set's, in both loop forms and tiled, and a point light's six faces with pcf and
 with vsm, too).
 """
 from __future__ import annotations
@@ -156,6 +156,16 @@ def _switched(tmp: Path) -> Path:
     return _written(tmp / "dynamic_switch.toml", text)
 
 
+def _tiled(tmp: Path) -> Path:
+    """tests/scenes/dynamic_lights.toml with its dynamic set's culling = "tiles", its placement beside it: render
+    culls its spots against 16-pixel tiles, the engine puts every light in one tile, and both draw alike."""
+    src = REPO / "tests" / "scenes" / "dynamic_lights.toml"
+    text = src.read_text().replace("[light_sets.crowd]\ndynamic = true\n", '[light_sets.crowd]\ndynamic = true\nculling = "tiles"\n')
+    assert 'culling = "tiles"' in text
+    shutil.copy(src.with_name("dynamic_lights.placement.toml"), tmp / "dynamic_tiles.placement.toml")
+    return _written(tmp / "dynamic_tiles.toml", text)
+
+
 SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "textured": lambda tmp: REPO / "scenes" / "textured.toml",
           "gltf": lambda tmp: gltf_scene(tmp / "textured.gltf"),
@@ -172,6 +182,8 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "dynamic": lambda tmp: REPO / "tests" / "scenes" / "dynamic_lights.toml",
           # the same lights in one storage buffer, one loop switching on the pair (loop = "switch": ids, first)
           "dynamic_switch": lambda tmp: _switched(tmp),
+          # the same lights read through a LightTiles index list per tile (culling = "tiles")
+          "dynamic_tiles": lambda tmp: _tiled(tmp),
           # a masked, two blended (drawn back to front, as the export's draw_order says) and a double-sided object
           "surface_state": lambda tmp: REPO / "tests" / "scenes" / "surface_state.toml"}
 
