@@ -71,6 +71,10 @@ def built(tmp_path_factory) -> dict[str, dict]:
     out["textured.toml"] = _build(REPO / "scenes" / "textured.toml", "--out", tmp / "textured.toml")
     out["depth_mask"] = _build(REPO / "tests" / "scenes" / "depth_mask.toml", "--out", tmp / "depth_mask")
     out["dynamic"] = _build(REPO / "tests" / "scenes" / "dynamic_lights.toml", "--out", tmp / "dynamic")  # light buffers
+    tiled = (REPO / "tests" / "scenes" / "dynamic_lights.toml").read_text().replace(
+        "[light_sets.crowd]\ndynamic = true\n", '[light_sets.crowd]\ndynamic = true\nculling = "tiles"\n')
+    (tmp / "tiled.toml").write_text(tiled)
+    out["tiled"] = _build(tmp / "tiled.toml", "--out", tmp / "tiled")  # a tiled set's LightTiles
     out["spot_shadow"] = _build(REPO / "tests" / "scenes" / "spot_shadow.toml", "--out", tmp / "spot",
                                 "--platform", "vulkan")  # a perspective shadow fit (its padding)
     out["vulkan"] = _build(EXAMPLE, "--out", tmp / "vulkan", "--platform", "vulkan")
