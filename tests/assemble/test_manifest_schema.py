@@ -71,6 +71,13 @@ def built(tmp_path_factory) -> dict[str, dict]:
     out["textured.toml"] = _build(REPO / "scenes" / "textured.toml", "--out", tmp / "textured.toml")
     out["depth_mask"] = _build(REPO / "tests" / "scenes" / "depth_mask.toml", "--out", tmp / "depth_mask")
     out["dynamic"] = _build(REPO / "tests" / "scenes" / "dynamic_lights.toml", "--out", tmp / "dynamic")  # light buffers
+    dyn = (REPO / "tests" / "scenes" / "dynamic_lights.toml").read_text()
+    assert "max = 64\n" in dyn
+    (tmp / "switch.toml").write_text(dyn.replace("max = 64\n", 'max = 64\nloop = "switch"\n', 1))
+    out["switch"] = _build(tmp / "switch.toml", "--out", tmp / "switch", "--platform", "vulkan")  # one buffer, ids
+    from tests.runtime.test_dynamic_shadows import MIXED, POINTS, _scene as shadowed
+    (tmp / "buffer_shadows.toml").write_text(shadowed(MIXED + POINTS[:1], True))  # depth arrays of buffer lights
+    out["buffer_shadows"] = _build(tmp / "buffer_shadows.toml", "--out", tmp / "buffer_shadows", "--platform", "vulkan")
     tiled = (REPO / "tests" / "scenes" / "dynamic_lights.toml").read_text().replace(
         "[light_sets.crowd]\ndynamic = true\n", '[light_sets.crowd]\ndynamic = true\nculling = "tiles"\n')
     (tmp / "tiled.toml").write_text(tiled)
