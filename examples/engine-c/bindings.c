@@ -15,6 +15,28 @@ static bool light_texture(engine *e, const draw_item *it, const texture_ref *t, 
     const manifest *m = e->m;
     const mobject *o = &m->objects[it->object];
     const cJSON *ln = cJSON_GetArrayItem(o->light_names, t->light);
+    const cJSON *pair = NULL;
+    const cJSON *dyn = j_opt(m->dynamic_light_sets, o->light_set);
+    if (dyn) {  /* a dynamic set: t->light is the pair's index; its first drawn light's binds say where */
+        const cJSON *x;
+        cJSON_ArrayForEach(x, j_opt(dyn, "pairs")) {
+            const cJSON *index = j_opt(x, "light_index");
+            if (cJSON_IsNumber(index) && index->valueint == t->light)
+                pair = x;
+        }
+        const cJSON *lights = j_opt(pair, "lights");
+        ln = NULL;
+        for (int k = 0; !ln && k < cJSON_GetArraySize(lights); k++) {
+            const light_pass *any;
+            const cJSON *name = cJSON_GetArrayItem(lights, k);
+            if (cJSON_IsString(name) && light_pass_of(e, name->valuestring, &any))
+                ln = name;
+        }
+        if (!ln)
+            return fail("%s: %s reads pair %d's %s of dynamic set %s, which has no drawn light — this engine binds "
+                        "a shadowed pair's array of its lights' maps", m->file, o->permutation, t->light, t->name,
+                        o->light_set);
+    }
     const light_pass *lp;
     if (!cJSON_IsString(ln))
         return fail("%s: %s reads light %d's %s; light set %s has no light %d", m->file, o->permutation, t->light,
@@ -39,6 +61,11 @@ static bool light_texture(engine *e, const draw_item *it, const texture_ref *t, 
         if (set != t->set || binding != t->binding || sampler_binding != t->sampler_binding)
             return j_fail(&m->src, where, "set %d binding %d/%d; the permutation's interface binds %s at %d %d/%d",
                           set, binding, sampler_binding, t->name, t->set, t->binding, t->sampler_binding);
+        if (pair) {  /* the pair's lights' maps, each its layers */
+            if (!t->array)
+                return j_fail(&m->src, where, "%s of a dynamic set's pair is not a 2d_array", t->name);
+            return pair_array_of(e, pair, where, view);
+        }
         if (t->array != (lp->face == 0))
             return j_fail(&m->src, where, "%s is %s, and light %s has %s", t->name, t->array ? "a 2d_array" : "2D",
                           lp->name, lp->face == 0 ? "six faces" : "one map");

@@ -296,6 +296,9 @@ void engine_free(engine *e)
     free(e->meshes);
     free(e->blocks);
     free(e->passes);
+    for (int i = 0; i < e->npairs; i++)
+        free(e->pairs[i].sources);
+    free(e->pairs);
     free(e->units);
     free(e->pipes);
     free(e->draws);

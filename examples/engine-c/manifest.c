@@ -82,7 +82,7 @@ static bool add_textures(const manifest *m, program *p, const cJSON *list, VkSha
         r.light = -1;
         if (j_opt(t, "light") && !j_int(src, t, "light", at, 0, 255, &r.light))
             return false;
-        r.array = strcmp(dim, "2d_array") == 0 && r.light >= 0;  /* a point light's six shadow faces */
+        r.array = strcmp(dim, "2d_array") == 0 && r.light >= 0;  /* six shadow faces, or a pair's lights' maps */
         if (strcmp(dim, "2d") != 0 && !r.array)
             return j_fail(src, at, "texture %s is %s; this engine binds 2D textures (and a light's 2d_array of "
                           "shadow faces) only", r.name, dim);

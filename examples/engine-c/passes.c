@@ -287,7 +287,7 @@ static bool setup_pass(engine *e, const char *name, const cJSON *dp, light_pass 
     /* A map the shaders sample (kind depth) is kept and filtered as the sampler row says (bilinear): the device
      * must sample and linearly filter D32_SFLOAT (lavapipe in Mesa 25 does; the renderer refuses otherwise). */
     VkImageUsageFlags usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | (lp->moments ? 0 : VK_IMAGE_USAGE_SAMPLED_BIT)
-                            | (face >= 0 && !lp->moments ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0);
+                            | (lp->moments ? 0 : VK_IMAGE_USAGE_TRANSFER_SRC_BIT);  /* copied into an array */
     VkFormatFeatureFlags need = VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT
         | (lp->moments ? 0 : VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
     if (!gpu_format_has(g, VK_FORMAT_D32_SFLOAT, need))
@@ -337,7 +337,7 @@ bool light_passes(engine *e)
 }
 
 /* The image a pass's result is sampled through: its depth, or its last blur target. */
-static const gpu_image *pass_result(const light_pass *lp)
+const gpu_image *pass_result(const light_pass *lp)
 {
     return lp->moments ? &lp->targets[lp->nblur] : &lp->depth;
 }
@@ -351,9 +351,93 @@ bool face_array(engine *e, light_pass *first)
                                VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, aspect, &first->array);
 }
 
-/* After every pass: each face's result copied into its layer of face 0's array, left SHADER_READ_ONLY. */
+/* Sources' results into the layers of `array`, every image left SHADER_READ_ONLY. */
+static void record_layer_copies(VkCommandBuffer cmd, const gpu_image *const *sources, int n, const gpu_image *array,
+                                VkImageAspectFlags aspect)
+{
+    VkImageMemoryBarrier bar[2];
+    VkImageLayout held = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, src = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    VkImageLayout dst = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    VkPipelineStageFlags before = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT
+                                | VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    bar[0] = (VkImageMemoryBarrier){VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER, NULL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                    VK_IMAGE_LAYOUT_UNDEFINED, dst, VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED,
+                                    array->image, {aspect, 0, 1, 0, (uint32_t)n}};
+    vkCmdPipelineBarrier(cmd, before, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1, bar);
+    for (int k = 0; k < n; k++) {
+        bar[0] = (VkImageMemoryBarrier){VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER, NULL, VK_ACCESS_SHADER_READ_BIT,
+                                        VK_ACCESS_TRANSFER_READ_BIT, held, src, VK_QUEUE_FAMILY_IGNORED,
+                                        VK_QUEUE_FAMILY_IGNORED, sources[k]->image, {aspect, 0, 1, 0, 1}};
+        vkCmdPipelineBarrier(cmd, before, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1, bar);
+        VkImageCopy region = {{aspect, 0, 0, 1}, {0, 0, 0}, {aspect, 0, (uint32_t)k, 1}, {0, 0, 0},
+                              {array->width, array->height, 1}};
+        vkCmdCopyImage(cmd, sources[k]->image, src, array->image, dst, 1, &region);
+        bar[0].srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT, bar[0].dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+        bar[0].oldLayout = src, bar[0].newLayout = held;
+        vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT
+                             | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1, bar);
+    }
+    bar[1] = (VkImageMemoryBarrier){VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER, NULL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                    VK_ACCESS_SHADER_READ_BIT, dst, held, VK_QUEUE_FAMILY_IGNORED,
+                                    VK_QUEUE_FAMILY_IGNORED, array->image, {aspect, 0, 1, 0, (uint32_t)n}};
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, 0, 0, NULL, 0,
+                         NULL, 1, &bar[1]);
+}
+
+/* A dynamic set's pair's array (made on first use): its lights' pass results in the set's order, a point light's
+ * six faces each, the layers each light's shadow_first_layer names (the manifest's ordinal × layers). */
+bool pair_array_of(engine *e, const cJSON *pair, const char *where, VkImageView *view)
+{
+    for (int i = 0; i < e->npairs; i++)
+        if (e->pairs[i].pair == pair) {
+            *view = e->pairs[i].image.view;
+            return true;
+        }
+    const cJSON *lights = j_arr(&e->m->src, pair, "lights", where), *ln;
+    int n = 0;
+    cJSON_ArrayForEach(ln, lights)
+        for (int l = 0; cJSON_IsString(ln) && l < e->npasses; l++)
+            n += strcmp(e->passes[l].name, ln->valuestring) == 0;
+    if (n == 0)
+        return j_fail(&e->m->src, where, "a shadowed pair with no drawn light: this engine has no map to bind");
+    if (e->npairs == e->cappairs) {
+        int cap = e->cappairs ? 2 * e->cappairs : 8;
+        pair_array *more = realloc(e->pairs, (size_t)cap * sizeof *more);
+        if (!more)
+            return fail("out of memory");
+        e->pairs = more, e->cappairs = cap;
+    }
+    pair_array *pa = &e->pairs[e->npairs];
+    memset(pa, 0, sizeof *pa);
+    if (!(pa->sources = calloc((size_t)n, sizeof *pa->sources)))
+        return fail("out of memory");
+    e->npairs++;
+    pa->pair = pair;
+    const light_pass *first = NULL;
+    cJSON_ArrayForEach(ln, lights)
+        for (int l = 0; cJSON_IsString(ln) && l < e->npasses; l++)
+            if (strcmp(e->passes[l].name, ln->valuestring) == 0) {
+                first = first ? first : &e->passes[l];
+                pa->sources[pa->nsources++] = pass_result(&e->passes[l]);
+            }
+    VkImageAspectFlags aspect = first->moments ? VK_IMAGE_ASPECT_COLOR_BIT : VK_IMAGE_ASPECT_DEPTH_BIT;
+    if (!gpu_image_array_new(e->g, pa->sources[0]->format, first->width, first->height, (uint32_t)n,
+                             VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, aspect, &pa->image))
+        return false;
+    *view = pa->image.view;
+    return true;
+}
+
+/* After every pass: each face's result copied into its layer of face 0's array, and each dynamic pair's lights'
+ * into its array; left SHADER_READ_ONLY. */
 void record_face_copies(const engine *e, VkCommandBuffer cmd)
 {
+    for (int i = 0; i < e->npairs; i++) {
+        const pair_array *pa = &e->pairs[i];
+        bool depth = pa->image.format == VK_FORMAT_D32_SFLOAT;
+        record_layer_copies(cmd, pa->sources, pa->nsources, &pa->image,
+                            depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT);
+    }
     for (int l = 0; l + 5 < e->npasses; l++) {
         const light_pass *lp = &e->passes[l];
         if (lp->face != 0)

@@ -73,6 +73,15 @@ typedef struct block_entry {
     const cJSON *layout;       /* the block description it was written by */
 } block_entry;
 
+/* A dynamic set's shadowed pair: its lights' maps (one each, a point light's six faces) in the layers of one 2D
+ * array, copied in after the passes (what its permutations bind). */
+typedef struct pair_array {
+    const cJSON *pair;         /* dynamic_light_sets.<set>.pairs[i] */
+    gpu_image image;
+    int nsources;
+    const gpu_image **sources; /* layer k's pass result */
+} pair_array;
+
 typedef struct engine {
     gpu *g;
     const manifest *m;
@@ -87,6 +96,8 @@ typedef struct engine {
     int nblocks, capblocks;
     light_pass *passes;
     int npasses;
+    pair_array *pairs;         /* made as the draws that read them are bound */
+    int npairs, cappairs;
     program *units;
     int nunits, capunits;
     pipe_entry *pipes;
@@ -124,6 +135,8 @@ bool color_state(const engine *e, const program *p, pipeline_state *st);
 bool light_passes(engine *e);
 bool face_array(engine *e, light_pass *first);
 void record_face_copies(const engine *e, VkCommandBuffer cmd);
+const gpu_image *pass_result(const light_pass *lp);
+bool pair_array_of(engine *e, const cJSON *pair, const char *where, VkImageView *view);
 bool make_render_pass(gpu *g, VkFormat color, VkImageLayout color_final, VkFormat depth, bool keep_depth,
                       VkImageLayout depth_final, VkRenderPass *out);
 bool make_framebuffer(gpu *g, VkRenderPass pass, const VkImageView *views, uint32_t n, uint32_t w, uint32_t h,

@@ -371,6 +371,26 @@ static bool fill_pair(const engine *e, const cJSON *pair, const char *where, con
             const cJSON *v = j_opt(params, name->valuestring);
             int n = bytes / 4;
             double values[16] = {0};
+            /* a shadowed light's matrices (a point light's faces) and pcf_texel: the export's, as in Lights */
+            const flight *fl = cJSON_IsString(ln) ? frame_light(e->f, ln->valuestring) : NULL;
+            int face = -1;
+            if (fl && strcmp(name->valuestring, "shadow_matrix") == 0)
+                face = 0;
+            else if (fl && fl->nfaces == 6 && sscanf(name->valuestring, "shadow_matrix_%d", &face) == 1)
+                face = face >= 1 && face <= 5 ? face : -1;
+            if (fl && face >= 0 && n == 16) {
+                const double *mat = face == 0 ? fl->shadow_matrix : fl->faces[face];
+                for (int c = 0; c < 16; c++) {
+                    float f = (float)mat[c];
+                    memcpy(data + (size_t)k * (size_t)stride + (size_t)offset + 4 * (size_t)c, &f, 4);
+                }
+                continue;
+            }
+            if (fl && fl->has_texel && n == 1 && strcmp(name->valuestring, "pcf_texel") == 0) {
+                float f = (float)fl->pcf_texel;
+                memcpy(data + (size_t)k * (size_t)stride + (size_t)offset, &f, 4);
+                continue;
+            }
             bool numbers = cJSON_IsArray(v) && cJSON_GetArraySize(v) == n;
             for (int c = 0; numbers && c < n; c++)
                 numbers = cJSON_IsNumber(cJSON_GetArrayItem(v, c));

@@ -22,7 +22,23 @@ def material_values(scene: Scene, name: str, specs: dict) -> dict:
 
 def light_values(scene: Scene, name: str, specs: dict) -> dict:
     given = scene.lights[name].params
-    return {k: given.get(k, s.default) for k, s in specs.items()}
+    out = {k: given.get(k, s.default) for k, s in specs.items()}
+    if FIRST_LAYER in specs:  # a buffer light's first layer in its pair's shadow array (link/faces.py)
+        out[FIRST_LAYER] = first_layer(scene, name)
+    return out
+
+
+def first_layer(scene: Scene, name: str) -> float:
+    """A buffer light's first layer in its pair's shadow array: its ordinal among the lights of its pair in its
+    (first) dynamic set, × its layers (six for a point light's faces)."""
+    light = scene.lights[name]
+    for set_name, dyn in scene.dynamic_sets.items():
+        names = scene.light_sets[set_name]
+        if name in names:
+            pair = dyn.pair_of(light)
+            same = [n for n in names if dyn.pair_of(scene.lights[n]) == pair]
+            return float(same.index(name) * shadow_layers(light.type))
+    return 0.0
 
 
 def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None) -> list[dict]:
@@ -70,7 +86,7 @@ def light_buffers(scene: Scene, names: list[str], dyn, c, overrides: dict | None
     their order, each element laid out as the block's parameters say (a static set's values, so both draw alike).
     A switch loop's one block (every pair's block) holds the pairs one after another, in the model's order, each
     element its ids (ids.x the pair's light index, int32) then its values (link/glue.py _switch_buffer).
-    A shadowed pair's light k has its first layer k × its layers (link/faces.py); overrides: {light: {param:
+    A shadowed pair's light k has its first layer k × its layers (first_layer); overrides: {light: {param:
     value}} over the scene's values (the renderer's fitted shadow matrices)."""
     out = {}
     for i, pair in enumerate(dyn.model):
@@ -83,7 +99,7 @@ def light_buffers(scene: Scene, names: list[str], dyn, c, overrides: dict | None
         for ln in names:
             if dyn.pair_of(scene.lights[ln]) == i:
                 v = {**light_values(scene, ln, specs), **(overrides or {}).get(ln, {})}
-                if FIRST_LAYER in specs:  # its layers in the pair's shadow array follow the pair's earlier lights'
+                if FIRST_LAYER in specs:  # in this set's order (a light of two sets: light_values says the first's)
                     v[FIRST_LAYER], ordinal = float(ordinal * shadow_layers(pair.light)), ordinal + 1
                 data += head + pack(slots, {s.name: _element(v[s.param], s) for s in slots}, (stride - len(head)) // 16)
         out[block.name] = out.get(block.name, b"") + data

@@ -6,8 +6,8 @@ The tolerance: the renderer compiles its own GLSL while the engine loads the bui
 pack, so a float may round differently in the last place, which can move a channel by one step of 8 bits; two
 steps or more is a real difference (a wrong binding, block, matrix or state moves whole regions, as the tests
 below that edit one field show). Measured on lavapipe (Mesa 25), 128 × 80: every channel equal (largest difference
-0) on all eleven scenes (the dynamic light set's, in both loop forms and tiled, and a point light's six faces with pcf and
-with vsm, too).
+0) on all thirteen scenes (the dynamic light set's, in both loop forms and tiled, a point light's six faces with pcf
+and with vsm, and a dynamic set of shadowed buffer lights, too).
 """
 from __future__ import annotations
 
@@ -147,6 +147,13 @@ def _point_vsm(tmp: Path) -> Path:
     return _written(tmp / "point_vsm.toml", text)
 
 
+def _dynamic_shadow(tmp: Path) -> Path:
+    from tests.runtime.test_dynamic_shadows import MIXED, PLACEMENT, SPOTS, _scene
+
+    (tmp / "dynamic_shadow.placement.toml").write_text(PLACEMENT)
+    return _written(tmp / "dynamic_shadow.toml", _scene([*MIXED, *SPOTS[2:]], True))
+
+
 def _switched(tmp: Path) -> Path:
     """tests/scenes/dynamic_lights.toml with its dynamic set's loop = "switch", its placement beside it."""
     src = REPO / "tests" / "scenes" / "dynamic_lights.toml"
@@ -178,6 +185,9 @@ SCENES = {"example": lambda tmp: REPO / "scenes" / "example.toml",
           "point_shadow": lambda tmp: REPO / "tests" / "scenes" / "point_ring.toml",
           # the same with vsm: each face's moments blurred, then copied into its layer
           "point_vsm": lambda tmp: _point_vsm(tmp),
+          # a dynamic set's shadowed pairs: two pcf spots in one array, a vsm point light's six faces, a
+          # pcf_hardware directional light (tests/runtime/test_dynamic_shadows.py's mixed set, 2 spots more)
+          "dynamic_shadow": lambda tmp: _dynamic_shadow(tmp),
           # a dynamic light set: 16 points and 2 spots in two storage buffers (manifest dynamic_light_sets)
           "dynamic": lambda tmp: REPO / "tests" / "scenes" / "dynamic_lights.toml",
           # the same lights in one storage buffer, one loop switching on the pair (loop = "switch": ids, first)

@@ -108,7 +108,7 @@ def test_the_ubershader_and_hybrid_draw_them_alike(lib, device, tmp_path, lights
 def test_the_element_holds_the_matrices_and_the_first_layer(lib, tmp_path):
     """The build's element of a point/pcf pair: six matrices and the first layer; light k starts at 6k (no GPU)."""
     from generator.link import link_permutation
-    from generator.link.values import light_buffers
+    from generator.link.values import first_layer, light_buffers
     from generator.scene.load import load_scene
 
     d = tmp_path
@@ -128,6 +128,7 @@ def test_the_element_holds_the_matrices_and_the_first_layer(lib, tmp_path):
     data = np.frombuffer(light_buffers(scene, scene.objects[0]["lights"], scene.dynamic_sets["all"], lp)["LightBuffer0"],
                          np.float32).reshape(3, -1)
     assert data[:, first.offset // 4].tolist() == [0.0, 6.0, 12.0]
+    assert [first_layer(scene, f"l{k}") for k in range(3)] == [0.0, 6.0, 12.0], "the manifest's params say the same"
 
 
 def test_a_set_whose_shadow_layers_exceed_2048_is_refused_at_its_max(lib, tmp_path):
