@@ -178,13 +178,29 @@ def check(out: Path, request: Request, store) -> dict | None:
         state = json.loads((out / STATE).read_bytes())
         if not state.get("complete"):
             return None
-        root = os.fspath(out)
-        for rel, size in state["files"].items():
-            if os.stat(os.path.join(root, rel)).st_size != size:
-                return None
+        if not _sizes_match(os.fspath(out), state["files"]):
+            return None
         return {**doc["summary"], "warnings": doc["warnings"], "unchanged": len(state["files"]) + 1}
     except (OSError, ValueError, KeyError, TypeError, AttributeError, RuntimeError):
         return None
+
+
+def _sizes_match(root: str, files: dict[str, int]) -> bool:
+    """Whether every file of `files` (path relative to root -> size) is there with its size. Stat'ed relative to
+    its directory's descriptor: 170,000 files of a 10,000-permutation tree take ~0.6 s so, ~0.8 s by whole paths."""
+    by_dir: dict[str, list[tuple[str, int]]] = {}
+    for rel, size in files.items():
+        d, _, name = rel.rpartition("/")
+        by_dir.setdefault(d, []).append((name, size))
+    for d, items in by_dir.items():
+        fd = os.open(os.path.join(root, d) if d else root, os.O_RDONLY | os.O_DIRECTORY)
+        try:
+            for name, size in items:
+                if os.stat(name, dir_fd=fd).st_size != size:
+                    return False
+        finally:
+            os.close(fd)
+    return True
 
 
 def _builtin() -> str:
