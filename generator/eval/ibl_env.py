@@ -244,9 +244,10 @@ def sh_basis(d: np.ndarray) -> np.ndarray:
     """(..., 9) real spherical harmonics Y_00, Y_1-1, Y_10, Y_11, Y_2-2, Y_2-1, Y_20, Y_21, Y_22 of unit d
     (Ramamoorthi & Hanrahan 2001 eq. 3, with their x, y, z = our x, z, y so that z is a direction's +Y here)."""
     x, y, z = d[..., 0], d[..., 2], d[..., 1]
-    return np.stack([0.282095 * np.ones_like(x), 0.488603 * y, 0.488603 * z, 0.488603 * x,
-                     1.092548 * x * y, 1.092548 * y * z, 0.315392 * (3 * z * z - 1), 1.092548 * x * z,
-                     0.546274 * (x * x - y * y)], -1)
+    c0, c1, c2 = 0.5 / np.sqrt(np.pi), np.sqrt(3 / (4 * np.pi)), 0.5 * np.sqrt(15 / np.pi)
+    c20, c22 = 0.25 * np.sqrt(5 / np.pi), 0.25 * np.sqrt(15 / np.pi)  # the printed 0.282095, 0.488603, ... exactly
+    return np.stack([c0 * np.ones_like(x), c1 * y, c1 * z, c1 * x, c2 * x * y, c2 * y * z, c20 * (3 * z * z - 1),
+                     c2 * x * z, c22 * (x * x - y * y)], -1)
 
 
 SH_A = np.array([np.pi] + [2 * np.pi / 3] * 3 + [np.pi / 4] * 5)
