@@ -78,7 +78,8 @@ def scene_keys(base: str, scene: Scene, lib: Library, keep_removed: bool, pack: 
                          sorted(repr(m) for m in scene.materials.values()),
                          sorted(repr(x) for x in scene.lights.values()), keep_removed,
                          *([sorted(repr(d) for d in scene.dynamic_sets.values())] if scene.dynamic_sets else []),
-                         *(["pack"] if pack is True else [f"pack-{pack}"] if pack else []))  # "only": --pack-only
+                         *(["pack"] if pack is True else [f"pack-{pack}"] if pack else []),  # "only": --pack-only
+                         *([] if scene.ubershader else ["no-ubershader"]))  # [scene] ubershader = false
     return Keys(keys, uber, tables, bricks)
 
 

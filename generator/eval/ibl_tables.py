@@ -100,7 +100,8 @@ def classify(spec: str, lib=None) -> list[Term]:
     for node in resolve_brdf(spec, lib).nodes:
         b = node.brick
         fillers = {slot: f.brick.id for slot, f in node.fillers}
-        ndf_params = {slot: set(f.brick.params or {}) for slot, f in node.fillers}.get("ndf", set())
+        own = {slot: set(f.brick.params or {}) for slot, f in node.fillers}
+        ndf_params, fresnel_params = own.get("ndf", set()), own.get("fresnel", set()) - {"f0"}
         if b.kind == "diffuse":
             how, why = DIFFUSE_HOW.get(b.id, ("refused", f"diffuse brick '{b.id}' has no ambient table: use "
                                              "lambert or gotanda_fitted for image-based lighting"))
@@ -108,6 +109,11 @@ def classify(spec: str, lib=None) -> list[Term]:
             aniso = bool(ndf_params & {"alpha_u", "alpha_v"})
             how, why = (("refused", f"NDF '{fillers['ndf']}' is anisotropic: a table over (n·v, α) holds isotropic "
                          "lobes only — use its isotropic form") if aniso else ("ambient_brdf", ""))
+            if fresnel_params and not aniso:
+                # a table baked at the brick's default eta, k would be silently wrong for every other metal
+                how, why = "refused", (f"Fresnel '{fillers['fresnel']}' reads {', '.join(sorted(fresnel_params))}, "
+                                       "which a table over (n·v, α) with f0 as scale and bias cannot hold — use "
+                                       "fresnel=schlick (f0 from the metal's reflectance) for image-based lighting")
         else:
             how, why = "refused", (f"specular brick '{b.id}' is not a microfacet term: the split sum's prefiltered "
                                    "cube assumes a microfacet lobe — use microfacet(...)")

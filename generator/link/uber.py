@@ -422,7 +422,9 @@ def _light_loop(b, prog, bind, lbuf, LightEntry, light_data, lnodes, snodes, lay
         for j in range(max(shadowed, 1)):
             targs = dict(args)
             for tex in texnames:
-                name = f"shadow{j}_{tex}"
+                # two filters may name their maps alike (pcf's and shadow_map's `shadow_map`): an array's name says
+                # so, or a 2D map and a 2D array of two filters would be one declaration
+                name = f"shadow{j}_{tex}" + ("_layers" if arrays else "")
                 if name not in {t.name for t in bind.textures}:
                     bind.textures.append(Texture(name, tex, "light", False, textype[tex].dim, j,
                                                  compare=textype[tex].compare))

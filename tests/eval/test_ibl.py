@@ -52,6 +52,9 @@ def test_classification_and_located_refusals():
     assert how == {"gotanda_fitted": "gotanda_eq4", "microfacet": "ambient_brdf"}
     with pytest.raises(ibl_tables.IblRefusal, match=r"^scene.toml:3:9: .*not a microfacet term"):
         ibl_tables.ambient_brdf("lambert+phong_normalized", where="scene.toml:3:9", store=False)
+    with pytest.raises(ibl_tables.IblRefusal, match="reads eta, k"):
+        ibl_tables.ambient_brdf("microfacet(ndf=ggx,fresnel=conductor_exact,vis=smith_ggx_height_correlated)",
+                                store=False)
     with pytest.raises(ibl_tables.IblRefusal, match="anisotropic"):
         ibl_tables.ambient_brdf("microfacet(ndf=ggx_anisotropic,fresnel=schlick,vis=smith_ggx_height_correlated_anisotropic)",
                                 store=False)
