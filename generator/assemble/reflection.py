@@ -107,7 +107,7 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
             return sum(len(lights_of(k)) for k in range(i)) if dyn.loop == "switch" else None
         if c is None:  # its blocks as the last build described them; its capacity and lights as the scene says now
             if name in old:
-                out[name] = {**old[name], "max": dyn.max, "fill": FILL, "pairs": [
+                out[name] = {**old[name], "max": dyn.max, "fill": FILL_SWITCH if dyn.loop == "switch" else FILL, "pairs": [
                     {**p, "lights": lights_of(p["light_index"]),
                      **({"first": first_of(p["light_index"])} if "first" in p else {})} for p in old[name]["pairs"]]}
             continue

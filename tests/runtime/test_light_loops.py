@@ -102,3 +102,30 @@ def test_an_unknown_loop_is_a_located_error_with_the_closest_name(lib, tmp_path)
     line = text.splitlines().index('loop = "swich"') + 1
     assert msg.startswith(f"{tmp_path / 's.toml'}:{line}:"), msg
     assert "loop is 'swich', not one of types, switch" in msg and 'did you mean loop = "switch"' in msg, msg
+
+
+def test_a_rebuild_that_composes_nothing_keeps_the_switch_sets_fill(tmp_path):
+    """The manifest's dynamic set entry of a build that composed none of its permutations (only the set's max
+    changed) is the last build's with the scene's capacity: its fill stays the switch buffer's."""
+    import json
+    import subprocess
+    import sys
+
+    from generator.assemble.reflection import FILL_SWITCH
+    from tests.assemble.test_manifest_schema import REPO
+    scene, out = tmp_path / "s.toml", tmp_path / "out"
+
+    def build():
+        r = subprocess.run([sys.executable, "-m", "generator.cli", "build", str(scene), "--out", str(out),
+                            "--platform", "vulkan"], cwd=REPO, capture_output=True, text=True, timeout=600)
+        assert r.returncode == 0, r.stderr[-3000:]
+        return json.loads((out / "manifest.json").read_text())["dynamic_light_sets"]["all"], r.stdout
+
+    scene.write_text(_scene(4, "switch"))
+    first, _ = build()
+    scene.write_text(_scene(4, "switch").replace('loop = "switch"\n', 'loop = "switch"\nmax = 8\n'))
+    second, said = build()
+    assert "(2 up to date" in said and " 0 shaders" in said, said
+    assert first["fill"] == second["fill"] == FILL_SWITCH
+    assert second["loop"] == "switch" and second["max"] == 8 != first["max"]
+    assert [p["first"] for p in second["pairs"]] == [p["first"] for p in first["pairs"]] == [0, 2]
