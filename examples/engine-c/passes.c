@@ -385,7 +385,7 @@ static void record_layer_copies(VkCommandBuffer cmd, const gpu_image *const *sou
 }
 
 /* A dynamic set's pair's array (made on first use): its lights' pass results in the set's order, a point light's
- * six faces each, the layers each light's shadow_first_layer names (the manifest's ordinal × layers). */
+ * six faces each, at the layers its first_layers names (each light's ordinal in the pair × its layers). */
 bool pair_array_of(engine *e, const cJSON *pair, const char *where, VkImageView *view)
 {
     for (int i = 0; i < e->npairs; i++)

@@ -391,6 +391,16 @@ static bool fill_pair(const engine *e, const cJSON *pair, const char *where, con
                 memcpy(data + (size_t)k * (size_t)stride + (size_t)offset, &f, 4);
                 continue;
             }
+            /* a shadowed pair's first layer: this set's (a light of two sets has one per set), not lights.<name>'s */
+            const cJSON *layers = j_opt(pair, "first_layers");
+            if (layers && n == 1 && strcmp(name->valuestring, "shadow_first_layer") == 0) {
+                const cJSON *at_k = cJSON_GetArrayItem(layers, k - at);
+                if (!cJSON_IsNumber(at_k))
+                    return j_fail(src, where, "first_layers of %s has no entry for light %d", bname, k - at);
+                float f = (float)at_k->valuedouble;
+                memcpy(data + (size_t)k * (size_t)stride + (size_t)offset, &f, 4);
+                continue;
+            }
             bool numbers = cJSON_IsArray(v) && cJSON_GetArraySize(v) == n;
             for (int c = 0; numbers && c < n; c++)
                 numbers = cJSON_IsNumber(cJSON_GetArrayItem(v, c));

@@ -11,6 +11,7 @@ Each platform spells the Interface in its own binding model (platforms.py: each 
 """
 from __future__ import annotations
 
+from ..link.faces import FIRST_LAYER, shadow_layers
 from ..link.values import is_switch, light_buffer_of, light_values, material_values
 from ..scene.light_sets import light_indices
 from ..scene.load import Scene
@@ -105,11 +106,17 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
             return [n for n in members if dyn.pair_of(scene.lights[n]) == i]
         def first_of(i, dyn=dyn, lights_of=lights_of):  # a switch buffer: where pair i's lights start
             return sum(len(lights_of(k)) for k in range(i)) if dyn.loop == "switch" else None
+
+        def layers_of(i, layout, dyn=dyn, lights_of=lights_of):  # a shadowed pair: its lights' first layers, here
+            if not any(sl["name"] == FIRST_LAYER for sl in layout):
+                return {}
+            return {"first_layers": [k * shadow_layers(dyn.model[i].light) for k in range(len(lights_of(i)))]}
         if c is None:  # its blocks as the last build described them; its capacity and lights as the scene says now
             if name in old:
                 out[name] = {**old[name], "max": dyn.max, "fill": FILL_SWITCH if dyn.loop == "switch" else FILL, "pairs": [
-                    {**p, "lights": lights_of(p["light_index"]),
-                     **({"first": first_of(p["light_index"])} if "first" in p else {})} for p in old[name]["pairs"]]}
+                    {**{k: v for k, v in p.items() if k != "first_layers"}, "lights": lights_of(p["light_index"]),
+                     **({"first": first_of(p["light_index"])} if "first" in p else {}),
+                     **layers_of(p["light_index"], p["layout"])} for p in old[name]["pairs"]]}
             continue
         pairs = []
         for i, pair in enumerate(dyn.model):
@@ -122,11 +129,11 @@ def dynamic_tables(scene: Scene, interfaces: dict, previous: dict | None, platfo
                 bindings[p] = next({k: v for k, v in row.items() if k not in ("name", "stages", "visibility")}
                                    for rows_ in rows.values() if isinstance(rows_, list) for row in rows_
                                    if isinstance(row, dict) and row.get("name") == block.name)
+            layout = [{k: v for k, v in sl.as_dict().items() if k in ("name", "type", "offset", "size")}
+                      for sl in block.slots if sl.light == i]
             pairs.append({"pair": pair.canonical(), "light_index": i, "block": block.name, "set": block.set,
-                          "binding": block.binding, "bindings": bindings, "stride": stride,
-                          "layout": [{k: v for k, v in sl.as_dict().items() if k in ("name", "type", "offset", "size")}
-                                     for sl in block.slots if sl.light == i],
-                          "lights": lights_of(i), **switch})
+                          "binding": block.binding, "bindings": bindings, "stride": stride, "layout": layout,
+                          "lights": lights_of(i), **switch, **layers_of(i, layout)})
         out[name] = {"max": dyn.max, "pairs": pairs, "fill": FILL_SWITCH if dyn.loop == "switch" else FILL,
                      **({"loop": dyn.loop} if dyn.loop != "types" else {}),
                      **({"culling": dyn.culling, "tiles": _tiles(c, platforms)} if dyn.culling == "tiles" else {})}

@@ -167,3 +167,47 @@ def test_the_manifest_says_where_each_buffer_light_lies_in_its_pair_s_array(lib,
     assert m["lights"]["l2"]["depth_pass"]["faces"]["layers"] == 6
     spot = m["lights"]["l0"]["depth_pass"]["binds"][0]
     assert spot["array"]["layers"] == 1 and spot["array"]["capacity_bytes"] == 8 * SHADOW_SIZE ** 2 * 4
+
+
+def test_a_light_of_two_sets_has_each_set_s_first_layer(lib, tmp_path):
+    """Two dynamic sets of the same three pcf spots in opposite orders: each pair's first_layers is its set's
+    (what its buffer holds), and a rebuild that composes nothing (only max changed) recomputes them."""
+    import json
+
+    from generator.assemble import BuildContext, build
+    from generator.link.values import light_buffers
+    from generator.scene.load import load_scene
+
+    text = _scene(SPOTS[:3], True).replace(
+        '[[objects]]\nname = "box1"\nmaterial = "grey"\nlights = "all"\n',
+        '[[objects]]\nname = "box1"\nmaterial = "grey"\nlights = "back"\n')
+    text = text.replace("max = 8\n", 'max = 8\n\n[light_sets.back]\ndynamic = true\nlights = ["l2", "l1", "l0"]\n'
+                        "max = 8\n", 1)
+    assert 'lights = "back"' in text and "[light_sets.back]" in text
+    (tmp_path / "s.toml").write_text(text)
+    (tmp_path / "s.placement.toml").write_text(PLACEMENT)
+
+    def manifest():
+        build(load_scene(tmp_path / "s.toml", lib), tmp_path / "out", BuildContext(lib))
+        return json.loads((tmp_path / "out" / "manifest.json").read_text())
+
+    m = manifest()
+    sets = m["dynamic_light_sets"]
+    assert sets["all"]["pairs"][0]["lights"] == ["l0", "l1", "l2"] and sets["all"]["pairs"][0]["first_layers"] == [0, 1, 2]
+    assert sets["back"]["pairs"][0]["lights"] == ["l2", "l1", "l0"] and sets["back"]["pairs"][0]["first_layers"] == [0, 1, 2]
+    # the light's own entry says its first set's layer; the pair's first_layers is what an engine writes
+    assert m["lights"]["l0"]["params"]["shadow_first_layer"] == 0 and sets["back"]["pairs"][0]["lights"][2] == "l0"
+    # what each set's buffer holds in shadow_first_layer: its pair's first_layers, light by light
+    scene = load_scene(tmp_path / "s.toml", lib)
+    from generator.link import link_permutation
+    for set_name in ("all", "back"):
+        obj = next(o for o in scene.objects if o["light_set"] == set_name)
+        lp = link_permutation(scene.permutations[obj["permutation"]], lib)
+        blk = lp.interface.block("LightBuffer0")
+        at = next(s for s in blk.slots if s.param == "shadow_first_layer").offset // 4
+        data = np.frombuffer(light_buffers(scene, obj["lights"], scene.dynamic_sets[set_name], lp)["LightBuffer0"],
+                             np.float32).reshape(3, -1)
+        assert data[:, at].tolist() == sets[set_name]["pairs"][0]["first_layers"]
+    (tmp_path / "s.toml").write_text(text.replace('"l0"]\nmax = 8\n', '"l0"]\nmax = 4\n'))
+    again = manifest()["dynamic_light_sets"]
+    assert again["back"]["max"] == 4 and again["back"]["pairs"][0]["first_layers"] == [0, 1, 2]
