@@ -68,7 +68,8 @@ FILL_SWITCH = ("one buffer for every pair (each pair's block is the same): pair 
 
 FILL_TILES = ("every frame, from the engine's light culling: a flat array of uint32 words, words 0-3 tiles_x, "
               "tiles_y, tile_size (pixels, the engine's choice) and pairs (the key's pair count); then per tile t = x + "
-              "y x tiles_x (x = floor(pixel x / tile_size), y likewise, from the framebuffer origin the API gives "
+              "y x tiles_x (x = min(floor(pixel x / tile_size), tiles_x - 1), y likewise; a 0 in tiles_x, tiles_y or "
+              "tile_size reads as 1), from the framebuffer origin the API gives "
               "the fragment's coordinate: top left in Vulkan, D3D and WebGPU, bottom left in OpenGL) and per pair i, "
               "at word 4 + 2 (t x pairs + i), its list's offset (a word index into this buffer) and count; then the "
               "lists, each word an element of pair i's buffer. A light may be in more tiles than it reaches, never "

@@ -17,6 +17,8 @@ x_i = i/(W − 1), read at u = x (W − 1)/W + 0.5/W), RGBA:
   factored out (eq. 6 carries it as a factor: footnote 4), integrated numerically (`diffuse_albedo`);
   the diffuse ambient term is ρ (1 − f0) B · E(n)/π with E the irradiance. At α → 0 it is
   1 − (1 − n·v)^5 exactly (the facet is the surface; ∫ F_diff cos/π = (1 − f0)(1 − (1 − μ)^5)).
+  A spec whose diffuse is Lambert gets B = 1 (ρ/π × irradiance is exact), one with no diffuse term B = 0;
+  any other diffuse brick (Oren-Nayar, …) is refused, located.
 - A = 1.
 
 The specular integral is importance-sampled with the term's own sampler (generator.eval.sampling: GGX by
@@ -132,13 +134,6 @@ def refuse(term: Term, where: str = "") -> None:
 _MEMO: dict[str, np.ndarray] = {}
 
 
-def _sources_key(paths) -> str:
-    h = hashlib.sha256()
-    for p in sorted({str(p) for p in paths}):
-        h.update(p.encode() + b"\0" + Path(p).read_bytes() + b"\0")
-    return h.hexdigest()
-
-
 def _code_paths() -> list[Path]:
     ref = _HERE.parent / "reference"
     return [*_HERE.glob("ibl*.py"), _HERE / "sampling.py", _HERE.parent / "link" / "sampling.py",
@@ -146,8 +141,8 @@ def _code_paths() -> list[Path]:
 
 
 def input_key(what: str, spec: str, size, samples: int, lib=None) -> str:
-    """The content key of a table: what it is, the term, size, samples and every source it is computed from.
-    Paths are hashed by their place relative to the package (the key is the same in any checkout)."""
+    """The content key of a table: what it is, the term, size, samples and every source it is computed from,
+    each source by its file name and bytes (no directory: the key is the same in any checkout)."""
     from ..spec.resolve import resolve_brdf
     lib = library_or_builtin(lib)
     bricks = [n.brick for top in resolve_brdf(spec, lib).nodes for n in top.tree] if spec else []
@@ -281,7 +276,7 @@ def _diffuse_texels(size, nodes=DIFFUSE_NODES) -> np.ndarray:
 
 def diffuse_table(size=SIZE, store=True, nodes=DIFFUSE_NODES) -> np.ndarray:
     """(H, W) the B channel: eq. 4's directional albedo over (n·v, √α), cached by input key."""
-    key = input_key("gotanda_eq4_albedo", "", size, int(np.prod(nodes)))
+    key = input_key("gotanda_eq4_albedo", "", size, 0) + "-" + "x".join(map(str, nodes))
     arr, _ = _cached(key, (size[1], size[0]), lambda: _diffuse_texels(size, nodes), store)
     return arr
 
@@ -327,16 +322,20 @@ def ambient_brdf(spec: str, size=SIZE, samples: int = SAMPLES, lib=None, where: 
         raise IblRefusal(f"{prefix}brdf '{spec}' has no specular term — the AmbientBRDF's scale and bias belong "
                          "to a microfacet term: add one, or light the diffuse term by SH9 alone")
     t = terms[0]
-    if t.how == "refused":
-        refuse(t, where)
+    diffuse = [d for d in classify(spec, lib) if d.kind == "diffuse"]
+    for d in [t, *diffuse]:
+        if d.how == "refused":
+            refuse(d, where)
+    # B: Gotanda's eq. 4 albedo for his diffuse, 1 for Lambert (exact: rho/pi x irradiance), 0 with no diffuse term
+    b_how = diffuse[0].how if diffuse else "none"
     w, h = int(size[0]), int(size[1])
-    key = input_key("ambient_brdf", t.spec, (w, h), samples, lib)
+    key = input_key("ambient_brdf", t.spec, (w, h), samples, lib) + "-" + b_how
     start = time.perf_counter()
 
     def make():
         out = np.zeros((h, w, 4))
         out[..., :2] = _specular_texels(t.spec, (w, h), samples, lib, where)
-        out[..., 2] = diffuse_table((w, h), store)
+        out[..., 2] = diffuse_table((w, h), store) if b_how == "gotanda_eq4" else float(b_how == "lambert")
         out[..., 3] = 1.0
         return out
 

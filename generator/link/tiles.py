@@ -11,7 +11,7 @@ layout rule of storage buffers, so GLSL std430, HLSL structured buffers and WGSL
 
 The tile is (⌊x / tile_size⌋, ⌊y / tile_size⌋) of the fragment's pixel coordinate (gl_FragCoord, SV_Position,
 @builtin(position): from the top left in Vulkan, D3D and WebGPU, from the bottom left in OpenGL), clamped to the
-grid. The tile size lives in the buffer, not in the shader, so an engine picks it (and the grid) without a rebuild.
+grid; a tile_size, tiles_x or tiles_y of 0 reads as 1 (the shader never divides by zero or reads past the grid). The tile size lives in the buffer, not in the shader, so an engine picks it (and the grid) without a rebuild.
 Why a list per (tile, pair) rather than one per tile: each pair keeps its own loop over its own buffer (loop
 "types", the measured default), so each needs its own indices.
 """
@@ -57,11 +57,14 @@ def tile_record(b: Builder, g: ir.Global, pairs: int) -> list[ir.Stmt]:
     def h(c):
         return ir.Swizzle(UINT, b.here(), b.var("tile_head", UVEC4), c)
 
+    def at_least_1(e):  # a header of zeros (an engine that filled nothing) reads tile 0, not past the buffer
+        return b.intrinsic("max", UINT, e, _u(b, 1))
+
     for axis, n in (("x", "x"), ("y", "y")):  # min(uint(frag_coord.axis) / tile_size, tiles_axis - 1)
         pix = ir.Construct(UINT, b.here(), [ir.Swizzle(FLOAT, b.here(), b.var(FRAG_COORD, VEC2, "param"), axis)])
-        out.append(b.decl(f"tile_{axis}0", b.arith("/", pix, h("z"))))
+        out.append(b.decl(f"tile_{axis}0", b.arith("/", pix, at_least_1(h("z")))))
         t0 = b.var(f"tile_{axis}0", UINT)
-        last = b.arith("-", h(n), _u(b, 1))
+        last = b.arith("-", at_least_1(h(n)), _u(b, 1))
         out.append(b.decl(f"tile_{axis}", ir.Select(UINT, b.here(), b.compare("<", t0, h(n)), b.copy(t0), last)))
     tile = b.arith("+", b.var("tile_x", UINT), b.arith("*", b.var("tile_y", UINT), h("x")))
     out.append(b.decl("tile_rec", b.arith("+", _u(b, HEADER_WORDS), b.arith("*", _u(b, RECORD_WORDS * pairs), tile))))

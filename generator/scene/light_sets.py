@@ -17,7 +17,8 @@
 The permutation key of an object lit by a dynamic set carries the set's model (sorted dynamic LightKeys,
 `lights=*point/none,*spot/none`; with loop = "switch" `lights=**point/none,**spot/none`), not its lights: any
 number of lights of those pairs is one shader per material; culling = "tiles" marks each pair `@tiles`
-(`lights=*point/none@tiles`): another shader, whose loops read the tile's index list (link/glue.py _tile_loop). Why "types" is the default: docs/design/link.md,
+(`lights=*point/none@tiles`): another shader, whose loops read the tile's index list (link/tiles.py tiled_loop).
+Why "types" is the default: docs/design/link.md,
 "Which light loop" (measured by benchmarks/lights.py).
 Why a model may name pairs no light has yet: an engine adding lights at run time needs the shader that reads
 them. A pair whose shadow filter samples a texture reads one 2D array per (pair, filter texture): each light of it

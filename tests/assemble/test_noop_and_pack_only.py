@@ -141,3 +141,20 @@ def test_pack_only_writes_no_loose_artifact_and_the_packs_of_a_loose_build(built
     finally:
         scene.write_text(text)
         _old(scene)
+
+
+@pytest.mark.parametrize("dir_fd", [True, False], ids=["dir_fd", "whole_paths"])
+def test_the_size_check_finds_a_changed_or_missing_file(tmp_path, monkeypatch, dir_fd):
+    """noop._sizes_match, by directory descriptors and (where a platform has none) by whole paths."""
+    from generator.assemble import noop
+    if not dir_fd:
+        monkeypatch.setattr(noop.os, "supports_dir_fd", set())
+    (tmp_path / "a").mkdir()
+    (tmp_path / "a" / "x.spv").write_bytes(b"1234")
+    (tmp_path / "m.json").write_bytes(b"{}")
+    files = {"a/x.spv": 4, "m.json": 2}
+    root = os.fspath(tmp_path)
+    assert noop._sizes_match(root, files)
+    assert not noop._sizes_match(root, {**files, "a/x.spv": 5})
+    with pytest.raises(OSError):  # check() reads a missing file as "not a no-op"
+        noop._sizes_match(root, {**files, "a/y.spv": 1})

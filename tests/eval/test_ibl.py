@@ -52,6 +52,12 @@ def test_classification_and_located_refusals():
     assert how == {"gotanda_fitted": "gotanda_eq4", "microfacet": "ambient_brdf"}
     with pytest.raises(ibl_tables.IblRefusal, match=r"^scene.toml:3:9: .*not a microfacet term"):
         ibl_tables.ambient_brdf("lambert+phong_normalized", where="scene.toml:3:9", store=False)
+    with pytest.raises(ibl_tables.IblRefusal, match=r"^scene.toml:4:2: brdf term 'oren_nayar': .*no ambient table"):
+        ibl_tables.ambient_brdf("oren_nayar+" + GGX, where="scene.toml:4:2", store=False)
+    lam = ibl_tables.ambient_brdf("lambert+" + GGX, size=(4, 4), samples=64, store=False)
+    bare = ibl_tables.ambient_brdf(GGX, size=(4, 4), samples=64, store=False)
+    assert (lam.texels[..., 2] == 1.0).all() and (bare.texels[..., 2] == 0.0).all()  # B: Lambert's 1, none's 0
+    assert lam.key != bare.key and np.array_equal(lam.texels[..., :2], bare.texels[..., :2])
     with pytest.raises(ibl_tables.IblRefusal, match="reads eta, k"):
         ibl_tables.ambient_brdf("microfacet(ndf=ggx,fresnel=conductor_exact,vis=smith_ggx_height_correlated)",
                                 store=False)
@@ -142,6 +148,20 @@ def test_rgbe_reader_reads_a_hand_written_file(tmp_path, rle):
     tol = np.maximum(want.max(axis=-1, keepdims=True), 1e-30) / 128.0
     assert np.all(np.abs(got - want) <= tol)
     assert np.all(got[:, :5] == 0.0)
+
+
+def test_rgbe_reader_divides_by_exposure_and_reads_crlf_headers(tmp_path):
+    pixels = [[(1.0, 0.5, 0.25)] * 8]
+    plain = _hdr(pixels, True)
+    head, _, body = plain.partition(b"FORMAT=32-bit_rle_rgbe\n")
+    p = tmp_path / "e.hdr"
+    p.write_bytes(head.replace(b"\n", b"\r\n") + b"EXPOSURE=2.0\r\nFORMAT=32-bit_rle_rgbe\r\nEXPOSURE=4\r\n"
+                  + body.replace(b"\n", b"\r\n", 1))
+    (tmp_path / "p.hdr").write_bytes(plain)
+    assert np.array_equal(ibl_env.read_hdr(p) * 8.0, ibl_env.read_hdr(tmp_path / "p.hdr"))  # pixel / (2 x 4)
+    p.write_bytes(head + b"EXPOSURE=-1\n" + b"FORMAT=32-bit_rle_rgbe\n" + body)
+    with pytest.raises(SourceError, match=r"e.hdr:3:10: .*positive number"):
+        ibl_env.read_hdr(p)
 
 
 def test_rgbe_reader_refuses_with_a_location(tmp_path):
