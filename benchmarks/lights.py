@@ -6,7 +6,13 @@ spot (N = 1: one point), drawn three ways, in one run on one device, as ratios b
 - static: the N lights as a static set, unrolled in the shader (N ≤ 32, the static cap);
 - types: a dynamic set, `loop = "types"`, one loop per light type over its own buffer (`*point/none,*spot/none`);
 - switch: a dynamic set, `loop = "switch"`, one loop over one buffer, a switch on each light's type
-  (`**point/none,**spot/none`).
+  (`**point/none,**spot/none`);
+- tiles: the types loop with `culling = "tiles"` (`*point_range/none@tiles,…`): each loop reads its 16-pixel
+  tile's index list, which the renderer's CPU culling fills. Tiles need lights with a reach, so these cases and
+  their "types" twins (form "types (ranged)") use point_range lights and spots of radius RANGE.
+
+The shadowed cases put shadow_map on every light, static and (types loop) dynamic: the same maps, as separate
+textures or as one 2D array per pair (a switch loop with shadows is refused).
 
 Per case: permutations and the cold build time (GLSL, Vulkan, no cache); the lavapipe frame time (median GPU ms of
 the render report's frames, the first dropped, over interleaved rounds: the machine's drift spreads over all
@@ -48,8 +54,11 @@ from generator.scene.load import load_scene  # noqa: E402
 RESULTS = REPO / "benchmarks" / "results"
 STATIC_COUNTS = (1, 4, 16, 32)  # a static set holds at most 32 (scene/light_sets.py MAX_LIGHTS_PER_SET)
 DYNAMIC_ONLY = (64, 256)
-SHADOWED = (1, 4)  # static sets with shadow_map on every light: the shadow maps' memory
+SHADOWED = (1, 4, 16)  # static and dynamic (types) sets with shadow_map on every light: the shadow maps' memory
 FORMS = ("static", "types", "switch")
+LABEL = {"ranged": "types (ranged)"}
+TILED = (64, 256)  # ranged lights, the types loop untiled and tiled
+RANGE = 1.5  # the ranged lights' radius (metres; the lights' circle has radius 2.5)
 RADV_SHOWN = {"VGPRs": "vgprs", "Instructions": "instructions", "Latency": "latency",
               "Subgroups per SIMD": "waves_per_simd"}
 PLACEMENT = ('[objects.floor]\nmesh = "plane"\nscale = [4.0, 1.0, 4.0]\n[objects.ball]\nmesh = "sphere"\n'
@@ -57,14 +66,17 @@ PLACEMENT = ('[objects.floor]\nmesh = "plane"\nscale = [4.0, 1.0, 4.0]\n[objects
 
 
 def scene_text(n: int, form: str, shadow: str = "none") -> str:
-    """The benchmark scene: n lights, even ones point, odd ones spot, as a static list or a dynamic set."""
+    """The benchmark scene: n lights, even ones point, odd ones spot, as a static list or a dynamic set; forms
+    "tiles" and "ranged" (the types loop untiled): point_range lights and spots of radius RANGE."""
+    ranged = form in ("tiles", "ranged")
     out = ['[materials.grey]\nbrdf = "lambert"\nparams = { rho_d = [0.8, 0.8, 0.8] }\n',
            '[materials.shiny]\nbrdf = "lambert+blinn_phong_normalized"\nparams = { rho_d = [0.5, 0.3, 0.2], n = 32.0 }\n']
     for i in range(n):
         a = 2 * math.pi * i / n
         c = [round(0.2 + 0.6 * abs(math.sin(a + k)), 3) * 8.0 / n for k in (0.0, 2.1, 4.2)]
-        kind = "point" if i % 2 == 0 else "spot"
+        kind = ("point_range" if ranged else "point") if i % 2 == 0 else "spot"
         aim = ", direction = [0.0, -1.0, 0.0], outer_angle = 1.2" if kind == "spot" else ""
+        aim += f", radius = {RANGE}" if ranged else ""
         out.append(f'[lights.l{i}]\ntype = "{kind}"\nshadow = "{shadow}"\nparams = {{ position = '
                    f'[{2.5 * math.cos(a):.4f}, 1.6, {2.5 * math.sin(a):.4f}], color = [{c[0]:.4f}, {c[1]:.4f}, '
                    f'{c[2]:.4f}]{aim} }}\n')
@@ -72,7 +84,10 @@ def scene_text(n: int, form: str, shadow: str = "none") -> str:
     if form == "static":
         out.append(f"[light_sets]\nall = [{names}]\n")
     else:
-        out.append(f'[light_sets.all]\ndynamic = true\nlights = [{names}]\nmax = {max(n, 256)}\nloop = "{form}"\n')
+        loop = "types" if ranged else form
+        cull = 'culling = "tiles"\n' if form == "tiles" else ""
+        cap = n if shadow != "none" else max(n, 256)  # a shadowed pair's array: max x layers, at most 2048
+        out.append(f'[light_sets.all]\ndynamic = true\nlights = [{names}]\nmax = {cap}\nloop = "{loop}"\n{cull}')
     out += ['[[objects]]\nname = "floor"\nmaterial = "grey"\nlights = "all"\n',
             '[[objects]]\nname = "ball"\nmaterial = "shiny"\nlights = "all"\n']
     return "\n".join(out)
@@ -84,7 +99,8 @@ def cases(quick: bool) -> list[tuple[int, str, str]]:
     dyn = (64,) if quick else DYNAMIC_ONLY
     out = [(n, f, "none") for n in static for f in FORMS]
     out += [(n, f, "none") for n in dyn for f in FORMS[1:]]
-    out += [(n, "static", "shadow_map") for n in (SHADOWED[:1] if quick else SHADOWED)]
+    out += [(n, f, "shadow_map") for n in (SHADOWED[:1] if quick else SHADOWED) for f in ("static", "types")]
+    out += [(n, f, "none") for n in (TILED[:1] if quick else TILED) for f in ("ranged", "tiles")]
     return out
 
 
@@ -153,22 +169,27 @@ def markdown(out: dict) -> str:
           "Written by `benchmarks/lights.py`; half the lights point, half spot (1 light: one point, where the two "
           "dynamic forms are the same shader but for the switch).", "",
           "## Frame time on lavapipe and build cost", "",
-          "| lights | form | key's lights | permutations | cold build s | GPU ms/frame | / static | switch / types "
+          "| lights | form | key's lights | permutations | cold build s | GPU ms/frame | / static | / types "
           "| shadow maps (layers) | shadow-map memory |",
           "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|"]
     for k, r in rows.items():
-        base = rows.get(name_of(r["lights"], "static", "none"))
-        types = rows.get(name_of(r["lights"], "types", "none"))
-        vs_static = f"{r['gpu_ms'] / base['gpu_ms']:.2f}" if base and r["shadow"] == "none" else ""
-        vs_types = f"{r['gpu_ms'] / types['gpu_ms']:.2f}" if types and r["form"] == "switch" else ""
+        base = rows.get(name_of(r["lights"], "static", r["shadow"]))
+        types = rows.get(name_of(r["lights"], "ranged" if r["form"] == "tiles" else "types", "none"))
+        vs_static = f"{r['gpu_ms'] / base['gpu_ms']:.2f}" if base and r["form"] not in ("ranged", "tiles") else ""
+        vs_types = f"{r['gpu_ms'] / types['gpu_ms']:.2f}" if types and r["form"] in ("switch", "tiles") else ""
         mem = f"{r['shadow_map_bytes'] / 2 ** 20:.1f} MiB" if r["shadow_map_bytes"] else "0"
-        form = r["form"] + ("" if r["shadow"] == "none" else f" ({r['shadow']})")
+        form = LABEL.get(r["form"], r["form"]) + ("" if r["shadow"] == "none" else f" ({r['shadow']})")
         key = r["ball_key"] if len(r["ball_key"]) <= 48 else r["ball_key"][:45] + "…"
         md.append(f"| {r['lights']} | {form} | `{key}` | {r['permutations']} | "
                   f"{r['cold_build_s']:.2f} | {r['gpu_ms']:.2f} | {vs_static} | {vs_types} | {r['shadow_maps']} | {mem} |")
     md += ["", "Permutations to cover every light count above, per material: static one per count "
            f"({out['static_counts']} counts × 2 materials = {2 * len(out['static_counts'])} shaders), dynamic one "
-           "(2 shaders, whatever the count up to `max`).", "",
+           "(2 shaders, whatever the count up to `max`). / static: against the static list of the same lights and "
+           "shadows; / types: the switch loop against the types loop, and the tiled loops against the same ranged "
+           f"lights untiled (point_range and spots of radius {RANGE} on a circle of radius 2.5; the renderer's CPU "
+           "culling, 16-pixel tiles). A dynamic shadowed pair's maps are one 2D array of the same layers the static "
+           "set's separate maps hold, so their memory is equal (an engine's array is sized max × layers: "
+           "the manifest's capacity_bytes).", "",
            "## RADV (null device, ACO): the ball's fragment shader", "",
            "VGPRs / instructions / latency (cycles, ACO's estimate) / waves per SIMD (occupancy). The dynamic forms' "
            "code does not depend on the light count, so one row per form covers every count.", "",
@@ -182,7 +203,7 @@ def markdown(out: dict) -> str:
         cells = [" / ".join(str(r["radv"][f][x]) for x in ("vgprs", "instructions", "latency", "waves_per_simd"))
                  for f in fam]
         lights = r["lights"] if r["form"] == "static" else "any"
-        form = r["form"] + ("" if r["shadow"] == "none" else f" ({r['shadow']})")
+        form = LABEL.get(r["form"], r["form"]) + ("" if r["shadow"] == "none" else f" ({r['shadow']})")
         md.append(f"| {lights} | {form} | " + " | ".join(cells) + " |")
     md += ["", "## Model", "", out["model"], ""]
     return "\n".join(md)

@@ -11,7 +11,8 @@ layout rule of storage buffers, so GLSL std430, HLSL structured buffers and WGSL
 
 The tile is (⌊x / tile_size⌋, ⌊y / tile_size⌋) of the fragment's pixel coordinate (gl_FragCoord, SV_Position,
 @builtin(position): from the top left in Vulkan, D3D and WebGPU, from the bottom left in OpenGL), clamped to the
-grid; a tile_size, tiles_x or tiles_y of 0 reads as 1 (the shader never divides by zero or reads past the grid). The tile size lives in the buffer, not in the shader, so an engine picks it (and the grid) without a rebuild.
+grid; a tile_size, tiles_x or tiles_y of 0 reads as 1 (the shader never divides by zero or reads past the grid).
+The tile size lives in the buffer, not in the shader, so an engine picks it (and the grid) without a rebuild.
 Why a list per (tile, pair) rather than one per tile: each pair keeps its own loop over its own buffer (loop
 "types", the measured default), so each needs its own indices.
 """
