@@ -13,7 +13,13 @@ byte-identical wherever it is built; `cache clear` removes it, a build without a
 
 The next build with the same request checks it first (``check``): the same scene bytes, the same files, no
 file added to or removed from a brick directory or the generator, the same tools, the outputs as the record
-left them, and every file the state record lists there with its size. Then it is a no-op, said as the full
+left them, and every file the state record lists there: each directory of the tree with the mtime and inode
+the record saw (a file removed, added or renamed into it changes its directory's mtime), and the size of each
+file of a directory the record could not vouch for (one modified less than DIR_MARGIN_NS before the record: a
+file timestamp is the kernel's coarse clock, a tick behind, so a change within that tick could leave the same
+mtime). A no-op that checked a directory file by file vouches for it in the record once it is old enough. A file
+rewritten in place under its own name is not seen — as Make and Ninja, which never read an
+output's bytes, the record trusts that only the build writes its outputs. Then it is a no-op, said as the full
 path says it, and it writes nothing. Any doubt — no record, another request, a stat that differs, a glTF
 scene (its buffers are not listed) — is the full path, which loads the scene and decides from the keys as
 before; only a build that succeeded records, so the full path also replaces a record it outgrew.
@@ -36,6 +42,7 @@ from .. import __version__
 NOOP = "noop-v1"  # the compile cache's namespace (io.Store) of the records
 FORMAT = 1
 MARGIN_NS = 2_000_000_000  # coarse file timestamps: FAT's are 2 s apart
+DIR_MARGIN_NS = 100_000_000  # an output directory modified this close to its record is checked file by file
 _PACKAGE = Path(__file__).resolve().parents[1]  # generator/
 _CODE = (".py", ".j2", ".toml")  # what keys.source_files and the versions file hash of it
 TOOLS = ("glslc", "glslangValidator", "spirv-val", "spirv-opt", "naga", "dxc")  # whose versions the keys hold
@@ -138,9 +145,14 @@ def record(out: Path, request: Request, scene, lib, res, templates, store) -> bo
         forget(out, store)
         return False
     outputs = {name: _outputs_stat(Path(out) / name) for name in ("manifest.json", STATE, VERSIONS)}
+    try:
+        tree = _tree_stat(os.fspath(out), _dirs(json.loads((Path(out) / STATE).read_bytes())["files"]), vouch=True)
+    except (OSError, ValueError, KeyError, TypeError):
+        forget(out, store)
+        return False
     doc = {"format": FORMAT, "generator": f"shadermatrix {__version__}", "request": request.key(),
            "scene": {"stat": scene_stat, "sha256": _sha256(scene_path)},
-           "code": code, "bricks": bricks, "files": files, "tools": tools, "outputs": outputs,
+           "code": code, "bricks": bricks, "files": files, "tools": tools, "outputs": outputs, "tree": tree,
            "depfile": _sha256(request.depfile) if request.depfile else None,
            "summary": {"scene": scene.name, "permutations": len(scene.permutations),
                        "packs": [p["path"] for p in res.manifest.get("packs", [])] if request.pack else []},
@@ -178,11 +190,35 @@ def check(out: Path, request: Request, store) -> dict | None:
         state = json.loads((out / STATE).read_bytes())
         if not state.get("complete"):
             return None
-        if not _sizes_match(os.fspath(out), state["files"]):
+        root, tree = os.fspath(out), doc["tree"]
+        if _tree_stat(root, tree) != tree:  # the directories it vouched for, as it left them
             return None
+        rest = _dirs(state["files"]) - set(tree)
+        if rest and not _sizes_match(root, {rel: size for rel, size in state["files"].items()
+                                            if rel.rpartition("/")[0] in rest}):  # the others' files, one by one
+            return None
+        if rest and (later := _tree_stat(root, rest, vouch=True)):  # found intact and now old enough: vouched
+            store.put(NOOP, _key(out), (json.dumps({**doc, "tree": {**tree, **later}}, sort_keys=True) + "\n").encode())
         return {**doc["summary"], "warnings": doc["warnings"], "unchanged": len(state["files"]) + 1}
     except (OSError, ValueError, KeyError, TypeError, AttributeError, RuntimeError):
         return None
+
+
+def _tree_stat(root: str, dirs, vouch: bool = False) -> dict[str, list[int]]:
+    """{directory (relative to root, "" the root): [mtime_ns, inode]} of `dirs`; vouch (when recording): only
+    those modified at least DIR_MARGIN_NS ago (the module docstring), the others left out."""
+    import time
+    now, out = time.time_ns(), {}
+    for d in sorted(dirs):
+        st = os.stat(os.path.join(root, d) if d else root)
+        if not vouch or now - st.st_mtime_ns >= DIR_MARGIN_NS:
+            out[d] = [st.st_mtime_ns, st.st_ino]
+    return out
+
+
+def _dirs(files: dict) -> set[str]:
+    """The directories (relative) holding `files` (relative paths)."""
+    return {rel.rpartition("/")[0] for rel in files}
 
 
 def _sizes_match(root: str, files: dict[str, int]) -> bool:
