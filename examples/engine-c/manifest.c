@@ -79,6 +79,9 @@ static bool add_textures(const manifest *m, program *p, const cJSON *list, VkSha
         const char *dim = j_str(src, t, "dimension", at);
         if (!dim)
             return false;
+        if (j_opt(t, "environment"))  /* image-based lighting: its cube and table are not build artifacts yet */
+            return j_fail(src, at, "texture %s is an environment's (image-based lighting), which this engine does not "
+                          "draw yet; draw the scene with `shadermatrix render`", r.name);
         r.light = -1;
         if (j_opt(t, "light") && !j_int(src, t, "light", at, 0, 255, &r.light))
             return false;

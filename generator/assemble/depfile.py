@@ -50,7 +50,8 @@ def _bricks(scene, lib) -> list:
         except (SourceError, SpecError):  # it fails to compose: the build fails, and no stamp is written
             continue
         nodes = [x for top in (*r.brdf, r.packing, *(lt.shadow for lt in r.lights)) for x in top.tree]
-        for b in [*(n.brick for n in nodes), *(lt.brick for lt in r.lights), r.output]:
+        env = [r.environment.brick] if r.environment is not None else []
+        for b in [*(n.brick for n in nodes), *(lt.brick for lt in r.lights), r.output, *env]:
             found[(b.kind, b.id)] = b
     return list(found.values())
 

@@ -54,6 +54,15 @@ class Entries:
             for o in self.scene.objects:
                 self.users.setdefault(o["permutation"], []).append(o)
 
+    def _environments(self) -> dict | None:
+        """The SH9 values of the scene's environments (assemble/environments.py), computed once per process."""
+        if not self.scene.environment_of:
+            return None
+        if "_env" not in self.__dict__:
+            from .environments import values
+            self.__dict__["_env"] = values(self.scene)
+        return self.__dict__["_env"]
+
     def __getstate__(self):  # the users are the scene's objects again: not sent twice
         return {"scene": self.scene, "keys": self.keys, "uber_key": self.uber_key}
 
@@ -78,7 +87,8 @@ class Entries:
         for h, c in pairs:
             rec.files = []
             entry = {**self.head(ctx.library, h), "bricks": dict(sorted(c.bricks.items())),
-                     "interface": c.interface.as_dict(), "uploads": uploads(self.scene, h, c, self.users.get(h, []))}
+                     "interface": c.interface.as_dict(), "uploads": uploads(self.scene, h, c, self.users.get(h, []),
+                                                                       self._environments())}
             errs = rec.unit(h, c.sources, part, entry)
             if not errs:
                 errs = rec.platforms(h, c, entry, checked, self.scene.permutations[h].precision)

@@ -94,13 +94,23 @@ def _perm_key(base: str, scene: Scene, lib: Library, perm, objs: list[dict]) -> 
     lights = sorted({ln for o in objs for ln in o["lights"]})
     values = {"objects": [[o["name"], o["material"], o["light_set"], list(o["lights"])] for o in objs],
               "materials": [repr(scene.materials[m]) for m in mats], "lights": [repr(scene.lights[ln]) for ln in lights]}
+    envs = sorted({scene.environment_of[o["light_set"]] for o in objs if o["light_set"] in scene.environment_of})
+    if envs:  # the environments its light sets use (their values are in the Lights block); absent: keys unchanged
+        values["environments"] = [_environment_key(scene.environments[e]) for e in envs]
     shape = content_key(base, perm.canonical(), sorted(bricks.items()))
     return content_key(shape, values), shape, bricks
+
+
+def _environment_key(env) -> str:
+    """An environment's declaration and its image's bytes (what its SH9 values are computed from)."""
+    from .environments import _source_key
+    return content_key(repr(env), _source_key(env))
 
 
 def _bricks_of(r: Resolved) -> dict[str, str]:
     """{display path: source hash} of every brick a resolved permutation reads: its BRDF's, its packing's (the
     normal filler within), each light's and its shadow filter's, its output's."""
     nodes = [x for top in (*r.brdf, r.packing, *(lt.shadow for lt in r.lights)) for x in top.tree]
+    env = [r.environment.brick] if r.environment is not None else []
     return {b.display_path: b.module.source_hash for b in [*(n.brick for n in nodes), *(lt.brick for lt in r.lights),
-                                                            r.output]}
+                                                            r.output, *env]}

@@ -125,6 +125,7 @@ class Composed:
     material: list[Slot] = field(default_factory=list)
     lights: list[list[Slot]] = field(default_factory=list)
     dialects: list[Source] = field(default_factory=list)  # platform dialects (gl, essl): validated, not SPIR-V
+    environment: list[Slot] = field(default_factory=list)  # the environment's values in the Lights block
 
 
 def _template_hash(name: str) -> str:
@@ -210,7 +211,8 @@ def compose_eval(spec: str, lib: Library, languages=LANGUAGES, ep: EvalProgram |
 
 def _call_args(lp) -> list[dict]:
     """How a template passes each shade() parameter: a local, a texture, or a slot of a block."""
-    slots = {s.name: ("material", s) for s in lp.material} | {s.name: ("lights", s) for ls in lp.lights for s in ls}
+    slots = {s.name: ("material", s) for s in lp.material} | {s.name: ("lights", s) for ls in lp.lights for s in ls} \
+        | {s.name: ("lights", s) for s in lp.environment}
     out = []
     for name, ty in lp.glue.signature:
         if ty.kind == "texture":
@@ -267,7 +269,7 @@ def compose_permutation(perm: Permutation | LinkedPermutation, lib: Library, lan
     for d in dialects:  # the platform dialects (GL's: gl/templates/, with the Vulkan GLSL's macros)
         extra += _stage_sources(lib, lp, language(d), f"permutation ({d})", bricks, templates)
     return Composed(perm.canonical(), perm.hash, sources, bricks, templates, iface, material=lp.material,
-                    lights=lp.lights, dialects=extra)
+                    lights=lp.lights, dialects=extra, environment=lp.environment)
 
 
 def _stage_sources(lib: Library, lp: LinkedPermutation, lang: Language, label: str, bricks, templates) -> list[Source]:

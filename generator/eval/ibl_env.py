@@ -369,15 +369,17 @@ def level_samples(texels: int, budget: int = 1 << 20) -> int:
     return int(min(max(k, 256), 65536))
 
 
-def prefilter(env: Environment, size: int = CUBE_SIZE, term: str = GGX_TERM, lib=None) -> list[np.ndarray]:
-    """The prefiltered radiance cube, level 0 (S × S, the mirror) to 1 × 1, each (6, s, s, 3) float64."""
+def prefilter(env: Environment, size: int = CUBE_SIZE, term: str = GGX_TERM, lib=None,
+              budget: int = 1 << 20) -> list[np.ndarray]:
+    """The prefiltered radiance cube, level 0 (S × S, the mirror) to 1 × 1, each (6, s, s, 3) float64; each
+    level ≥ 1 draws about `budget` samples in all (level_samples: at least 256 per texel)."""
     from ..io.ktx2 import full_level_count
     levels = full_level_count(size, size)
     out = [env.radiance(cube_dirs(size, 4)).reshape(6, size, 4, size, 4, 3).mean(axis=(2, 4))]
     for k in range(1, levels):
         s = max(1, size >> k)
         r = cube_dirs(s).reshape(-1, 3)
-        n = level_samples(len(r))
+        n = level_samples(len(r), budget)
         out.append(prefilter_dirs(env, r, level_alpha(k, levels), n, term, lib).reshape(6, s, s, 3))
     return out
 

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import hashlib
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -76,51 +76,8 @@ def axes(size=SIZE) -> tuple[np.ndarray, np.ndarray]:
 
 # ------------------------------------------------------------------ which terms get what
 
-@dataclass(frozen=True)
-class Term:
-    """One term of a BRDF spec as IBL sees it: its spec, brick, and how its ambient term is computed."""
-
-    spec: str
-    kind: str  # "diffuse" | "specular"
-    brick: str
-    how: str  # "ambient_brdf" | "gotanda_eq4" | "lambert" | "refused"
-    why: str = ""
-    fillers: dict = field(default_factory=dict)
-
-
-DIFFUSE_HOW = {"lambert": ("lambert", "exact: ρ/π × irradiance (B = 1)"),
-               "gotanda_fitted": ("gotanda_eq4", "B channel: eq. 4 integrated numerically (not the eq. 8 fit)")}
-
-
-def classify(spec: str, lib=None) -> list[Term]:
-    """How IBL treats each term of `spec` (no baking): the microfacet terms with an isotropic NDF get the
-    AmbientBRDF (scale, bias) — whether their Fresnel is affine in f0 is checked when baked — Lambert and
-    Gotanda's diffuse get the B channel; every other term is refused with the reason."""
-    from ..spec.resolve import resolve_brdf
-    lib = library_or_builtin(lib)
-    out = []
-    for node in resolve_brdf(spec, lib).nodes:
-        b = node.brick
-        fillers = {slot: f.brick.id for slot, f in node.fillers}
-        own = {slot: set(f.brick.params or {}) for slot, f in node.fillers}
-        ndf_params, fresnel_params = own.get("ndf", set()), own.get("fresnel", set()) - {"f0"}
-        if b.kind == "diffuse":
-            how, why = DIFFUSE_HOW.get(b.id, ("refused", f"diffuse brick '{b.id}' has no ambient table: use "
-                                             "lambert or gotanda_fitted for image-based lighting"))
-        elif b.id == "microfacet":
-            aniso = bool(ndf_params & {"alpha_u", "alpha_v"})
-            how, why = (("refused", f"NDF '{fillers['ndf']}' is anisotropic: a table over (n·v, α) holds isotropic "
-                         "lobes only — use its isotropic form") if aniso else ("ambient_brdf", ""))
-            if fresnel_params and not aniso:
-                # a table baked at the brick's default eta, k would be silently wrong for every other metal
-                how, why = "refused", (f"Fresnel '{fillers['fresnel']}' reads {', '.join(sorted(fresnel_params))}, "
-                                       "which a table over (n·v, α) with f0 as scale and bias cannot hold — use "
-                                       "fresnel=schlick (f0 from the metal's reflectance) for image-based lighting")
-        else:
-            how, why = "refused", (f"specular brick '{b.id}' is not a microfacet term: the split sum's prefiltered "
-                                   "cube assumes a microfacet lobe — use microfacet(...)")
-        out.append(Term(node.key, b.kind, b.id, how, why, fillers))
-    return out
+# classify(), Term and DIFFUSE_HOW are the spec stage's verdict (spec/ambient.py), which the glue reads too
+from ..spec.ambient import DIFFUSE_HOW, Term, classify  # noqa: E402,F401
 
 
 def refuse(term: Term, where: str = "") -> None:

@@ -313,8 +313,33 @@ def load_brick(path: Path, text: str | None = None, shown: str | None = None) ->
                   str(meta.get("fp16", "")).strip(), float(meta.get("tolerance", 0.0)),
                   meta.get("encodes", "linear"), reciprocal=str(meta.get("reciprocal", "")).strip())
     _check_entries(brick, loc)
+    if kind == "environment":
+        _check_environment(brick, loc, positions)
     brick.sampling = split_sampling(brick)
     return brick
+
+
+def _check_environment(b: Brick, loc, positions) -> None:
+    """An environment brick declares the contract's textures (kinds.ENVIRONMENT_TEXTURES) and reads each with
+    its dimension: the glue binds them by name, the radiance cube per light set, the AmbientBRDF table per BRDF."""
+    from ..lang.types import texture_type
+    from .kinds import ENVIRONMENT_TEXTURES
+    names = set(b.textures)
+    if names != set(ENVIRONMENT_TEXTURES):
+        extra = sorted(names - set(ENVIRONMENT_TEXTURES))
+        line, col = positions.get(("textures", extra[0]), positions.get(("textures",), (loc.line, loc.col))) \
+            if extra else positions.get(("textures",), (loc.line, loc.col))
+        want = ", ".join(f"'{n}' ({d})" for n, d in ENVIRONMENT_TEXTURES.items())
+        raise SourceError(b.display_path, line, col, f"an environment brick declares the textures {want}, and this "
+                          f"one declares {', '.join(repr(n) for n in sorted(names)) or 'none'}",
+                          "declare exactly those (the glue binds them by name): \"textures\": {\"radiance\": {...}, "
+                          "\"ambient_brdf\": {...}}")
+    for f in b.entries:
+        for p in f.params:
+            if p.name in ENVIRONMENT_TEXTURES and p.ty != texture_type(ENVIRONMENT_TEXTURES[p.name]):
+                raise SourceError(b.display_path, p.loc.line, p.loc.col, f"texture '{p.name}' is {p.ty} here, and the "
+                                  f"environment contract reads it as a texture{ENVIRONMENT_TEXTURES[p.name]}",
+                                  f"annotate it texture{ENVIRONMENT_TEXTURES[p.name]}")
 
 
 # Functions the link stage and the templates generate (link/glue.py brdf_lit<suffix>, brdf<suffix>, brdf_switch,

@@ -111,5 +111,18 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
          doc="the texture coordinates the material's textures are sampled at (an optional slot of a packing)"),
     Kind("output", (Entry("output", VEC4, (Arg("color", VEC3, required=True),)),), "surface",
          doc="the output transform of the outgoing radiance"),
+    # `ambient`: the outgoing radiance an environment adds after the lights (image-based lighting). The glue
+    # passes the shading normal N, the unit view vector V and, from the BRDF's parameters by name, kd (what the
+    # diffuse ambient term multiplies: rho_d (1 - f0) for Gotanda's diffuse, rho_d for Lambert, 0 with no diffuse
+    # term: eval/ibl_tables.py DIFFUSE_HOW), f0 and alpha of the microfacet term (link/glue.py ambient). Its
+    # textures are the contract's too (ENVIRONMENT_TEXTURES): the scene's environment binds the radiance cube in
+    # the light set's group, the renderer the BRDF's AmbientBRDF table in the material's.
+    Kind("environment", (Entry("ambient", VEC3, (Arg("N", VEC3, required=True), Arg("V", VEC3, required=True),
+                                                 Arg("kd", VEC3), Arg("f0", VEC3), Arg("alpha", FLOAT))),),
+         "surface", doc="image-based lighting: the outgoing radiance of an environment, added after the lights"),
 )}
+# The textures an environment brick declares, by name and dimension: the prefiltered radiance cube (the light
+# set's environment: set 0) and the AmbientBRDF table of the material's BRDF (set 1); textures are bound by name.
+ENVIRONMENT_TEXTURES = {"radiance": "cube", "ambient_brdf": "2d"}
+ENVIRONMENT_GROUP = {"radiance": "light", "ambient_brdf": "material"}
 BRDF_KINDS = ("diffuse", "specular")

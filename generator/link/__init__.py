@@ -9,7 +9,7 @@ links into one program, deterministically.
 from __future__ import annotations
 
 import hashlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..lang.types import Type
 from ..library.bricks import Library
@@ -136,6 +136,7 @@ class LinkedPermutation:
     interface: Interface
     material: list[Slot]
     lights: list[list[Slot]]
+    environment: list[Slot] = field(default_factory=list)  # the environment's values, after the lights' (Lights)
 
 
 SHADE_KERNEL = {"Info": 2, "Lights": 3, "Material": 4, "buffers": 5}  # set 0 bindings of a shade kernel
@@ -165,6 +166,11 @@ def _pack_values(g: ShadeGlue, surface: int) -> tuple[list[Slot], int, list[Slot
     for i, vals in enumerate(g.lights):
         slots, light_count = layout([(n, p, e, t, s, i) for n, p, e, t, s in vals], light_count)
         light_slots += slots
+    if g.environment:  # the light set's environment: the Lights block's last group, from a new vec4
+        env, light_count = layout([(n, p, e, t, s, None) for n, p, e, t, s in g.environment], light_count)
+        for x in env:
+            x.environment = True
+        light_slots += env
     return mat + more, mat_count, light_slots, light_count
 
 
@@ -217,10 +223,12 @@ def _link(r: Resolved, lib: Library, kernel: bool) -> LinkedPermutation:
         blocks.append(Block(TILES_BLOCK, 0, binding, "storage", [{"name": "w", "type": "uvec4[]", "offset": 0,
                                                                    "size": 0, "array_stride": 16}]))
     params = {"material": {p: s for _, p, _, _, s in g.material}}
+    if g.environment:
+        params["environment"] = {p: s for _, p, _, _, s in g.environment}
     for i, lt in enumerate(r.lights):
         params[f"light{i}"] = (buffer_params if lt.dynamic else face_params)(lt)  # six faces, a first layer (link/faces.py)
     stages = {"comp": "main"} if kernel else {"vert": "main", "frag": "main"}
     iface = Interface(stages, g.brdf.reads, g.surface, blocks, g.textures,
                       [Location(0, "out_color", "vec4")], params=params)
     lights = [[s for s in light_slots if s.light == i] for i in range(len(r.lights))]
-    return LinkedPermutation(r.perm, r, prog, g, iface, mat_slots, lights)
+    return LinkedPermutation(r.perm, r, prog, g, iface, mat_slots, lights, [s for s in light_slots if s.environment])

@@ -136,6 +136,7 @@ class ShadeGlue:
     light_buffers: list[ir.Global] = field(default_factory=list)  # per dynamic light: its storage buffer
     light_buffer_slots: list[list[Slot]] = field(default_factory=list)  # and where its element holds each value
     light_tiles: ir.Global | None = None  # a tiled dynamic set's LightTiles buffer (link/tiles.py)
+    environment: list[tuple] = field(default_factory=list)  # the environment's values (e_*), as `material`
 
 
 class _Binder:
@@ -195,6 +196,8 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
         prog.link(lt.shadow)
     out_node = r.output_node
     prog.link(out_node)
+    if r.environment is not None:
+        prog.link(r.environment)
     bind = _Binder(b)
     dynamic_lights: list[ir.Global] = []
     buffer_slots: list[list[Slot]] = []
@@ -304,6 +307,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
             else:
                 stmts.extend([loop(i, body_i)] if dyn else body_i)
 
+        stmts.extend(ambient(prog, b, bind, r, provided))
         stmts.extend(emission(b, bind, r.surface))
         shaded = bind.call(prog, out_node, "output", "o_", "material", None, {}, args={"color": b.var("Lo", VEC3)})
         stmts.extend(surface_output(b, bind, r, shaded))
@@ -325,7 +329,9 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     light_values = []
     for i, lt in enumerate(r.lights):
         light_values.append([] if lt.dynamic else [(f"l{i}_{n}", k, e, ty, p) for n, k, e, ty, p in face_params(lt).flat])
-    values = [(n, t) for n, _, _, t, _ in material] + [(n, t) for vals in light_values for n, _, _, t, _ in vals]
+    env_values = [(f"e_{n}", k, e, ty, p) for n, k, e, ty, p in r.environment_params.flat]
+    values = [(n, t) for n, _, _, t, _ in material] + [(n, t) for vals in light_values for n, _, _, t, _ in vals] \
+        + [(n, t) for n, _, _, t, _ in env_values]
     missing = [n for n in bind.params if n not in dict(values)]
     assert not missing, f"shade() binds {missing}, which no brick declares"
     sig += values + [(t.name, t.ty) for t in bind.textures]
@@ -335,7 +341,7 @@ def shade_glue(prog: Program, r: Resolved) -> ShadeGlue:
     prog.add(b.function("shade", sig, VEC4, shade_body))
     prog.globals.extend(dynamic_lights + tiled)
     return ShadeGlue(sig, surface, material, light_values, bind.textures, bg, dynamic_lights, buffer_slots,
-                     tiled[0] if tiled else None)
+                     tiled[0] if tiled else None, env_values)
 
 
 IVEC4 = vector("int", 4)
@@ -355,6 +361,45 @@ def uv_transform(prog: Program, b: Builder, bind: _Binder, packing: Node,
     call = bind.call(prog, node, "map_uv", "m_", "material", None, {}, args)
     bind.uv = b.var(UV_LOCAL, SURFACE["uv"])
     return [b.decl(UV_LOCAL, call)]
+
+
+def ambient(prog: Program, b: Builder, bind: _Binder, r: Resolved, provided: dict) -> list[ir.Stmt]:
+    """`Lo += <environment>_ambient(N, V, kd, f0, alpha, …)` after the lights when the permutation has an
+    environment (image-based lighting: library/kinds.py's contract), [] otherwise. f0 and alpha are the BRDF's
+    parameters by name (the packing's where it provides them); kd is what the diffuse ambient term multiplies
+    (spec/ambient.py DIFFUSE_HOW): rho_d (1 − f0) for Gotanda's diffuse (his footnote 4), rho_d for Lambert (the
+    vertex-coloured one with COLOR_0), 0 with no diffuse term. The environment's textures bind by the contract's
+    names: the radiance cube with the light set's values (set 0), the AmbientBRDF table with the material's (set 1).
+    What the BRDF cannot give (a refused term, no alpha or f0) is a verdict of spec/resolve.py, raised before."""
+    node = r.environment
+    if node is None:
+        return []
+    from ..library.kinds import ENVIRONMENT_GROUP
+    from ..spec.ambient import classify_nodes
+
+    def value(name: str) -> ir.Expr:
+        if name in provided:
+            return b.copy(provided[name])
+        ty = r.brdf_params[name].ty
+        bind.params[f"m_{name}"] = ty
+        return b.var(f"m_{name}", ty, "param")
+
+    diffuse = [t.how for t in classify_nodes(r.brdf) if t.kind == "diffuse"]
+    f0 = value("f0")
+    if f0.ty != VEC3:
+        f0 = b.construct(VEC3, f0)
+    if not diffuse:
+        kd = b.construct(VEC3, b.const(0.0))
+    elif diffuse[0] == "gotanda_eq4":
+        kd = b.arith("*", value("rho_d"), b.arith("-", b.construct(VEC3, b.const(1.0)), b.copy(f0)))
+    else:
+        kd = value("rho_d")
+    args = {"N": b.var("N", VEC3), "V": b.var("V", VEC3, "param"), "kd": kd, "f0": f0, "alpha": value("alpha")}
+    before = len(bind.textures)
+    call = bind.call(prog, node, "ambient", "e_", "environment", None, {}, args)
+    for t in bind.textures[before:]:  # the contract's textures: the light set's cube, the material's table
+        t.group, t.environment = ENVIRONMENT_GROUP[t.param], True
+    return [b.assign(b.var("Lo", VEC3), call, "+")]
 
 
 def surface_inputs(b: Builder, bind: _Binder, r: Resolved, bg: BrdfGlue, provided: dict) -> list[ir.Stmt]:

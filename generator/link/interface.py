@@ -36,6 +36,7 @@ class Slot:
     base: int = 0  # byte offset of the vec4 array in its block
     element: int | None = None  # the element of an array parameter
     component: int = 0  # its first component in vec4 `index` (0 = .x … 3 = .w); 0 for a vec4 or mat4
+    environment: bool = False  # a value of the light set's environment (the Lights block's last group)
 
     @property
     def width(self) -> int:
@@ -63,6 +64,8 @@ class Slot:
         d = {"name": name, "type": str(self.ty), "offset": self.offset, "size": self.ty.components * 4}
         if self.light is not None:
             d["light"] = self.light
+        if self.environment:
+            d["environment"] = True
         if self.spec is not None:
             d["default"] = self.spec.default if self.element is None else self.spec.default[self.element]
             d["range"] = list(self.spec.range) if self.spec.range else None
@@ -194,6 +197,9 @@ class Texture:
     set: int = 0
     binding: int = 0
     compare: bool = False  # a depth texture read through a comparison sampler (texture2d_shadow)
+    # an environment brick's (library/kinds.ENVIRONMENT_TEXTURES): the light set's radiance cube (group "light",
+    # no light) or the material's BRDF's AmbientBRDF table (group "material")
+    environment: bool = False
 
     @property
     def ty(self) -> Type:
@@ -207,6 +213,8 @@ class Texture:
             d.update(format="depth", sampler="comparison", compare_op="less_or_equal")
         if self.light is not None:
             d["light"] = self.light
+        if self.environment:
+            d["environment"] = True
         return d
 
 

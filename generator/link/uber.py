@@ -175,6 +175,11 @@ def link_ubershader(perms: list[Permutation | Resolved], lib, kernel: bool = Fal
     modes, double_sided, emits = {"opaque"}, False, {"none"}
     for r in [p if isinstance(p, Resolved) else resolve(p, lib) for p in perms]:
         p = r.perm
+        if p.environment:  # located at the environment that lights it (the scene's [environments.NAME])
+            with within(p.origin, p.canonical()):
+                raise KeyProblem("environment", "the ubershader does not draw environments yet (image-based "
+                                 f"lighting: {p.canonical()})", "set [scene] ubershader = false and render with "
+                                 "--mode specialized, or light this set without an environment")
         if (p.brdf, p.packing, p.output) not in [v.key for v in variants]:
             probe = resolve(Permutation(p.brdf, (), p.packing, p.output, p.precision, origin=p.origin), lib)
             variants.append(Variant(p.brdf, p.packing, p.output, link_permutation(probe, lib).material))

@@ -41,9 +41,25 @@ def first_layer(scene: Scene, name: str) -> float:
     return 0.0
 
 
-def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None) -> list[dict]:
+def environment_values(scene: Scene, light_set: str, specs: dict, baked: dict | None = None) -> dict:
+    """The values of the environment lighting `light_set` (scene/environments.py), by the brick's names: its
+    intensity and the radiance cube's levels from the scene, the SH9 coefficients sh0 … sh8 from `baked`
+    ({environment name: {name: value}}, what assemble/environments.py computes from its image), the brick's
+    defaults (0) for what is not given."""
+    name = scene.environment_of.get(light_set)
+    if name is None:
+        return {}
+    env = scene.environments[name]
+    out = {k: s.default for k, s in specs.items()}
+    out.update({k: v for k, v in (("intensity", env.intensity), ("radiance_levels", float(env.levels))) if k in specs})
+    out.update({k: v for k, v in ((baked or {}).get(name) or {}).items() if k in specs})
+    return out
+
+
+def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None, environments: dict | None = None) -> list[dict]:
     """Per (material, light set) drawn with permutation `h`: the Material and Lights blocks, ready to upload.
-    objects: the scene's objects drawn with `h`, when the caller has them grouped (else every object is looked at)."""
+    objects: the scene's objects drawn with `h`, when the caller has them grouped (else every object is looked at).
+    environments: the baked values of the scene's environments (environment_values), {name: {param: value}}."""
     mine = [o for o in scene.objects if o["permutation"] == h] if objects is None else objects
     out, seen = [], set()
     for obj in mine:
@@ -65,7 +81,12 @@ def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None) -> list[
             for i, (ln, slots) in enumerate(zip(obj["lights"], c.lights)):
                 v = light_values(scene, ln, c.interface.params.get(f"light{i}", {}))
                 lvals.update({s.name: _element(v[s.param], s) for s in slots})
-            item["Lights"] = pack([s for ls in c.lights for s in ls], lvals, lb.members[-1]["size"] // 16).hex()
+            env = getattr(c, "environment", None) or []
+            if env:  # the light set's environment: the block's last group (link._pack_values)
+                ev = environment_values(scene, obj["light_set"], c.interface.params.get("environment", {}), environments)
+                lvals.update({s.name: _element(ev[s.param], s) for s in env})
+            item["Lights"] = pack([s for ls in c.lights for s in ls] + list(env), lvals,
+                                  lb.members[-1]["size"] // 16).hex()
         out.append(item)
     for item in out:
         item["objects"] = [o["name"] for o in mine

@@ -171,7 +171,7 @@ def _override_lights(raw: bytes, slots, lights: list[str], matrices: dict, texel
 
 def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), language: str = "glsl",
                  device=None, progress: bool = False, uber_ids: str = "buffer", shadow_size: int = SHADOW_SIZE,
-                 placement_file=None, build=None, export=None) -> Report:
+                 placement_file=None, build=None, export=None, environments=None) -> Report:
     """Render `frames` frames of `scene` into out/frame_NNNN.png; returns the report (also out/report.json).
 
     uber_ids: "buffer" (the variant read from the material entry: one ubershader pipeline) or
@@ -184,6 +184,8 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     a permutation its manifest lists is read from there too.
     export: a folder to write the frame export into (runtime/frame_export.py: meshes, object matrices, camera,
     the shadowed lights' matrices, as this render used them).
+    environments: the scene's baked environments (runtime/environment.EnvironmentInputs, what
+    assemble.environments.bake makes): needed where a light set has an environment (image-based lighting).
     """
     from ..link.values import entry_bytes, light_entry, uploads
     from ..compose import compose_permutation
@@ -228,13 +230,17 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
     linked = {h: link_permutation(r, lib) for h, r in resolved.items()}
     composed = {h: compose_permutation(lp, lib, (language,)) for h, lp in linked.items()}
     spec_ids = uber_ids == "specialization"
-    uber, u = compose_ubershader(list(perms.values()), lib, (language,), specialized=spec_ids)
+    # the ubershader does not draw environments yet (link/uber.py refuses them, located): a specialized render of a
+    # scene with one composes none
+    uber, u = None, None
+    if mode != "specialized" or not any(p.environment for p in perms.values()):
+        uber, u = compose_ubershader(list(perms.values()), lib, (language,), specialized=spec_ids)
     # The depth passes' units (compose/depth.py): what the build writes for an engine, compiled here with the rest.
     shadowed_textures = shadowed_lights(scene, resolved.values())
     plan = depth_plan(shadowed_textures, linked)
     depth_units = compose_depth_units(plan, lib, (language,))
     jobs = {}
-    for tag, c in [*composed.items(), ("ubershader", uber), *depth_units.items()]:
+    for tag, c in [*composed.items(), *([("ubershader", uber)] if uber is not None else []), *depth_units.items()]:
         for s in c.sources:
             jobs[(tag, s.stage)] = CompileJob(f"{tag}.{s.stage}.{language}", language, s.stage, s.text,
                                               line_map=tuple(map(tuple, s.line_map)))
@@ -304,6 +310,11 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
         mtex = MaterialTextures(device, build, {m: getattr(scene.materials[m], "images", None) or {}
                                                 for m in sorted({o["material"] for o in scene.objects})})
         owned.append(mtex)
+        # the environments' radiance cubes and the lit BRDFs' AmbientBRDF tables (runtime/environment.py)
+        from .environment import EnvironmentTextures
+        etex = EnvironmentTextures(device, environments, scene)
+        owned.append(etex)
+        env_values = environments.values() if environments is not None else None
 
         def material_texture(t, material):
             """(image, sampler) of material texture t: the build's artifact and its sampler where the material
@@ -358,7 +369,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             for i, obj in enumerate(scene.objects):
                 h, res = obj["permutation"], {}
                 if h in plan.masked:  # its material's Material block and coverage texture, as its colour pass binds them
-                    up = next(x for x in uploads(scene, h, composed[h]) if x["material"] == obj["material"])
+                    up = next(x for x in uploads(scene, h, composed[h], environments=env_values) if x["material"] == obj["material"])
                     mi = mask_interface(depth_units, h)
                     bound = {t.param: material_texture(t, obj["material"]) for t in mi.textures}
                     res = mask_resources(mi, buf(bytes.fromhex(up["Material"]), U),
@@ -386,57 +397,58 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                                           "shadow_matrix": matrices[ln], "layers": len(drawn.faces) or 1}
 
         eye, vp = placed.camera(W, H)
-        variant = {v.key: k for k, v in enumerate(u.variants)}
+        variant = {v.key: k for k, v in enumerate(u.variants)} if u is not None else {}
         draws = []
         materials = sorted({o["material"] for o in scene.objects})
-        mat_rows, mat_ids = [], []
-        for name in materials:  # MaterialEntry m: the variant and the material's specialized Material block
-            obj = next(o for o in scene.objects if o["material"] == name)
-            p = perms[obj["permutation"]]
-            up = next(x for x in uploads(scene, obj["permutation"], composed[obj["permutation"]])
-                      if x["material"] == name)
-            data = np.zeros((u.material_vec4s, 4), np.float32)
-            block = np.frombuffer(bytes.fromhex(up.get("Material", "")), np.float32).reshape(-1, 4)
-            k = variant[(p.brdf, p.packing, p.output)]
-            n = max([0] + [s.index + s.width for s in u.variants[k].slots])  # the bricks' part: the surface's
-            data[:n] = block[:n]  # values come after it, and the ubershader reads them from data[surface_at]
-            if u.surface_at is not None:
-                at = {s.param: s for s in composed[obj["permutation"]].material if s.light is None}
-                data[u.surface_at, :2] = [block[at[x].index, at[x].component] if x in at else 0.0
-                                          for x in ("base_alpha", "alpha_cutoff")]
-                if "emissive" in at:  # and the emission after them (a vec3: three components of its vec4)
-                    e = at["emissive"]
-                    data[u.surface_at + 1, :3] = block[e.index, e.component:e.component + 3]
-            mat_ids.append((k, ALPHA_IDS[p.surface.alpha], EMISSIVE_IDS[p.surface.emissive], 0))
-            mat_rows.append(data)
-        material_buffer = buf(entry_bytes(np.array(mat_ids), np.stack(mat_rows)), S)
         light_buffers, slot_lights = {}, {}
-        for set_name, names in scene.light_sets.items():
-            ids, rows, shadow_slot = [], [], 0
-            slot_lights[set_name] = []  # ubershader shadow-map slot j -> the light whose map it is
-            dyn, pair_slot, layer_of = scene.dynamic_sets.get(set_name), {}, {}
-            for ln in names:
-                L = scene.lights[ln]
-                data = light_entry(u, L.type, L.shadow, light_vals[ln])
-                textured = bool(sampled[L.shadow])
-                slot, first = shadow_slot, 0
-                if textured and dyn is not None:  # a buffer pair's lights share its array: one slot, their layers
-                    pair = dyn.pair_of(L)
-                    if pair not in pair_slot:
-                        pair_slot[pair] = shadow_slot
-                        slot_lights[set_name].append(("pair", pair))
+        if uber is not None:  # the ubershader's MaterialEntry and LightEntry buffers
+            mat_rows, mat_ids = [], []
+            for name in materials:  # MaterialEntry m: the variant and the material's specialized Material block
+                obj = next(o for o in scene.objects if o["material"] == name)
+                p = perms[obj["permutation"]]
+                up = next(x for x in uploads(scene, obj["permutation"], composed[obj["permutation"]], environments=env_values)
+                          if x["material"] == name)
+                data = np.zeros((u.material_vec4s, 4), np.float32)
+                block = np.frombuffer(bytes.fromhex(up.get("Material", "")), np.float32).reshape(-1, 4)
+                k = variant[(p.brdf, p.packing, p.output)]
+                n = max([0] + [s.index + s.width for s in u.variants[k].slots])  # the bricks' part: the surface's
+                data[:n] = block[:n]  # values come after it, and the ubershader reads them from data[surface_at]
+                if u.surface_at is not None:
+                    at = {s.param: s for s in composed[obj["permutation"]].material if s.light is None}
+                    data[u.surface_at, :2] = [block[at[x].index, at[x].component] if x in at else 0.0
+                                              for x in ("base_alpha", "alpha_cutoff")]
+                    if "emissive" in at:  # and the emission after them (a vec3: three components of its vec4)
+                        e = at["emissive"]
+                        data[u.surface_at + 1, :3] = block[e.index, e.component:e.component + 3]
+                mat_ids.append((k, ALPHA_IDS[p.surface.alpha], EMISSIVE_IDS[p.surface.emissive], 0))
+                mat_rows.append(data)
+            material_buffer = buf(entry_bytes(np.array(mat_ids), np.stack(mat_rows)), S)
+            for set_name, names in scene.light_sets.items():
+                ids, rows, shadow_slot = [], [], 0
+                slot_lights[set_name] = []  # ubershader shadow-map slot j -> the light whose map it is
+                dyn, pair_slot, layer_of = scene.dynamic_sets.get(set_name), {}, {}
+                for ln in names:
+                    L = scene.lights[ln]
+                    data = light_entry(u, L.type, L.shadow, light_vals[ln])
+                    textured = bool(sampled[L.shadow])
+                    slot, first = shadow_slot, 0
+                    if textured and dyn is not None:  # a buffer pair's lights share its array: one slot, their layers
+                        pair = dyn.pair_of(L)
+                        if pair not in pair_slot:
+                            pair_slot[pair] = shadow_slot
+                            slot_lights[set_name].append(("pair", pair))
+                            shadow_slot += 1
+                        slot, first = pair_slot[pair], layer_of.get(pair, 0)
+                        layer_of[pair] = first + shadow_layers(L.type)
+                    elif textured:
+                        slot_lights[set_name].append(ln)
                         shadow_slot += 1
-                    slot, first = pair_slot[pair], layer_of.get(pair, 0)
-                    layer_of[pair] = first + shadow_layers(L.type)
-                elif textured:
-                    slot_lights[set_name].append(ln)
-                    shadow_slot += 1
-                # ids.w: faces (1: a point light's six) + 2 × its first layer (link/uber.py)
-                ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), slot if textured else 0,
-                            int(faced(L.type, sampled[L.shadow])) + 2 * first))
-                rows.append(data)
-            if rows:
-                light_buffers[set_name] = buf(entry_bytes(np.array(ids), np.stack(rows)), S)
+                    # ids.w: faces (1: a point light's six) + 2 × its first layer (link/uber.py)
+                    ids.append((u.light_types.index(L.type), u.shadows.index(L.shadow), slot if textured else 0,
+                                int(faced(L.type, sampled[L.shadow])) + 2 * first))
+                    rows.append(data)
+                if rows:
+                    light_buffers[set_name] = buf(entry_bytes(np.array(ids), np.stack(rows)), S)
 
         def empty_lights():  # a light set with no lights: one all-zero entry (a light of colour 0; a storage
             # buffer range cannot be empty)
@@ -521,7 +533,7 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
             c = composed[h]
             frame = frame_buf
             obj_buf = object_bufs[i]
-            up = next(x for x in uploads(scene, h, c) if x["material"] == obj["material"]
+            up = next(x for x in uploads(scene, h, c, environments=env_values) if x["material"] == obj["material"]
                       and x["light_set"] == obj["light_set"])
             spec = {(0, 0): frame, (2, 0): obj_buf}
             lb = c.interface.block("Lights")
@@ -546,7 +558,11 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     tile_bufs[obj["light_set"]] = buf(light_tiles.tile_words(lists, (W, H)).tobytes(), S)
                 spec[(tb.set, tb.binding)] = tile_bufs[obj["light_set"]]
             for t in c.interface.textures:
-                if t.group == "light" and dyn is not None:  # a buffer light's pair: one array of its lights' maps
+                if t.environment and t.group == "light":  # the light set's environment's radiance cube
+                    res, smp = etex.radiance(obj["light_set"])
+                elif t.environment:  # the material's BRDF's AmbientBRDF table
+                    res, smp = etex.table(scene.materials[obj["material"]].brdf, sampler)
+                elif t.group == "light" and dyn is not None:  # a buffer light's pair: one array of its lights' maps
                     res, smp = pair_array(obj["light_set"], t.light, t), sampler_of(t)
                 elif t.group == "light":
                     res, smp = light_texture(t, obj["lights"][t.light]), sampler_of(t)
@@ -554,26 +570,28 @@ def render_scene(scene, lib, mode: str, frames: int, out, size=(256, 160), langu
                     mtex.check_binding(obj["material"], t)
                     res, smp = material_texture(t, obj["material"])
                 spec[(t.set, t.binding)], spec[(t.set, t.binding + 1)] = res, smp
-            ub = {(0, 0): frame, (2, 0): obj_buf,
-                  (1, 0): buf(np.array([materials.index(obj["material"]), 0, 0, 0], np.int32), U),
-                  (1, 1): material_buffer}
-            lbuf = uber.interface.block("LightBuffer")
-            if lbuf is not None:  # a scene without lights has an ubershader without a light buffer
-                ub[(lbuf.set, lbuf.binding)] = light_buffers.get(obj["light_set"]) or empty_lights()
-            for t in uber.interface.textures:  # the draw's material's textures and samplers, as the specialized path's
-                if t.group == "light":
-                    slots = slot_lights[obj["light_set"]]
-                    if t.light >= len(slots):
-                        res = stand_in(t)
-                    elif isinstance(slots[t.light], tuple):  # a dynamic set's pair: its one array
-                        res = pair_array(obj["light_set"], slots[t.light][1], t)
+            ub = None
+            if uber is not None:
+                ub = {(0, 0): frame, (2, 0): obj_buf,
+                      (1, 0): buf(np.array([materials.index(obj["material"]), 0, 0, 0], np.int32), U),
+                      (1, 1): material_buffer}
+                lbuf = uber.interface.block("LightBuffer")
+                if lbuf is not None:  # a scene without lights has an ubershader without a light buffer
+                    ub[(lbuf.set, lbuf.binding)] = light_buffers.get(obj["light_set"]) or empty_lights()
+                for t in uber.interface.textures:  # the draw's material's textures and samplers, as the specialized path's
+                    if t.group == "light":
+                        slots = slot_lights[obj["light_set"]]
+                        if t.light >= len(slots):
+                            res = stand_in(t)
+                        elif isinstance(slots[t.light], tuple):  # a dynamic set's pair: its one array
+                            res = pair_array(obj["light_set"], slots[t.light][1], t)
+                        else:
+                            res = as_layers(t, light_texture(t, slots[t.light]))
+                        smp = sampler_of(t)
                     else:
-                        res = as_layers(t, light_texture(t, slots[t.light]))
-                    smp = sampler_of(t)
-                else:
-                    mtex.check_binding(obj["material"], t, ubershader=True)
-                    res, smp = material_texture(t, obj["material"])
-                ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, smp
+                        mtex.check_binding(obj["material"], t, ubershader=True)
+                        res, smp = material_texture(t, obj["material"])
+                    ub[(t.set, t.binding)], ub[(t.set, t.binding + 1)] = res, smp
             draws.append((h, spec, ub, mesh_of[i]))
         report.textures, report.texture_notes = mtex.report(), list(mtex.notes)
 

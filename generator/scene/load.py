@@ -11,6 +11,8 @@ Schema (docs/guide/scenes.md, every key):
     [light_sets]       NAME = [light names, in order]  (static: the key lists them)
     [light_sets.NAME]  dynamic = true, lights = [names], max = N (default 256), model = ["type/shadow", …]
                        (dynamic: the key carries the model; scene/light_sets.py)
+    [environments.NAME] image = "file.hdr" | sky = "default", rotation, intensity, size, light_sets = [...], brick
+                       ([scene] environment = NAME: every other light set's; scene/environments.py)
     [[objects]]        name, material = NAME, lights = light set NAME
 Only (material × light set) pairs that some object uses become permutations.
 """
@@ -30,6 +32,7 @@ from ..spec.permutation import PRECISIONS, LightKey, Permutation, SpecError, can
 from ..spec.resolve import Resolved, check_packing, light_params, resolve
 from ..spec.surface import DEFAULT as DEFAULT_SURFACE, Surface
 from ..spec.where import Origin, Where
+from .environments import read_environments
 from .light_sets import MAX_LIGHTS_PER_SET, DynamicSet, read_light_sets  # noqa: F401 (the cap, read here too)
 from .locate import Locator
 from .textures import declared, toml_bindings
@@ -76,6 +79,10 @@ class Scene:
     # light set name -> DynamicSet (scene/light_sets.py): the sets whose lights a loop reads from buffers
     dynamic_sets: dict[str, DynamicSet] = field(default_factory=dict)
     ubershader: bool = True  # [scene] ubershader = false: build ships no fallback ubershader (assemble/entries.py ubershader_warning)
+    # [environments.NAME] (scene/environments.py), and per light set the one that lights it and where it is declared
+    environments: dict = field(default_factory=dict)
+    environment_of: dict[str, str] = field(default_factory=dict)
+    environment_at: dict[str, tuple[int, int]] = field(default_factory=dict)
 
 
 def read_toml(path: Path, what: str, syntax_hint: str, limit: int = MAX_INPUT_BYTES) -> tuple[dict, "Locator"]:
@@ -189,6 +196,7 @@ def _load_toml(path: Path, lib: Library) -> Scene:
         scene.lights[name] = Light(name, ltype, shadow, params)
 
     read_light_sets(loc, data, scene, lib)  # static lists and dynamic tables (scene/light_sets.py)
+    read_environments(loc, data, scene, lib)  # image-based lighting per light set (scene/environments.py)
 
     objects = data.get("objects", [])
     if not isinstance(objects, list):
@@ -224,7 +232,13 @@ def _load_toml(path: Path, lib: Library) -> Scene:
             keys = dyn.model
             set_at = at("light_sets", lset, "model" if "model" in data["light_sets"][lset] else "lights")
             origin = Origin(parts[mat] + tuple((f"light{k}", set_at) for k in range(len(keys))))
-        perm = Permutation(m.brdf, keys, m.packing, output, precision, m.surface, origin)
+        env = scene.environment_of.get(lset)
+        if env is not None:  # the environment's brick is an axis of the key; its image is the set's data
+            origin = Origin(origin.parts + (("environment", Where(shown, *scene.environment_at[lset])),))
+        perm = Permutation(m.brdf, keys, m.packing, output, precision, m.surface, origin,
+                           scene.environments[env].brick if env is not None else "")
+        if env is not None and perm not in hashes:
+            _check_environment(loc, perm, lib, mat, env, lset)
         h = hashes.get(perm)
         if h is None:  # the first object of a permutation: where messages about it will point
             h = hashes[perm] = perm.hash
@@ -233,6 +247,15 @@ def _load_toml(path: Path, lib: Library) -> Scene:
         scene.users.setdefault(h, []).append(oname)
         scene.objects.append({"name": oname, "material": mat, "light_set": lset, "lights": names, "permutation": h})
     return scene
+
+
+def _check_environment(loc: Locator, perm: Permutation, lib: Library, mat: str, env: str, lset: str) -> None:
+    """A material an environment lights needs a BRDF whose terms it can light (spec/ambient.py): refused at the
+    material's brdf, naming the material, the environment and the light set."""
+    for part, what, todo in resolve(perm, lib).problems:
+        if part == "brdf":
+            raise loc.error(loc.find(f"materials.{mat}", "brdf"), f"material '{mat}', lit by environment '{env}' "
+                            f"(light set '{lset}'): {what}", todo)
 
 
 SURFACE_KEYS = ("alpha", "double_sided", "vertex_color", "emissive")  # a material's surface state (spec/surface.py)

@@ -41,7 +41,15 @@ SCENE_SCHEMA = {
     "additionalProperties": False,
     "properties": {
         "scene": {"type": "object", "additionalProperties": False,
-                  "properties": {"name": NAME, "output": SPEC, "precision": NAME, "ubershader": {"type": "boolean"}}},
+                  "properties": {"name": NAME, "output": SPEC, "precision": NAME, "ubershader": {"type": "boolean"},
+                                 # the environment of every light set no environment names (scene/environments.py)
+                                 "environment": NAME}},
+        # image-based lighting: an image or the procedural sky, and the light sets it lights
+        "environments": {"type": "object", "propertyNames": NAME, "additionalProperties": {
+            "type": "object", "additionalProperties": False,
+            "properties": {"image": {"type": "string", "minLength": 1, "maxLength": 4096}, "sky": NAME,
+                           "rotation": NUMBER, "intensity": NUMBER, "size": {"type": "integer"},
+                           "light_sets": {"type": "array", "items": NAME, "maxItems": 4096}, "brick": NAME}}},
         "materials": {"type": "object", "propertyNames": NAME, "additionalProperties": {
             "type": "object", "additionalProperties": False, "required": ["brdf"],
             "properties": {"brdf": SPEC, "packing": SPEC, "params": PARAMS,
@@ -71,7 +79,8 @@ _TYPES = {"object": "a table", "array": "an array", "string": "a string", "numbe
           "integer": "a whole number", "boolean": "true or false"}
 _EXAMPLES = {"scene": "[scene] name = \"courtyard\"", "materials": "[materials.NAME] brdf = \"lambert\"",
              "lights": "[lights.NAME] type = \"point\"", "light_sets": "[light_sets] NAME = [\"sun\"]",
-             "objects": "[[objects]] material = \"NAME\" lights = \"SET\""}
+             "objects": "[[objects]] material = \"NAME\" lights = \"SET\"",
+             "environments": "[environments.NAME] sky = \"default\""}
 
 
 def _what(value) -> str:
@@ -90,7 +99,7 @@ def _header(path: list) -> tuple[str, list, int]:
     if path[0] == "objects":
         nth = path[1] if len(path) > 1 and isinstance(path[1], int) else 0
         return "objects", [str(p) for p in path[2:]], nth
-    if path[0] in ("materials", "lights") and len(path) > 1:
+    if path[0] in ("materials", "lights", "environments") and len(path) > 1:
         return f"{path[0]}.{path[1]}", [str(p) for p in path[2:]], 0
     return str(path[0]), [str(p) for p in path[1:]], 0
 

@@ -144,6 +144,12 @@ def spec_params(brdf=(), packing=None, output=None, lights=(), memo: dict | None
     return Policy(own, Params({k: s for k, s in packed.items() if k not in own}), out, material, groups)
 
 
+def group(nodes, memo: dict | None = None) -> Params:
+    """The policy over `nodes` as one group of their own (an environment brick's: its values are the light
+    set's, laid out after the lights)."""
+    return (_merged(nodes) if memo is None else _cached(nodes, memo))[0]
+
+
 def _cached(nodes, memo: dict):
     """_merged(nodes), kept in `memo` per these very Node objects (the entry holds them, so their ids name no
     other node while it lives): the spec stage keeps one Node per spec string and brick (parse_spec's memo), made

@@ -241,6 +241,8 @@ class Permutation:
     surface: Surface = DEFAULT_SURFACE  # alpha mode, double-sided, vertex colours, emission (spec/surface.py)
     # where it was asked for (spec/where.py): not part of the key, so equal keys from two places are one permutation
     origin: Origin | None = field(default=None, compare=False, repr=False)
+    # the environment brick that adds image-based lighting after the lights ("": none; the key's text unchanged)
+    environment: str = ""
 
     def canonical(self) -> str:
         """The key as text; the surface state at its defaults writes nothing (earlier keys and hashes unchanged).
@@ -248,8 +250,9 @@ class Permutation:
         text = self.__dict__.get("_canonical")
         if text is None:
             lights = ",".join(k.canonical() for k in self.lights) or "-"
+            env = f";environment={self.environment}" if self.environment else ""  # absent: the key unchanged
             text = (f"brdf={self.brdf};lights={lights};packing={self.packing};"
-                    f"output={self.output};precision={self.precision}{self.surface.canonical()}")
+                    f"output={self.output};precision={self.precision}{self.surface.canonical()}{env}")
             object.__setattr__(self, "_canonical", text)  # frozen: the text is derived, not a field
         return text
 

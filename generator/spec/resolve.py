@@ -11,12 +11,13 @@ that asked for it, a spec string's column, or the key's own text.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from ..library.bricks import Brick, Library
 from ..library.inputs import BY_NAME, SHADING
 from .constraints import CONSTRAINTS, supplies_tangent
-from .params import Frozen, Params, spec_params
+from .ambient import ambient_problem
+from .params import Frozen, Params, group, spec_params
 from .permutation import Node, Permutation, parse_brdf, parse_spec
 from .surface import Surface
 from .where import KeyProblem, Origin, Where, within
@@ -78,6 +79,10 @@ class Resolved:
     # (spec/constraints.py) under part "packing", the surface state's under its key; () when it may exist
     problems: tuple[tuple[str, str, str], ...]
     origin: Origin | None  # where it was asked for (Permutation.origin)
+    # the environment brick (image-based lighting after the lights: Permutation.environment) and its parameters,
+    # the light set's values (e_*: the Lights block's last group); None and empty without one
+    environment: Node | None = None
+    environment_params: Params = field(default_factory=Params)
 
 
 def _walk(*tops: Node):
@@ -150,7 +155,7 @@ def resolve(perm: Permutation, lib: Library) -> Resolved:
 
 def _bricks(r: Resolved) -> list[Brick]:
     return [x.brick for x in _walk(*r.brdf, r.packing, *(lt.shadow for lt in r.lights))] \
-        + [lt.brick for lt in r.lights] + [r.output]
+        + [lt.brick for lt in r.lights] + [r.output] + ([r.environment.brick] if r.environment is not None else [])
 
 
 def _kept(lib: Library, what: str, nodes, make):
@@ -194,6 +199,14 @@ def _resolve(perm: Permutation, lib: Library) -> Resolved:
         raise KeyProblem("output", f"unknown output brick '{perm.output}'",
                          f"known: {', '.join(b.id for b in lib.of_kind('output'))}")
     out_node = _node(lib, out)
+    env_node, env_params = None, Params()
+    if perm.environment:
+        eb = lib.get("environment", perm.environment)
+        if eb is None:
+            raise KeyProblem("environment", f"unknown environment brick '{perm.environment}'",
+                             f"known: {', '.join(b.id for b in lib.of_kind('environment')) or 'none'}")
+        env_node = _node(lib, eb)
+        env_params = group([env_node], lib.memo)
     policy = spec_params(brdf, packing, out_node, [(ln, sh) for _, ln, sh in pairs], memo=lib.memo)
     lights = tuple(LightPart(lb, ln, sh, lk.dynamic, lp.params, lp.light, lp.shadow,
                              tuple(t for x in sh.tree for t in x.brick.textures))
@@ -208,7 +221,8 @@ def _resolve(perm: Permutation, lib: Library) -> Resolved:
     key = perm.canonical()
     r = Resolved(perm, key, perm.hash, brdf, "+".join(n.key for n in brdf), packing, dict(packing.fillers)["normal"],
                  lights, out, out_node, perm.surface, policy.brdf, policy.packing, policy.output, policy.material,
-                 Params(perm.surface.params()), Frozen(textures), tangent, frame, inputs, (), perm.origin)
+                 Params(perm.surface.params()), Frozen(textures), tangent, frame, inputs, (), perm.origin,
+                 env_node, env_params)
     # the verdict reads the value it belongs to: set before the value leaves here (a second dataclass made by
     # replace() cost as much as the rest of a resolve that the memos serve)
     object.__setattr__(r, "problems", tuple(_problems(r)))
@@ -224,6 +238,10 @@ def _problems(r: Resolved):
     if sf.vertex_color and "rho_d" not in r.brdf_params:
         yield ("vertex_color", "vertex_color multiplies rho_d, and this BRDF has no rho_d",
                "use a BRDF with a diffuse term (lambert, …) or drop vertex_color")
+    if r.environment is not None:  # what the environment's glue binds of the BRDF (spec/ambient.py)
+        what, todo = ambient_problem(r.brdf, r.brdf_params)
+        if what:
+            yield "brdf", what, todo
     clash = [k for k in r.surface_params if k in r.material_params]
     if clash:
         yield ("alpha" if clash[0] != "emissive" else "emissive", f"the surface state's parameter '{clash[0]}' is "

@@ -64,7 +64,7 @@ def _state_scene() -> str:
 def built(tmp_path_factory) -> dict[str, dict]:
     """Manifests of builds that between them write every field: the scenes of scenes/ (the example with packs, with
     packs only and on one platform), masked shadow casters, every surface state with tables, a glTF file, textures with samplers, a
-    removed permutation, a stale and a failed one, a scene with no object."""
+    removed permutation, a stale and a failed one, a scene with no object, an environment."""
     tmp = tmp_path_factory.mktemp("manifests")
     out: dict[str, dict] = {}
     out["example"] = _build(EXAMPLE, "--out", tmp / "example", "--pack")
@@ -82,6 +82,11 @@ def built(tmp_path_factory) -> dict[str, dict]:
         "[light_sets.crowd]\ndynamic = true\n", '[light_sets.crowd]\ndynamic = true\nculling = "tiles"\n')
     (tmp / "tiled.toml").write_text(tiled)
     out["tiled"] = _build(tmp / "tiled.toml", "--out", tmp / "tiled")  # a tiled set's LightTiles
+    (tmp / "environment.toml").write_text(  # image-based lighting: its values and textures marked "environment"
+        '[scene]\nenvironment = "sky"\nubershader = false\n[environments.sky]\nsky = "default"\nsize = 16\n'
+        '[materials.metal]\nbrdf = "microfacet(ndf=ggx,fresnel=schlick,vis=smith_ggx_height_correlated)"\n'
+        '[light_sets]\nnone = []\n[[objects]]\nmaterial = "metal"\nlights = "none"\n')
+    out["environment"] = _build(tmp / "environment.toml", "--out", tmp / "environment", "--platform", "vulkan")
     out["spot_shadow"] = _build(REPO / "tests" / "scenes" / "spot_shadow.toml", "--out", tmp / "spot",
                                 "--platform", "vulkan")  # a perspective shadow fit (its padding)
     out["vulkan"] = _build(EXAMPLE, "--out", tmp / "vulkan", "--platform", "vulkan")

@@ -261,8 +261,10 @@ class _FunctionEmitter(ControlEmitter):
     def intrinsic(self, e: ir.Intrinsic) -> str:
         args = [self.expr(a) for a in e.args]
         n = e.name
-        if n in ("sample", "sample_level"):  # level 0 only: the lod of sample_level is not read
+        if n in ("sample", "sample_level"):  # level 0, or (sample_level of a mip chain: resources._lod) its lod
             dim = e.args[0].ty.dim
+            if n == "sample_level" and not e.args[0].ty.arrayed:
+                return f"_lod({_SAMPLERS[dim]}, {args[0]}, {args[1]}, {args[2]})"
             layer = f", {args[2]}" if e.args[0].ty.arrayed else ""
             return f"{_SAMPLERS[dim]}({args[0]}, {args[1]}{layer})"
         if n == "sample_compare":

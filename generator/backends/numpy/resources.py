@@ -19,7 +19,8 @@ as 0 (alpha 1), as Vulkan expands formats with fewer components. Sampling is fix
 bilinear, clamp-to-edge addressing, texel centres at (i + 0.5) / W, mip level 0 only —
 a Vulkan sampler with VK_FILTER_LINEAR (min and mag), VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
 unnormalizedCoordinates off, on a one-level image (where implicit-LOD `sample` and
-any `sample_level` lod read level 0 too). Weights are exact (float64); a GPU may round
+any `sample_level` lod read level 0 too); a list of arrays given for a 2D or cube texture is a mip chain,
+which `sample_level` reads at its lod, linear between levels (`_lod`: mipmapMode LINEAR). Weights are exact (float64); a GPU may round
 them to its sub-texel precision (Vulkan requires ≥ 4 bits, subTexelPrecisionBits), so
 compare with a tolerance of that fraction of the texel differences. lavapipe filters
 float formats in float32: on R32G32B32A32_SFLOAT it agrees to ~1e-6
@@ -265,6 +266,26 @@ def _texcube(t, d):
     img = _image(t, cube=True)
     face, s, tt = cube_face(d)
     return _bilinear(img, face.astype(np.intp), s, tt).astype(d.dtype)
+
+
+def _lod(fetch, t, c, lod):
+    """sample_level of a 2D or cube texture: an array is one level (read there whatever the lod); a list or tuple
+    of arrays is a mip chain, level 0 first, read at `lod` clamped to [0, levels − 1], linear between the two
+    levels around it and bilinear within each (a Vulkan sampler with mipmapMode LINEAR and maxLod ≥ levels − 1:
+    d = floor(lod), (1 − frac) · level d + frac · level d + 1)."""
+    if not isinstance(t, (list, tuple)):
+        return fetch(t, c)
+    c = np.asarray(c)
+    lod = np.clip(np.nan_to_num(np.asarray(lod, np.float64)), 0.0, len(t) - 1.0)
+    k0 = np.floor(lod)
+    f = (lod - k0)[..., None]
+    k1 = np.minimum(k0 + 1.0, len(t) - 1.0)
+    out = None
+    for k, level in enumerate(t):
+        v = np.asarray(fetch(level, c), np.float64)
+        w = np.where((k0 == k)[..., None], 1.0 - f, 0.0) + np.where((k1 == k)[..., None], f, 0.0)
+        out = v * w if out is None else out + v * w
+    return out.astype(c.dtype)
 
 
 # ---------------------------------------------------------------- buffers from GPU bytes

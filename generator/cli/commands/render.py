@@ -47,9 +47,14 @@ def run(args) -> int:
         # the texture part of a build, into the render's folder: the renderer reads what an engine reads
         from ...assemble.render_inputs import scene_textures
         build = scene_textures(scene, out, lib)
+    environments = None
+    if scene.environment_of:  # image-based lighting: SH9, the prefiltered cubes, the AmbientBRDF tables, baked
+        from ...assemble.environments import bake
+        environments = bake(scene, lib)
     try:
         report = render_scene(scene, lib, args.mode, args.frames, out, (int(m[1]), int(m[2])),
-                              args.language, progress=progress(), build=build, export=args.export)
+                              args.language, progress=progress(), build=build, export=args.export,
+                              environments=environments)
     except VulkanUnavailable as e:
         raise VulkanUnavailable(f"no Vulkan device to render on: {e} — install Mesa lavapipe (`make setup`)") from None
     if report.cache_problem:
