@@ -78,7 +78,7 @@ def uploads(scene: Scene, h: str, c, objects: list[dict] | None = None, environm
         lb = c.interface.block("Lights")
         if lb is not None:
             lvals = {}
-            for i, (ln, slots) in enumerate(zip(obj["lights"], c.lights)):
+            for i, (ln, slots) in enumerate(zip(obj["lights"] if dyn is None else [], c.lights)):
                 v = light_values(scene, ln, c.interface.params.get(f"light{i}", {}))
                 lvals.update({s.name: _element(v[s.param], s) for s in slots})
             env = getattr(c, "environment", None) or []

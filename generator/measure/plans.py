@@ -201,6 +201,10 @@ def _compose(fn) -> Composed | str:
 
 # ------------------------------------------------------------------ per brick
 
+# the specular term an environment brick's row is measured on (an environment lights microfacet terms only)
+ENVIRONMENT_LIT = "lambert+microfacet(ndf=ggx,fresnel=schlick,vis=smith_ggx_height_correlated)"
+
+
 def standin(lib: Library, kind: str) -> Brick | None:
     """The stand-in brick of a kind (generator/measure/standins, or generated for slot kinds)."""
     return next((b for b in lib.of_kind(kind) if is_standin(b)), None)
@@ -312,6 +316,9 @@ def brick_rows(lib: Library, languages=REPORT_LANGUAGES, gpu=None, store=None) -
                 perm_plan("brick", b.id, kind, replace(base, packing=f"{standin(lib, 'packing').id}(normal={b.id})"))
             elif kind == "output":
                 perm_plan("brick", b.id, kind, replace(base, output=b.id))
+            elif kind == "environment":  # a GGX/Schlick metal lit by it, minus the same metal without it
+                metal = replace(base, brdf=ENVIRONMENT_LIT)
+                perm_plan("brick", b.id, kind, replace(metal, environment=b.id), baseline=metal)
             elif kind == "uv":  # in the first packing with a uv slot: that packing with minus without it
                 host = next((p for p in lib.of_kind("packing") if not is_standin(p)
                              and any(v["kind"] == "uv" for v in p.slots.values())), None)
@@ -426,7 +433,9 @@ def scene_rows(scene: Scene, lib: Library, languages=REPORT_LANGUAGES, gpu=None,
                 row_of("permutation", h, perm.canonical(), stage, lang, h, course, tuple(scene.users.get(h, [])),
                        len(perm.lights), "; ".join(errors[h]) if h in errors else None)
     perms = [scene.permutations[h] for h in sorted(scene.permutations) if h not in errors]
-    if perms:  # the scene's ubershader: one shader for every permutation (docs/design/link.md)
+    # the scene's ubershader: one shader for every permutation (docs/design/link.md); it does not draw environments
+    # yet (link/uber.py refuses them), so a scene with one has no ubershader row
+    if perms and not any(p.environment for p in perms):
         try:
             uber, _ = compose_ubershader(perms, lib, languages)
             jobs = source_jobs("ubershader", uber.sources)
