@@ -134,7 +134,7 @@ def test_a_metal_sphere_reflects_its_environment_as_the_split_sum_says(lib, devi
 def test_the_default_sky_with_its_sun_lights_a_metal(lib, device, tmp_path):
     from generator.assemble.environments import bake
 
-    scene = _load(lib, tmp_path, _scene('sky = "default"\nintensity = 0.5\nsize = 16'))
+    scene = _load(lib, tmp_path, _scene('sky = "default"\nintensity = 0.5\nsize = 8'))
     inputs = bake(scene, lib)
     got = _render(lib, device, scene, tmp_path, "glsl", inputs)
     hit, _, _ = _expected(scene, inputs)
